@@ -1,0 +1,101 @@
+"""Turn an IRML description into a generic :class:`Chain`; combine rigid bodies."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.description._model import Chain, Inertial, RobotDescription
+
+
+def rot_z(theta: float) -> FloatArray:
+    c, s = np.cos(theta), np.sin(theta)
+    out = np.eye(4)
+    out[:2, :2] = [[c, -s], [s, c]]
+    return out
+
+
+def dh_link(d: float, r: float, alpha: float) -> FloatArray:
+    """Constant part of a standard DH transform: ``Tz(d) @ Tx(r) @ Rx(alpha)``."""
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    return np.array(
+        [[1.0, 0.0, 0.0, r], [0.0, ca, -sa, 0.0], [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]]
+    )
+
+
+def dh_transform(theta: float, d: float, r: float, alpha: float) -> FloatArray:
+    """Thesis eq. 2.10: ``Rz(theta) Tz(d) Tx(r) Rx(alpha)``."""
+    return rot_z(theta) @ dh_link(d, r, alpha)
+
+
+def transform_inertial(inertial: Inertial, transform: FloatArray) -> Inertial:
+    """Express a body's mass properties in another frame (``p_new = T @ p_old``)."""
+    rot = transform[:3, :3]
+    return Inertial.from_arrays(
+        inertial.mass,
+        rot @ inertial.com_array + transform[:3, 3],
+        rot @ inertial.inertia_array @ rot.T,
+    )
+
+
+def combine_inertials(a: Inertial, b: Inertial) -> Inertial:
+    """Mass properties of two rigid bodies fixed together (same frame)."""
+    m = a.mass + b.mass
+    if m <= 0:
+        raise ValueError("combined mass must be positive")
+    c = (a.mass * a.com_array + b.mass * b.com_array) / m
+    total = np.zeros((3, 3))
+    for body in (a, b):
+        d = body.com_array - c
+        total += body.inertia_array + body.mass * (d @ d * np.eye(3) - np.outer(d, d))
+    return Inertial.from_arrays(m, c, total)
+
+
+def _nan_if_none(values: list[float | None]) -> FloatArray:
+    return np.array([np.nan if v is None else v for v in values], dtype=float)
+
+
+def chain_from_description(
+    desc: RobotDescription, *, gravity: float = 9.80665, payload: Inertial | None = None
+) -> Chain:
+    """Build the kinematic/dynamic chain of an IRML description.
+
+    Joint frame ``i`` is DH frame ``i-1`` rotated by ``offset_i + sign_i * q_i``
+    about its z axis; link ``i``'s mass properties, given in DH frame ``i``, are
+    moved into joint frame ``i`` by the constant ``Tz(d_i) Tx(r_i) Rx(alpha_i)``;
+    the tool frame is DH frame ``n``. A payload (given in the tool frame) is added
+    to the last link; ``payload`` overrides the description's own.
+    """
+    n = len(desc.joints)
+    placements = np.empty((n, 4, 4))
+    coms = np.empty((n, 3))
+    inertias = np.empty((n, 3, 3))
+    prev = np.eye(4)
+    links = []
+    for i, j in enumerate(desc.joints):
+        placements[i] = prev @ rot_z(j.offset)
+        link = dh_link(j.d, j.r, j.alpha)
+        links.append(transform_inertial(j.inertial, link))
+        prev = link
+    tool = prev
+    load = payload if payload is not None else desc.payload
+    if load is not None and load.mass > 0:
+        links[-1] = combine_inertials(links[-1], transform_inertial(load, tool))
+    for i, body in enumerate(links):
+        coms[i] = body.com_array
+        inertias[i] = body.inertia_array
+    return Chain(
+        name=desc.name,
+        joint_names=tuple(f"joint_{j.id}" for j in desc.joints),
+        placements=placements,
+        axes=np.array([[0.0, 0.0, j.sign] for j in desc.joints]),
+        masses=np.array([b.mass for b in links]),
+        coms=coms,
+        inertias=inertias,
+        tool=tool,
+        lower=_nan_if_none([j.lower for j in desc.joints]),
+        upper=_nan_if_none([j.upper for j in desc.joints]),
+        velocity=_nan_if_none([j.velocity for j in desc.joints]),
+        effort=_nan_if_none([j.effort for j in desc.joints]),
+        gravity=np.array([0.0, 0.0, -gravity]),
+    )

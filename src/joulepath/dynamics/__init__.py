@@ -1,0 +1,24 @@
+"""Rigid-body dynamics: the :class:`Robot`, two inverse-dynamics implementations, friction."""
+
+from joulepath.dynamics._friction import (
+    CoulombViscousFriction,
+    ElastoPlasticFriction,
+    Friction,
+    FrictionSum,
+)
+from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le
+from joulepath.dynamics._rnea import PinocchioRnea
+from joulepath.dynamics._robot import METHODS, Robot, load_robot
+
+__all__ = [
+    "METHODS",
+    "CoulombViscousFriction",
+    "ElastoPlasticFriction",
+    "Friction",
+    "FrictionSum",
+    "PinocchioRnea",
+    "Robot",
+    "lagrange_euler",
+    "load_robot",
+    "mass_matrix_le",
+]

@@ -1,0 +1,124 @@
+"""Joint friction as composable per-joint terms.
+
+A friction term maps joint velocities ``qd`` (``(..., n)``, rad/s) to the torque
+the drives must add to overcome friction (``(..., n)``, N·m); it opposes motion,
+so it has the sign of ``qd``. Terms add up with ``+``::
+
+    friction = ElastoPlasticFriction() + CoulombViscousFriction(viscous=0.1)
+
+Parameters are scalars (every joint) or sequences of one value per joint.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.errors import InvalidInput
+
+PerJoint = float | tuple[float, ...]
+
+
+@runtime_checkable
+class Friction(Protocol):
+    """Anything with ``torque(qd) -> tau_friction`` of the same shape."""
+
+    def torque(self, qd: FloatArray) -> FloatArray: ...
+
+
+class _Addable:
+    def __add__(self, other: Friction) -> FrictionSum:
+        if not isinstance(other, Friction):
+            return NotImplemented
+        left = self.terms if isinstance(self, FrictionSum) else (self,)
+        right = other.terms if isinstance(other, FrictionSum) else (other,)
+        return FrictionSum(terms=(*left, *right))  # type: ignore[arg-type]
+
+
+def _param(value: PerJoint, name: str) -> FloatArray:
+    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    if arr.ndim != 1 or not np.all(np.isfinite(arr)) or np.any(arr < 0):
+        raise InvalidInput(f"friction parameter {name} must be ≥ 0 (one value or one per joint)")
+    return arr
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ElastoPlasticFriction(_Addable):
+    """The thesis' elasto-plastic friction (§2.1, Appendix B), ``mu_k = 0.504, mu_s = 0.302``.
+
+    ``form="listing"`` (default) is what the thesis' code computes::
+
+        tau_f = mu_k * sgn(qd) * (1 - exp(-(|qd| - mu_s) / mu_k))
+
+    ``form="text"`` is the printed equation::
+
+        tau_f = mu_k * sgn(qd) * (1 - exp(-|qd| - mu_s) / mu_k)
+
+    Both are zero at ``qd = 0``, jump at 0 and change sign at low speed (the
+    listing form below ``|qd| = mu_s``); they are reproduced as published. Use
+    :class:`CoulombViscousFriction` for a conventional model.
+    """
+
+    mu_k: PerJoint = 0.504
+    mu_s: PerJoint = 0.302
+    form: str = "listing"
+
+    def __post_init__(self) -> None:
+        if self.form not in ("listing", "text"):
+            raise InvalidInput(f"form must be 'listing' or 'text', got {self.form!r}")
+        if np.any(_param(self.mu_k, "mu_k") == 0):
+            raise InvalidInput("mu_k must be positive")
+        _param(self.mu_s, "mu_s")
+
+    def torque(self, qd: FloatArray) -> FloatArray:
+        mk = _param(self.mu_k, "mu_k")
+        ms = _param(self.mu_s, "mu_s")
+        v = np.abs(qd)
+        if self.form == "listing":
+            shape = 1.0 - np.exp(-(v - ms) / mk)
+        else:
+            shape = 1.0 - np.exp(-v - ms) / mk
+        out: FloatArray = mk * np.sign(qd) * shape
+        return out
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CoulombViscousFriction(_Addable):
+    """``tau_f = coulomb * sgn(qd) + viscous * qd`` (N·m and N·m·s/rad).
+
+    With ``smoothing > 0`` (rad/s) the sign is replaced by ``tanh(qd / smoothing)``,
+    which keeps the torque continuous through zero speed.
+    """
+
+    coulomb: PerJoint = 0.0
+    viscous: PerJoint = 0.0
+    smoothing: float = 0.0
+
+    def __post_init__(self) -> None:
+        _param(self.coulomb, "coulomb")
+        _param(self.viscous, "viscous")
+        if not self.smoothing >= 0:
+            raise InvalidInput("smoothing must be ≥ 0 rad/s")
+
+    def torque(self, qd: FloatArray) -> FloatArray:
+        fc = _param(self.coulomb, "coulomb")
+        fv = _param(self.viscous, "viscous")
+        sgn = np.tanh(qd / self.smoothing) if self.smoothing > 0 else np.sign(qd)
+        out: FloatArray = fc * sgn + fv * qd
+        return out
+
+
+@dataclass(frozen=True, slots=True)
+class FrictionSum(_Addable):
+    """The sum of several friction terms."""
+
+    terms: tuple[Friction, ...]
+
+    def torque(self, qd: FloatArray) -> FloatArray:
+        total = np.zeros_like(qd, dtype=float)
+        for term in self.terms:
+            total = total + term.torque(qd)
+        return total

@@ -1,0 +1,331 @@
+"""The :class:`Robot`: a chain with its kinematics, dynamics, limits and checks."""
+
+from __future__ import annotations
+
+import os
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from joulepath import energy as _energy
+from joulepath._typing import ArrayLike, FloatArray
+from joulepath.description import (
+    HOME,
+    PRESETS,
+    Chain,
+    Finding,
+    Inertial,
+    RobotDescription,
+    chain_from_description,
+    chain_from_urdf,
+    check_inertial,
+    check_physical,
+    pinocchio_model,
+    preset_path,
+    read_irml,
+)
+from joulepath.dynamics._friction import Friction
+from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le
+from joulepath.dynamics._rnea import PinocchioRnea
+from joulepath.errors import InvalidInput, InvalidRobotDescription
+from joulepath.kinematics import Pose, check_q, forward_kinematics, geometric_jacobian
+
+METHODS = ("pinocchio", "lagrange-euler")
+
+
+class Robot:
+    """A six-axis (or any n-axis serial revolute) arm.
+
+    Build one with :func:`load_robot`. Joint arrays have shape ``(..., n)`` with
+    any batch shape, in SI units (rad, rad/s, rad/s², N·m).
+
+    Examples
+    --------
+    >>> robot = load_robot("irb120")
+    >>> robot.fk([0, 0, 0, 0, 0, 0]).position_mm.round(3)
+    array([374.,   0., 630.])
+    """
+
+    def __init__(
+        self,
+        chain: Chain,
+        *,
+        description: RobotDescription | None = None,
+        source: str | None = None,
+        payload: Inertial | None = None,
+    ) -> None:
+        self.chain = chain
+        self.description = description
+        self.source = source
+        self.payload = payload
+
+    # ------------------------------------------------------------------ facts
+    @property
+    def name(self) -> str:
+        return self.chain.name
+
+    @property
+    def n_joints(self) -> int:
+        return self.chain.n_joints
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        return self.chain.joint_names
+
+    @property
+    def lower(self) -> FloatArray:
+        """Nominal lower joint limits, rad (NaN where unknown)."""
+        return self.chain.lower.copy()
+
+    @property
+    def upper(self) -> FloatArray:
+        return self.chain.upper.copy()
+
+    @property
+    def velocity_limit(self) -> FloatArray:
+        """Maximum joint speeds, rad/s (NaN where unknown)."""
+        return self.chain.velocity.copy()
+
+    @property
+    def effort_limit(self) -> FloatArray:
+        """Maximum joint torques, N·m (NaN where unknown)."""
+        return self.chain.effort.copy()
+
+    @property
+    def home(self) -> FloatArray:
+        """Home configuration (rad): q = 0 in ABB's convention."""
+        return np.zeros(self.n_joints)
+
+    def joint_ranges(self, name: str = "nominal") -> tuple[FloatArray, FloatArray]:
+        """``(lower, upper)`` of a named range set (``"nominal"``, or e.g. ``"lab"``)."""
+        if name == "nominal":
+            return self.lower, self.upper
+        if self.description is None:
+            raise InvalidInput(f"robot {self.name!r} has only the 'nominal' range set")
+        rs = self.description.range_set(name)
+        return np.array(rs.lower), np.array(rs.upper)
+
+    @property
+    def range_set_names(self) -> tuple[str, ...]:
+        extra = tuple(rs.name for rs in self.description.range_sets) if self.description else ()
+        return ("nominal", *extra)
+
+    # ------------------------------------------------------------- kinematics
+    def fk(self, q: ArrayLike) -> Pose:
+        """Tool0 pose for ``q`` of shape ``(..., n)`` (rad)."""
+        return forward_kinematics(self.chain, q)
+
+    def jacobian(self, q: ArrayLike) -> FloatArray:
+        """Geometric Jacobian at tool0 in the base frame, shape ``(..., 6, n)``."""
+        return geometric_jacobian(self.chain, q)
+
+    # --------------------------------------------------------------- dynamics
+    @cached_property
+    def pinocchio_model(self) -> Any:
+        """The ``pinocchio.Model`` of this robot (with a ``tool0`` frame)."""
+        return pinocchio_model(self.chain)
+
+    @cached_property
+    def _rnea(self) -> PinocchioRnea:
+        return PinocchioRnea(self.pinocchio_model)
+
+    def _broadcast(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike
+    ) -> tuple[FloatArray, FloatArray, FloatArray, tuple[int, ...]]:
+        n = self.n_joints
+        arrays = [check_q(x, n, name) for x, name in ((q, "q"), (qd, "qd"), (qdd, "qdd"))]
+        try:
+            shape = np.broadcast_shapes(*(a.shape for a in arrays))
+        except ValueError as err:
+            raise InvalidInput(
+                f"q, qd and qdd have shapes {[a.shape for a in arrays]} that do not broadcast"
+            ) from err
+        flat = [np.broadcast_to(a, shape).reshape(-1, n) for a in arrays]
+        return flat[0], flat[1], flat[2], shape
+
+    def inverse_dynamics(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        *,
+        friction: Friction | None = None,
+        method: str = "pinocchio",
+    ) -> FloatArray:
+        """Joint torques τ(q, qd, qdd) in N·m, same batch shape as the inputs.
+
+        Parameters
+        ----------
+        q, qd, qdd : array_like of shape (..., n)
+            rad, rad/s, rad/s²; broadcast against each other.
+        friction : Friction, optional
+            Added to the rigid-body torque (see :mod:`joulepath.dynamics`).
+        method : {"pinocchio", "lagrange-euler"}
+            Pinocchio's RNEA (fast) or the thesis' Lagrange–Euler formulation
+            (independent cross-check, slower).
+        """
+        qf, qdf, qddf, shape = self._broadcast(q, qd, qdd)
+        if method == "pinocchio":
+            tau = self._rnea(qf, qdf, qddf)
+        elif method == "lagrange-euler":
+            tau = lagrange_euler(self.chain, qf, qdf, qddf)
+        else:
+            raise InvalidInput(f"method must be one of {METHODS}, got {method!r}")
+        if friction is not None:
+            tau = tau + friction.torque(qdf)
+        return tau.reshape(shape)
+
+    def mass_matrix(self, q: ArrayLike) -> FloatArray:
+        """Joint-space inertia matrix D(q), shape ``(..., n, n)`` (Lagrange–Euler eq. 2.20)."""
+        qa = check_q(q, self.n_joints)
+        flat = qa.reshape(-1, self.n_joints)
+        return mass_matrix_le(self.chain, flat).reshape(qa.shape + (self.n_joints,))
+
+    def gravity_torque(self, q: ArrayLike) -> FloatArray:
+        """Static holding torques at rest, N·m, shape ``(..., n)``."""
+        qa = check_q(q, self.n_joints)
+        zero = np.zeros_like(qa)
+        return self.inverse_dynamics(qa, zero, zero)
+
+    def joint_energy(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        dt: float | ArrayLike,
+        *,
+        friction: Friction | None = None,
+        mode: str = "absolute",
+        copper_loss: float | ArrayLike | None = None,
+    ) -> FloatArray:
+        """Per-sample, per-joint energy (J) of sampled motion: see :func:`joulepath.energy.joint_energy`."""
+        tau = self.inverse_dynamics(q, qd, qdd, friction=friction)
+        return _energy.joint_energy(tau, np.asarray(qd, float), dt, mode=mode, copper_loss=copper_loss)
+
+    def path_energy(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        dt: float | ArrayLike,
+        *,
+        friction: Friction | None = None,
+        mode: str = "absolute",
+        copper_loss: float | ArrayLike | None = None,
+    ) -> _energy.PathEnergy:
+        """Energy of sampled paths ``(..., n_steps, n)``: per joint and total, summed over time."""
+        tau = self.inverse_dynamics(q, qd, qdd, friction=friction)
+        return _energy.path_energy(tau, np.asarray(qd, float), dt, mode=mode, copper_loss=copper_loss)
+
+    # ---------------------------------------------------------------- payload
+    def with_payload(
+        self,
+        mass: float,
+        com: ArrayLike = (0.0, 0.0, 0.0),
+        inertia: ArrayLike | None = None,
+    ) -> Robot:
+        """A copy of this robot carrying a payload at tool0.
+
+        Parameters
+        ----------
+        mass : float
+            kg (ABB ``loaddata.mass``).
+        com : array_like of shape (3,)
+            Centre of mass in the tool0 frame, m (ABB ``loaddata.cog``, in mm there).
+        inertia : array_like of shape (3, 3) or (3,), optional
+            About the centre of mass, tool0 axes, kg·m²; a 3-vector is the diagonal
+            (ABB ``ix, iy, iz``). Default: a point mass.
+        """
+        inertia_arr = np.zeros((3, 3)) if inertia is None else np.asarray(inertia, dtype=float)
+        if inertia_arr.shape == (3,):
+            inertia_arr = np.diag(inertia_arr)
+        load = Inertial.from_arrays(mass, com, inertia_arr)
+        problems = [f for f in check_inertial("payload", load) if f.severity == "error"]
+        if mass < 0 or (mass > 0 and inertia is not None and problems):
+            raise InvalidInput("; ".join(str(p) for p in problems) or "payload mass must be ≥ 0")
+        if self.description is not None:
+            chain = chain_from_description(self.description, payload=load)
+        else:
+            from joulepath.description import combine_inertials, transform_inertial
+
+            base = Inertial.from_arrays(
+                self.chain.masses[-1], self.chain.coms[-1], self.chain.inertias[-1]
+            )
+            last = combine_inertials(base, transform_inertial(load, self.chain.tool))
+            masses = self.chain.masses.copy()
+            coms = self.chain.coms.copy()
+            inertias = self.chain.inertias.copy()
+            masses[-1], coms[-1], inertias[-1] = last.mass, last.com_array, last.inertia_array
+            from dataclasses import replace
+
+            chain = replace(self.chain, masses=masses, coms=coms, inertias=inertias)
+        return Robot(chain, description=self.description, source=self.source, payload=load)
+
+    # ----------------------------------------------------------------- checks
+    def check_physical(self) -> list[Finding]:
+        """Everything not physical about this robot's description (errors first)."""
+        if self.description is not None:
+            return check_physical(self.description)
+        out: list[Finding] = []
+        for i, name in enumerate(self.joint_names):
+            body = Inertial.from_arrays(self.chain.masses[i], self.chain.coms[i], self.chain.inertias[i])
+            out += check_inertial(f"link of {name}", body)
+            lo, hi = self.chain.lower[i], self.chain.upper[i]
+            if np.isfinite(lo) and np.isfinite(hi) and not lo < hi:
+                out.append(Finding("error", f"{name} limits", f"lower {lo} ≥ upper {hi}"))
+        out.sort(key=lambda f: f.severity != "error")
+        return out
+
+    def summary(self) -> str:
+        """A few lines describing the robot (used by ``joulepath robot show``)."""
+        lines = [f"{self.name}  ({self.n_joints} revolute joints, source: {self.source})"]
+        if self.description is not None and self.description.manufacturer:
+            lines[0] = f"{self.description.manufacturer} " + lines[0]
+        lines.append("joint        lower°    upper°   speed°/s   mass kg")
+        for i, name in enumerate(self.joint_names):
+            lo, hi, v = np.degrees([self.chain.lower[i], self.chain.upper[i], self.chain.velocity[i]])
+            lines.append(
+                f"{name:<10} {lo:8.1f}  {hi:8.1f}  {v:8.1f}  {self.chain.masses[i]:8.3f}"
+            )
+        lines.append(f"moving mass {self.chain.masses.sum():.3f} kg")
+        if self.payload is not None:
+            lines.append(f"payload {self.payload.mass:.3f} kg at {self.payload.com} m (tool0)")
+        if len(self.range_set_names) > 1:
+            lines.append("range sets: " + ", ".join(self.range_set_names))
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        return f"Robot(name={self.name!r}, n_joints={self.n_joints}, source={self.source!r})"
+
+
+def load_robot(name_or_path: str | os.PathLike[str], *, tool_frame: str | None = None) -> Robot:
+    """Load a bundled robot by name (``"irb120"``) or a robot file (``.irml`` or ``.urdf``).
+
+    Raises
+    ------
+    InvalidRobotDescription
+        Unknown name, unreadable or invalid file, unsupported extension.
+    """
+    text = os.fspath(name_or_path)
+    if text in PRESETS:
+        path = preset_path(text)
+    else:
+        path = Path(text)
+        if not path.exists():
+            raise InvalidRobotDescription(
+                f"{text}: no such file and not a bundled robot (bundled: {', '.join(PRESETS)})"
+            )
+    suffix = path.suffix.lower()
+    if suffix in (".irml", ".xml"):
+        desc = read_irml(path)
+        return Robot(chain_from_description(desc), description=desc, source=str(path))
+    if suffix == ".urdf":
+        return Robot(chain_from_urdf(path, tool_frame=tool_frame), source=str(path))
+    raise InvalidRobotDescription(
+        f"{path}: unknown robot file type {suffix!r}; use .irml or .urdf"
+    )
+
+
+__all__ = ["HOME", "METHODS", "Robot", "load_robot"]

@@ -1,0 +1,35 @@
+"""Errors raised by joulepath.
+
+Every error a user can cause derives from :class:`JoulepathError`; each leaf also
+derives from the matching built-in so that ``except ValueError`` keeps working::
+
+    JoulepathError
+    ├── InvalidRobotDescription (ValueError)   a robot file that cannot be used
+    ├── InvalidInput (ValueError)              arrays or arguments of the wrong shape or range
+    ├── LimitViolation (ValueError)            a result that would drive a joint past a limit
+    └── MissingDependency (ImportError)        an optional extra is not installed
+
+Messages say what was received, what was expected and how to fix it.
+"""
+
+from __future__ import annotations
+
+
+class JoulepathError(Exception):
+    """Base class of every error joulepath raises on bad input."""
+
+
+class InvalidRobotDescription(JoulepathError, ValueError):
+    """A robot description (IRML, URDF) is missing a field or holds an invalid value."""
+
+
+class InvalidInput(JoulepathError, ValueError):
+    """An argument has the wrong shape, type or range."""
+
+
+class LimitViolation(JoulepathError, ValueError):
+    """A trajectory or program would drive a joint past its range, speed or torque."""
+
+
+class MissingDependency(JoulepathError, ImportError):
+    """An optional dependency is not installed; the message names the extra to install."""

@@ -1,0 +1,29 @@
+"""Kinematics of a serial chain: tool pose (ABB units and conventions) and Jacobian."""
+
+from joulepath.kinematics._fk import (
+    Pose,
+    check_q,
+    forward_kinematics,
+    geometric_jacobian,
+    link_frames,
+)
+from joulepath.kinematics._rotations import (
+    axis_angle_matrix,
+    euler_zyx_to_rotation,
+    quaternion_to_rotation,
+    rotation_to_euler_zyx,
+    rotation_to_quaternion,
+)
+
+__all__ = [
+    "Pose",
+    "axis_angle_matrix",
+    "check_q",
+    "euler_zyx_to_rotation",
+    "forward_kinematics",
+    "geometric_jacobian",
+    "link_frames",
+    "quaternion_to_rotation",
+    "rotation_to_euler_zyx",
+    "rotation_to_quaternion",
+]
