@@ -1,0 +1,5 @@
+"""``python -m joulepath``."""
+
+from joulepath.cli import main
+
+raise SystemExit(main())

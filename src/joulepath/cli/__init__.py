@@ -1,0 +1,5 @@
+"""The ``joulepath`` command line: thin over the library (see ``joulepath --help``)."""
+
+from joulepath.cli._main import main
+
+__all__ = ["main"]

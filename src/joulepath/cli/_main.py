@@ -1,0 +1,67 @@
+"""Entry point: parse, dispatch, and turn user errors into one line and exit code 2."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+
+import typer
+
+from joulepath.cli._robot import robot_app
+from joulepath.cli._demo import demo
+from joulepath.errors import JoulepathError
+
+app = typer.Typer(
+    name="joulepath",
+    help="Energy-optimal point-to-point moves for six-axis industrial robot arms.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+app.add_typer(robot_app, name="robot")
+app.command("demo")(demo)
+
+
+def _version(value: bool) -> None:
+    if value:
+        from joulepath import __version__
+
+        typer.echo(f"joulepath {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    debug: bool = typer.Option(False, "--debug", help="Show tracebacks of errors."),
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Print the version."
+    ),
+) -> None:
+    """Energy-optimal point-to-point moves for six-axis industrial robot arms."""
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI with ``argv`` (default: ``sys.argv[1:]``); return the exit code."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in args
+    if debug:  # accepted anywhere on the line, handled as a root option
+        args = ["--debug", *(a for a in args if a != "--debug")]
+    try:
+        result = app(args=args, prog_name="joulepath", standalone_mode=False)
+    except JoulepathError as err:
+        if debug:
+            raise
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    except typer.Exit as err:
+        return int(err.exit_code)
+    except typer.Abort:
+        print("aborted", file=sys.stderr)
+        return 130
+    except typer.TyperException as err:  # usage errors: bad option values, missing arguments
+        show = getattr(err, "show", None)
+        if show is None:
+            raise
+        show()
+        return 2
+    return int(result) if isinstance(result, int) else 0
