@@ -245,14 +245,13 @@ def parse_irml(data: str | bytes, *, source: str = "<string>") -> RobotDescripti
     name = _text(_child(root, "name", ctx, "robot"), ctx, "robot")
     manu = _children(root, "manufacturer")
     manufacturer = (manu[0].text or "").strip() if manu else ""
-    joints: list[JointDescription] = []
-    seen: set[int] = set()
+    seen: set[str] = set()
     for el in _children(root, "joint"):
-        joint = _joint(el, ctx)
-        if joint.id in seen:
-            raise ctx.fail(f"joint {joint.id}", "duplicate joint id", "give each joint its own id")
-        seen.add(joint.id)
-        joints.append(joint)
+        raw = (el.get("id") or "").strip()
+        if raw and raw in seen:
+            raise ctx.fail(f"joint {raw}", "duplicate joint id", "give each joint its own id")
+        seen.add(raw)
+    joints = [_joint(el, ctx) for el in _children(root, "joint")]
     if not joints:
         raise ctx.fail("robot", "has no <joint>", "describe at least one joint")
     info: list[tuple[str, str]] = []
