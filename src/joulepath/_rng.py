@@ -25,7 +25,7 @@ def check_rng(seed: int | np.random.Generator | None) -> np.random.Generator:
 
     Examples
     --------
-    >>> check_rng(3).integers(10) == check_rng(3).integers(10)
+    >>> bool(check_rng(3).integers(10) == check_rng(3).integers(10))
     True
     """
     if isinstance(seed, np.random.Generator):

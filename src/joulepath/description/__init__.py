@@ -23,12 +23,12 @@ from joulepath.description._pinocchio import chain_from_urdf, pinocchio_model
 from joulepath.description._presets import HOME, PRESETS, preset_description, preset_path
 
 __all__ = [
-    "HOME",
-    "PRESETS",
     "Chain",
     "Finding",
+    "HOME",
     "Inertial",
     "JointDescription",
+    "PRESETS",
     "RangeSet",
     "RobotDescription",
     "chain_from_description",

@@ -11,11 +11,11 @@ from joulepath.dynamics._rnea import PinocchioRnea
 from joulepath.dynamics._robot import METHODS, Robot, load_robot
 
 __all__ = [
-    "METHODS",
     "CoulombViscousFriction",
     "ElastoPlasticFriction",
     "Friction",
     "FrictionSum",
+    "METHODS",
     "PinocchioRnea",
     "Robot",
     "lagrange_euler",
