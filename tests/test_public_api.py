@@ -10,7 +10,7 @@ import joulepath
 
 SRC = Path(joulepath.__file__).parent
 PACKAGES = ["joulepath", "joulepath.description", "joulepath.kinematics", "joulepath.dynamics",
-            "joulepath.trajectory"]
+            "joulepath.trajectory", "joulepath.data", "joulepath.export", "joulepath.sim"]
 
 
 @pytest.mark.parametrize("name", PACKAGES)
@@ -37,12 +37,16 @@ ALLOWED = {
     "kinematics": {"description"},
     "dynamics": {"description", "kinematics", "energy"},
     "trajectory": {"description", "kinematics", "dynamics"},
+    "data": {"dynamics"},  # annotations only (TYPE_CHECKING); robot passed in by the caller
+    "export": {"description", "kinematics", "dynamics", "trajectory", "data"},
+    "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb"},
     "energy": set(),
     "units": set(),
+    "abb": set(),
     "demo": {"description", "kinematics", "dynamics", "trajectory", "energy"},
     "cli": None,  # may import anything
 }
-FOUNDATION = {"_typing", "_rng", "_io", "errors", "units"}
+FOUNDATION = {"_typing", "_rng", "_io", "errors", "units", "abb", "__version__"}
 
 
 def _imports(path: Path) -> set[str]:

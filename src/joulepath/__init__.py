@@ -10,6 +10,7 @@ from joulepath import energy, units
 from joulepath.dynamics import Robot, load_robot
 from joulepath.errors import (
     InvalidInput,
+    InvalidLog,
     InvalidRobotDescription,
     JoulepathError,
     LimitViolation,
@@ -20,6 +21,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "InvalidInput",
+    "InvalidLog",
     "InvalidRobotDescription",
     "JoulepathError",
     "LimitViolation",

@@ -6,6 +6,7 @@ derives from the matching built-in so that ``except ValueError`` keeps working::
     JoulepathError
     ├── InvalidRobotDescription (ValueError)   a robot file that cannot be used
     ├── InvalidInput (ValueError)              arrays or arguments of the wrong shape or range
+    ├── InvalidLog (ValueError)                a joint log or energy table that cannot be used
     ├── LimitViolation (ValueError)            a result that would drive a joint past a limit
     └── MissingDependency (ImportError)        an optional extra is not installed
 
@@ -25,6 +26,10 @@ class InvalidRobotDescription(JoulepathError, ValueError):
 
 class InvalidInput(JoulepathError, ValueError):
     """An argument has the wrong shape, type or range."""
+
+
+class InvalidLog(JoulepathError, ValueError):
+    """A joint log (or energy table) is malformed; the message names file, line and field."""
 
 
 class LimitViolation(JoulepathError, ValueError):

@@ -7,6 +7,7 @@ from collections.abc import Sequence
 
 import typer
 
+from joulepath.cli._data import ingest, rapid_app, simulate
 from joulepath.cli._robot import robot_app
 from joulepath.cli._demo import demo
 from joulepath.errors import JoulepathError
@@ -19,6 +20,9 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 app.add_typer(robot_app, name="robot")
+app.add_typer(rapid_app, name="rapid")
+app.command("simulate")(simulate)
+app.command("ingest")(ingest)
 app.command("demo")(demo)
 
 

@@ -1,0 +1,91 @@
+"""``joulepath rapid collect``, ``joulepath simulate``, ``joulepath ingest``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from joulepath.cli._common import console
+
+rapid_app = typer.Typer(help="Write RAPID programs for the ABB controller.", no_args_is_help=True)
+
+
+@rapid_app.command("collect")
+def rapid_collect(
+    out: Path = typer.Option(..., "--out", help="Folder for JPCollect.mod and JPMeasure.mod."),
+    robot: str = typer.Option("irb120", help="Robot name or .irml/.urdf path."),
+    moves: int = typer.Option(1000, min=1, help="Number of random moves."),
+    range_set: str = typer.Option("collection", help="Joint bounds: collection (App. D.1), lab, nominal."),
+    mode: str = typer.Option("rand", help="rand: draw on the controller; table: embed the moves of --seed."),
+    seed: int = typer.Option(0, help="Seed of the moves (table) or of the controller's generator (rand)."),
+) -> int:
+    """Write the data-collection programs of thesis Appendix D (collection + measurement)."""
+    from joulepath import load_robot
+    from joulepath._io import atomic_write_text
+    from joulepath.export import collection_programs
+
+    programs = collection_programs(
+        load_robot(robot), n_moves=moves, range_set=range_set, mode=mode, seed=seed
+    )
+    out.mkdir(parents=True, exist_ok=True)
+    for name, text in programs.items():
+        atomic_write_text(out / name, text)
+        console.print(f"wrote {out / name}")
+    return 0
+
+
+def simulate(
+    out: Path = typer.Option(..., "--out", help="Log file (.csv) for one run, or a folder for --plan."),
+    plant: str = typer.Option("lab", help="sim (nominal twin) or lab (emulated real robot)."),
+    moves: int = typer.Option(1000, min=1, help="Number of random moves."),
+    seed: int = typer.Option(0, help="Seed of the random moves and of the plant's noise."),
+    plan: str = typer.Option("", help="'thesis': real, sim, micro and test datasets in one go."),
+    robot: str = typer.Option("irb120", help="Robot name or .irml path."),
+    workers: int = typer.Option(2, min=1, help="Processes for --plan."),
+) -> int:
+    """Simulate data collection: random moves on the sim or lab plant, logged like the controller."""
+    from joulepath.sim import simulate as run, simulate_plan
+
+    if plan:
+        if plan != "thesis":
+            raise typer.BadParameter(f"unknown plan {plan!r}; the only plan is 'thesis'", param_hint="--plan")
+        with console.status("simulating the thesis' datasets (real, sim, micro, test)..."):
+            results = simulate_plan(
+                out, seed=seed, robot=robot, workers=workers,
+                progress=lambda r: console.print(
+                    f"  {r['name']:>5}: {r['moves']} {r['plant']} moves, {r['rows']:,} log rows, "
+                    f"{r['table_rows']:,} table rows in {r['table_moves']} moves"
+                ),
+            )
+        console.print(f"wrote {len(results)} logs under {out / 'logs'} and tables {out}/<name>.parquet")
+        return 0
+    target = out if out.suffix == ".csv" else out / f"{plant}-{seed}.csv"
+    with console.status(f"simulating {moves} moves on the {plant} plant..."):
+        res = run(target, plant=plant, n_moves=moves, seed=seed, robot=robot)
+    console.print(
+        f"wrote {res.log} ({res.n_rows:,} rows, {res.n_moves} moves, {res.duration_s:.1f} s) "
+        f"and {res.moves}"
+    )
+    return 0
+
+
+def ingest(
+    logs: list[Path] = typer.Argument(..., help="Controller logs (App. D.2) or generic joint CSVs."),
+    out: Path = typer.Option(..., "--out", help="Energy table to write (.parquet)."),
+    robot: str = typer.Option(
+        "", help="Robot of the logs: checks controller logs' TCP columns, gives generic logs the full 40 features."
+    ),
+) -> int:
+    """Turn joint logs into the 40-feature energy table (or the joint-only one)."""
+    from joulepath import load_robot
+    from joulepath.data import ingest as run, save_table
+
+    r = load_robot(robot) if robot else None
+    table = run([str(p) for p in logs], robot=r, progress=lambda p: console.print(f"read {p}"))
+    save_table(table, out)
+    console.print(
+        f"wrote {out}: {len(table.frame):,} rows, {table.n_moves} moves, "
+        f"feature set {table.feature_set} ({len(table.features)} inputs)"
+    )
+    return 0

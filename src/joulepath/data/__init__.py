@@ -1,0 +1,34 @@
+"""Data: joint logs (controller and generic), the energy-table schema, ingestion."""
+
+from joulepath.data._features import segment_moves
+from joulepath.data._logs import JointLog, controller_log_text, read_log, write_controller_log
+from joulepath.data._schema import (
+    FEATURE_SETS,
+    FEATURES_FULL,
+    FEATURES_JOINT,
+    GENERIC_REQUIRED,
+    LOG_COLUMNS,
+    TARGETS,
+    table_columns,
+)
+from joulepath.data._table import EnergyTable, check_columns, ingest, load_table, save_table
+
+__all__ = [
+    "EnergyTable",
+    "FEATURES_FULL",
+    "FEATURES_JOINT",
+    "FEATURE_SETS",
+    "GENERIC_REQUIRED",
+    "JointLog",
+    "LOG_COLUMNS",
+    "TARGETS",
+    "check_columns",
+    "controller_log_text",
+    "ingest",
+    "load_table",
+    "read_log",
+    "save_table",
+    "segment_moves",
+    "table_columns",
+    "write_controller_log",
+]

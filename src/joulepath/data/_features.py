@@ -1,0 +1,182 @@
+"""From a validated joint log to energy-table rows: move segmentation, finite differences, targets."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from joulepath._typing import FloatArray
+from joulepath.data._logs import JointLog
+from joulepath.data._schema import FEATURE_SETS, N_JOINTS, TARGETS, table_columns
+
+REST_SPEED = 1.0 * np.pi / 180.0
+"""Joint speed (rad/s) below which every joint counts as at rest: 1 deg/s."""
+
+CORNER_DIP = 0.6
+"""A blended corner: a local minimum of the joint speed below this share of both neighbouring peaks ..."""
+
+CORNER_TURN_DEG = 30.0
+"""... or a dip where the direction of joint motion turns by more than this angle."""
+
+
+def segment_moves(
+    t: FloatArray, qd: FloatArray, *, speed_scale: FloatArray | None = None
+) -> np.ndarray:
+    """Label each sample with the move it belongs to; -1 for idle samples before the first move.
+
+    A move starts where the arm sets off after standing still (all joints below
+    :data:`REST_SPEED`), or at a blended corner (zone ``z1..z200``): a local minimum
+    of the normalised joint speed ``max_i |qd_i| / speed_scale_i`` that either dips
+    below :data:`CORNER_DIP` of the peaks on both sides, or dips at all while the
+    direction of joint motion turns by more than :data:`CORNER_TURN_DEG` between
+    those peaks (a joint-interpolated move never turns). A move keeps its trailing rest.
+
+    Parameters
+    ----------
+    t : ndarray of shape (n,)
+    qd : ndarray of shape (n, n_joints)
+        rad/s.
+    speed_scale : ndarray of shape (n_joints,), optional
+        Per-joint speed limits used to normalise (default 1).
+
+    Returns
+    -------
+    ndarray of int64, shape (n,)
+    """
+    n = t.size
+    moving = np.abs(qd).max(axis=1) > REST_SPEED
+    scale = np.ones(qd.shape[1]) if speed_scale is None else np.where(
+        np.isfinite(speed_scale) & (speed_scale > 0), speed_scale, 1.0
+    )
+    vel = qd / scale
+    speed = np.abs(vel).max(axis=1)
+    starts = np.nonzero(moving & ~np.r_[False, moving[:-1]])[0]
+    stops = np.nonzero(moving & ~np.r_[moving[1:], False])[0]
+    cos_turn = np.cos(np.radians(CORNER_TURN_DEG))
+    corners = []
+    # blended corners inside each moving stretch (stretch k runs from starts[k] to stops[k])
+    for s, e in zip(starts, stops, strict=True):
+        seg = speed[s : e + 1]
+        if seg.size < 5:
+            continue
+        d = np.diff(seg)
+        minima = np.nonzero((d[:-1] < 0) & (d[1:] >= 0))[0] + 1
+        last = 0
+        for k, m in enumerate(minima):
+            right_end = minima[k + 1] if k + 1 < minima.size else seg.size
+            pl = last + int(np.argmax(seg[last:m]))
+            pr = m + int(np.argmax(seg[m:right_end]))
+            peak = min(seg[pl], seg[pr])
+            if not seg[m] < 0.95 * peak:
+                continue
+            a, b = vel[s + pl], vel[s + pr]
+            turn = a @ b < cos_turn * np.linalg.norm(a) * np.linalg.norm(b)
+            if seg[m] < CORNER_DIP * peak or turn:
+                corners.append(s + m)
+                last = m
+    bounds = np.zeros(n, dtype=bool)
+    bounds[starts] = True
+    bounds[np.asarray(corners, dtype=np.int64)] = True
+    labels = np.cumsum(bounds) - 1
+    return labels.astype(np.int64)
+
+
+def _differentiate(values: FloatArray, t: FloatArray, first: np.ndarray, last: np.ndarray) -> FloatArray:
+    """d/dt within moves: central differences, one-sided at each move's first and last row."""
+    out = np.zeros_like(values)
+    if values.shape[0] < 2:
+        return out
+    fwd = (values[1:] - values[:-1]) / (t[1:] - t[:-1])[:, None]
+    central = np.zeros_like(values)
+    central[1:-1] = (values[2:] - values[:-2]) / (t[2:] - t[:-2])[:, None]
+    interior = ~(first | last)
+    out[interior] = central[interior]
+    lone = first & last
+    f = first & ~lone
+    l_ = last & ~lone
+    out[f] = fwd[np.nonzero(f)[0]]
+    out[l_] = fwd[np.nonzero(l_)[0] - 1]
+    return out
+
+
+def sample_lengths(t: FloatArray) -> FloatArray:
+    """Length of each sample, s: ``t[k+1] - t[k]``; the last sample repeats the previous one."""
+    if t.size < 2:
+        return np.zeros_like(t)
+    dt = np.diff(t)
+    return np.r_[dt, dt[-1]]
+
+
+def log_to_frame(
+    log: JointLog,
+    *,
+    feature_set: str,
+    tcp: tuple[FloatArray, FloatArray, FloatArray] | None = None,
+    speed_scale: FloatArray | None = None,
+    move_offset: int = 0,
+) -> pd.DataFrame:
+    """Energy-table rows of one log.
+
+    Parameters
+    ----------
+    log : JointLog
+    feature_set : {"full40", "joint"}
+    tcp : (position m (n, 3), quaternion w-first (n, 4), EulerZYX z,y,x rad (n, 3)), optional
+        TCP signals for ``full40``; default: the ones the log carries.
+    speed_scale : ndarray of shape (6,), optional
+        Joint speed limits for move segmentation.
+    move_offset : int
+        Added to the move labels (to keep ``move_id`` unique across files).
+    """
+    t = log.t
+    if log.move is not None:
+        _, labels = np.unique(log.move, return_inverse=True)
+        labels = labels.astype(np.int64)
+        keep = np.ones(t.size, dtype=bool)
+    else:
+        labels = segment_moves(t, log.qd, speed_scale=speed_scale)
+        keep = labels >= 0
+    dt = sample_lengths(t)
+    idx = np.nonzero(keep)[0]
+    t, labels, dt = t[idx], labels[idx], dt[idx]
+    q, qd, tau = log.q[idx], log.qd[idx], log.tau[idx]
+    first = np.r_[True, labels[1:] != labels[:-1]]
+    last = np.r_[labels[1:] != labels[:-1], True]
+    cols: dict[str, FloatArray] = {"move_id": labels + move_offset, "t": t}
+    qdd = log.qdd[idx] if log.qdd is not None else _differentiate(qd, t, first, last)
+    for i in range(N_JOINTS):
+        cols[f"q{i + 1}"] = q[:, i]
+        cols[f"dq{i + 1}"] = qd[:, i]
+        cols[f"ddq{i + 1}"] = qdd[:, i]
+    if feature_set == "full40":
+        if tcp is None:
+            if log.tcp_position is None or log.tcp_quaternion is None or log.tcp_euler is None:
+                raise ValueError("full40 needs TCP signals")
+            tcp = (log.tcp_position, log.tcp_quaternion, log.tcp_euler)
+        pos, quat, eul = (a[idx] for a in tcp)
+        eul = np.unwrap(eul, axis=0)
+        vel = _differentiate(pos, t, first, last)
+        acc = _differentiate(vel, t, first, last)
+        rate = _differentiate(eul, t, first, last)
+        rate_acc = _differentiate(rate, t, first, last)
+        wrapped = (eul + np.pi) % (2 * np.pi) - np.pi
+        for k, name in enumerate(("x", "y", "z")):
+            cols[name] = pos[:, k]
+            cols[f"d{name}"] = vel[:, k]
+            cols[f"dd{name}"] = acc[:, k]
+        for k, name in enumerate(("qw", "qx", "qy", "qz")):
+            cols[name] = quat[:, k]
+        for k, (name, dname) in enumerate((("yaw", "phi"), ("pitch", "theta"), ("roll", "psi"))):
+            cols[name] = wrapped[:, k]
+            cols[f"d{dname}"] = rate[:, k]
+            cols[f"dd{dname}"] = rate_acc[:, k]
+    energy = np.abs(tau * qd) * dt[:, None]
+    for i in range(N_JOINTS):
+        cols[f"E{i + 1}"] = energy[:, i]
+    cols["E"] = energy.sum(axis=1)
+    cols["dt"] = dt
+    frame = pd.DataFrame(cols)
+    return frame[list(table_columns(feature_set))]
+
+
+__all__ = ["FEATURE_SETS", "TARGETS", "log_to_frame", "sample_lengths", "segment_moves"]

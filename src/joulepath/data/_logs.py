@@ -1,0 +1,339 @@
+"""Joint logs: the controller's CSV (thesis Appendix D.2) and a generic CSV for any arm.
+
+Controller log (``kind="controller"``): header exactly
+``t,q1,dq1,tau1,...,q6,dq6,tau6,x,y,z,e1,e2,e3,e4,psi,theta,phi``; units s, deg, deg/s,
+N·m, mm, unit quaternion with ``e1 = w``, RAPID EulerZYX in deg (``psi`` about X,
+``theta`` about Y, ``phi`` about Z); values as ``NumToStr(value, 5)`` writes them.
+
+Generic log (``kind="generic"``): a header naming at least ``t`` (s) and, per
+joint, ``q{i}`` (rad), ``dq{i}`` (rad/s), ``tau{i}`` (N·m); optional ``ddq{i}``
+(rad/s²) and ``move`` (an integer move label). Columns may come in any order.
+
+Files are parsed block by block with pyarrow's streaming CSV reader. When that
+fails, a line-by-line pass finds the exact line and field to report. Every check
+(header, field count, numbers, NaN, strictly increasing time, duplicated rows,
+plausible units) reports file and line; nothing is written for a log that fails.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+
+from joulepath._io import atomic_write_text
+from joulepath._typing import FloatArray
+from joulepath.data._schema import GENERIC_REQUIRED, LOG_COLUMNS, N_JOINTS
+from joulepath.errors import InvalidLog
+from joulepath.units import DEG, MM
+
+_MAX_REPORTED = 5
+_BLOCK = 1 << 22  # 4 MiB blocks
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class JointLog:
+    """A validated joint log in SI units.
+
+    Attributes
+    ----------
+    source : str
+    kind : {"controller", "generic"}
+    t : ndarray of shape (n,)
+        s.
+    q, qd, tau : ndarray of shape (n, 6)
+        rad, rad/s, N·m.
+    qdd : ndarray of shape (n, 6) or None
+        Logged accelerations (generic logs only), rad/s².
+    tcp_position : ndarray of shape (n, 3) or None
+        m (controller logs).
+    tcp_quaternion : ndarray of shape (n, 4) or None
+        ``(w, x, y, z)``.
+    tcp_euler : ndarray of shape (n, 3) or None
+        RAPID EulerZYX ``(z, y, x)`` in rad.
+    move : ndarray of shape (n,) or None
+        Move labels given by a generic log.
+    """
+
+    source: str
+    kind: str
+    t: FloatArray
+    q: FloatArray
+    qd: FloatArray
+    tau: FloatArray
+    qdd: FloatArray | None = None
+    tcp_position: FloatArray | None = None
+    tcp_quaternion: FloatArray | None = None
+    tcp_euler: FloatArray | None = None
+    move: np.ndarray | None = None
+
+    @property
+    def n_rows(self) -> int:
+        return int(self.t.size)
+
+
+def _fail(source: str, problems: list[str], fix: str = "") -> InvalidLog:
+    shown = problems[:_MAX_REPORTED]
+    more = len(problems) - len(shown)
+    text = "; ".join(shown) + (f"; and {more} more" if more > 0 else "")
+    return InvalidLog(f"{source}: {text}" + (f" ({fix})" if fix else ""))
+
+
+def _read_header(path: Path, source: str) -> list[str]:
+    try:
+        with path.open("r", encoding="utf-8", newline="") as fh:
+            first = fh.readline()
+    except OSError as err:
+        raise InvalidLog(f"{source}: cannot be read ({err.strerror})") from err
+    except UnicodeDecodeError as err:
+        raise InvalidLog(f"{source}: line 1: not UTF-8 text; is this a CSV log?") from err
+    if not first.strip():
+        raise InvalidLog(
+            f"{source}: is empty; a log starts with a header line such as "
+            f"'{','.join(LOG_COLUMNS[:4])},...'"
+        )
+    return [h.strip() for h in first.strip().split(",")]
+
+
+def detect_kind(header: list[str], source: str) -> str:
+    """``"controller"`` or ``"generic"`` from a header; InvalidLog for anything else."""
+    if tuple(header) == LOG_COLUMNS:
+        return "controller"
+    if "x" not in header and all(c in header for c in GENERIC_REQUIRED):
+        dup = sorted({h for h in header if header.count(h) > 1})
+        if dup:
+            raise InvalidLog(f"{source}: line 1: duplicated column(s) {', '.join(dup)}")
+        return "generic"
+    if len(header) == len(LOG_COLUMNS) or "x" in header:
+        wrong = [
+            f"field {i + 1} is {got!r}, expected {want!r}"
+            for i, (got, want) in enumerate(zip(header, LOG_COLUMNS, strict=False))
+            if got != want
+        ]
+        if len(header) != len(LOG_COLUMNS):
+            wrong.insert(0, f"{len(header)} columns instead of {len(LOG_COLUMNS)}")
+        raise InvalidLog(
+            f"{source}: line 1: not the controller log header ({'; '.join(wrong[:3])}); "
+            f"expected: {','.join(LOG_COLUMNS)}"
+        )
+    missing = [c for c in GENERIC_REQUIRED if c not in header]
+    raise InvalidLog(
+        f"{source}: line 1: header lacks column(s) {', '.join(missing)}; a generic log needs "
+        "t and q{i}, dq{i}, tau{i} for i = 1..6 (s, rad, rad/s, N·m)"
+    )
+
+
+def _diagnose(path: Path, source: str, header: list[str]) -> InvalidLog:
+    """Line-by-line pass that names the lines and fields pyarrow could not parse."""
+    problems: list[str] = []
+    n = len(header)
+    with path.open("r", encoding="utf-8", newline="") as fh:
+        lines = fh.read().split("\n")
+    last = len(lines)
+    while last > 1 and not lines[last - 1].strip():
+        last -= 1
+    for lineno in range(2, last + 1):
+        raw = lines[lineno - 1].rstrip("\r")
+        if not raw.strip():
+            problems.append(f"line {lineno}: empty line")
+            continue
+        fields = next(csv.reader(io.StringIO(raw)))
+        if len(fields) != n:
+            what = f"line {lineno}: {len(fields)} fields instead of {n}"
+            if lineno == last and len(fields) < n:
+                what += " (the file is truncated: delete the last line or export again)"
+            problems.append(what)
+            continue
+        for name, value in zip(header, fields, strict=True):
+            try:
+                float(value)
+            except ValueError:
+                problems.append(f"line {lineno}, field {name}: {value!r} is not a number")
+        if len(problems) > _MAX_REPORTED:
+            break
+    if not problems:
+        problems.append("cannot be parsed as CSV")
+    return _fail(source, problems)
+
+
+def _parse(path: Path, source: str, header: list[str]) -> dict[str, np.ndarray]:
+    types = {h: pa.float64() for h in header}
+    if "move" in header:
+        types["move"] = pa.int64()
+    convert = pacsv.ConvertOptions(
+        column_types=types, null_values=[], strings_can_be_null=False,
+        quoted_strings_can_be_null=False,
+    )
+    read = pacsv.ReadOptions(block_size=_BLOCK)
+    chunks: dict[str, list[np.ndarray]] = {h: [] for h in header}
+    try:
+        with pacsv.open_csv(path, read_options=read, convert_options=convert) as reader:
+            for batch in reader:
+                for h, col in zip(batch.schema.names, batch.columns, strict=True):
+                    chunks[h].append(col.to_numpy(zero_copy_only=False))
+    except (pa.ArrowInvalid, pa.ArrowTypeError) as err:
+        raise _diagnose(path, source, header) from err
+    out = {h: (np.concatenate(v) if v else np.empty(0)) for h, v in chunks.items()}
+    if out["t"].size == 0:
+        raise InvalidLog(f"{source}: has a header but no data lines")
+    return out
+
+
+def _check_rows(cols: dict[str, np.ndarray], header: list[str], source: str) -> None:
+    problems: list[str] = []
+    data = np.column_stack([cols[h].astype(float) for h in header])
+    bad = ~np.isfinite(data)
+    if bad.any():
+        for r, c in zip(*np.nonzero(bad), strict=True):
+            problems.append(f"line {r + 2}, field {header[c]}: {data[r, c]} is not a finite number")
+            if len(problems) > _MAX_REPORTED:
+                break
+        raise _fail(source, problems, "remove or repair those lines")
+    same = np.all(data[1:] == data[:-1], axis=1)
+    if same.any():
+        rows = np.nonzero(same)[0] + 3
+        raise _fail(
+            source,
+            [f"line {r} duplicates line {r - 1}" for r in rows],
+            "the logger wrote a sample twice: delete the duplicated lines",
+        )
+    t = cols["t"]
+    back = np.nonzero(np.diff(t) <= 0)[0]
+    if back.size:
+        raise _fail(
+            source,
+            [f"line {k + 3}: t = {t[k + 1]:g} s does not increase (line {k + 2}: t = {t[k]:g} s)"
+             for k in back],
+            "time must strictly increase; are two logs concatenated?",
+        )
+
+
+def _unit_ratio(q: FloatArray, qd: FloatArray, t: FloatArray) -> FloatArray:
+    """Per joint: median |logged speed| / median |d(logged position)/dt| over moving samples."""
+    dq_fd = np.gradient(q, t, axis=0)
+    ratios = np.full(q.shape[1], np.nan)
+    for j in range(q.shape[1]):
+        moving = np.abs(dq_fd[:, j]) > 1e-3 * max(np.abs(dq_fd[:, j]).max(), 1e-12)
+        if moving.sum() >= 5 and np.abs(qd[moving, j]).max() > 0:
+            ratios[j] = np.median(np.abs(qd[moving, j])) / np.median(np.abs(dq_fd[moving, j]))
+    return ratios
+
+
+def _check_units(q: FloatArray, qd: FloatArray, t: FloatArray, source: str, kind: str) -> None:
+    unit = "deg" if kind == "controller" else "rad"
+    ratios = _unit_ratio(q, qd, t)
+    problems = []
+    factor = 180.0 / np.pi
+    for j, r in enumerate(ratios):
+        if not np.isfinite(r):
+            continue
+        if abs(np.log(r / factor)) < 0.4:
+            problems.append(
+                f"column q{j + 1} looks like radians next to dq{j + 1} in degrees/s "
+                f"(dq{j + 1} is {r:.1f} times dq/dt of q{j + 1})"
+                if unit == "deg"
+                else f"column dq{j + 1} looks like deg/s next to q{j + 1} in rad "
+                f"(dq{j + 1} is {r:.1f} times dq/dt of q{j + 1})"
+            )
+        elif abs(np.log(r * factor)) < 0.4:
+            problems.append(
+                f"column dq{j + 1} looks like rad/s next to q{j + 1} in degrees "
+                f"(dq{j + 1} is 1/{1 / r:.1f} of dq/dt of q{j + 1})"
+                if unit == "deg"
+                else f"column q{j + 1} looks like degrees next to dq{j + 1} in rad/s "
+                f"(dq{j + 1} is 1/{1 / r:.1f} of dq/dt of q{j + 1})"
+            )
+    if kind == "generic":
+        big = np.nonzero(np.abs(q).max(axis=0) > 4 * np.pi)[0]
+        problems += [
+            f"column q{j + 1} reaches {np.abs(q[:, j]).max():.1f}, more than 4π: degrees in a "
+            "radian log?" for j in big
+        ]
+    if problems:
+        fix = (
+            "controller logs are in deg and deg/s" if unit == "deg"
+            else "generic logs are in rad and rad/s: convert the columns"
+        )
+        raise _fail(source, problems, fix)
+
+
+def read_log(path: str | os.PathLike[str]) -> JointLog:
+    """Read and validate one controller or generic joint log.
+
+    Raises
+    ------
+    InvalidLog
+        With the file, line and field of every problem found (up to five).
+    """
+    p = Path(path)
+    source = str(p)
+    header = _read_header(p, source)
+    kind = detect_kind(header, source)
+    cols = _parse(p, source, header)
+    _check_rows(cols, header, source)
+    t = cols["t"]
+    joints = range(1, N_JOINTS + 1)
+    q = np.column_stack([cols[f"q{i}"] for i in joints])
+    qd = np.column_stack([cols[f"dq{i}"] for i in joints])
+    tau = np.column_stack([cols[f"tau{i}"] for i in joints])
+    _check_units(q, qd, t, source, kind)
+    if kind == "controller":
+        quat = np.column_stack([cols[c] for c in ("e1", "e2", "e3", "e4")])
+        norms = np.linalg.norm(quat, axis=1)
+        bad = np.nonzero(np.abs(norms - 1.0) > 1e-3)[0]
+        if bad.size:
+            raise _fail(
+                source,
+                [f"line {k + 2}: quaternion e1..e4 has norm {norms[k]:.4f}, not 1" for k in bad],
+            )
+        return JointLog(
+            source=source, kind=kind, t=t, q=q * DEG, qd=qd * DEG, tau=tau,
+            tcp_position=np.column_stack([cols["x"], cols["y"], cols["z"]]) * MM,
+            tcp_quaternion=quat,
+            tcp_euler=np.column_stack([cols["phi"], cols["theta"], cols["psi"]]) * DEG,
+        )
+    qdd = None
+    if all(f"ddq{i}" in cols for i in joints):
+        qdd = np.column_stack([cols[f"ddq{i}"] for i in joints])
+    move = cols["move"].astype(np.int64) if "move" in cols else None
+    return JointLog(source=source, kind=kind, t=t, q=q, qd=qd, tau=tau, qdd=qdd, move=move)
+
+
+def _numtostr(values: FloatArray) -> np.ndarray:
+    """RAPID ``NumToStr(value, 5)`` of single-precision ``num`` values, as strings."""
+    as_num = values.astype(np.float32).astype(np.float64)
+    return np.char.mod("%.5f", np.round(as_num, 5))
+
+
+def controller_log_text(
+    t: FloatArray,
+    q_deg: FloatArray,
+    qd_deg: FloatArray,
+    tau: FloatArray,
+    tcp_mm: FloatArray,
+    quat: FloatArray,
+    euler_xyz_deg: FloatArray,
+) -> str:
+    """The controller's CSV text (header and rows) for sampled signals in its units.
+
+    ``euler_xyz_deg`` holds the columns ``psi, theta, phi`` (EulerZYX about X, Y, Z).
+    """
+    cols = [t[:, None]]
+    for i in range(N_JOINTS):
+        cols += [q_deg[:, i : i + 1], qd_deg[:, i : i + 1], tau[:, i : i + 1]]
+    cols += [tcp_mm, quat, euler_xyz_deg]
+    data = np.concatenate(cols, axis=1)
+    text = _numtostr(data)
+    body = "\n".join(",".join(row) for row in text.tolist())
+    return ",".join(LOG_COLUMNS) + "\n" + body + "\n"
+
+
+def write_controller_log(path: str | os.PathLike[str], text: str) -> Path:
+    """Write a controller log atomically."""
+    return atomic_write_text(path, text)

@@ -1,0 +1,153 @@
+"""Two plants that turn commanded motion into a controller log.
+
+* ``sim`` — the nominal twin (what RobotStudio gives): the robot's nominal rigid-body
+  model, nominal Coulomb + viscous friction, motion exactly as commanded, no noise.
+* ``lab`` — the real robot the twin never matches: link masses, centres of mass and
+  inertias perturbed (one fixed "robot instance" per ``instance_seed``), a 0.35 kg
+  flange adapter, stronger friction with a Stribeck bump and a direction asymmetry,
+  gear losses in the measured motor torque (``tau/eta`` when driving, ``tau*eta``
+  when braking), torque and speed sensor noise, and a servo tracking lag (the
+  actual motion is the command through a critically damped 2nd-order filter).
+
+Both are printed the same way: the controller's units with 5 decimals of
+single-precision ``num`` values (``NumToStr(value, 5)``).
+
+The friction values are assumptions (no identified friction of the IRB 120 is
+public); they are of the size reported for robots of this class.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy import signal
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import CoulombViscousFriction, Friction, Robot
+from joulepath.errors import InvalidInput
+from joulepath.sim._controller import MotionPlan, evaluate_plan
+
+PLANTS = ("sim", "lab")
+
+NOMINAL_COULOMB = (0.9, 1.1, 0.7, 0.25, 0.25, 0.15)
+"""N·m, joint side (assumed)."""
+NOMINAL_VISCOUS = (0.6, 0.7, 0.4, 0.08, 0.08, 0.04)
+"""N·m·s/rad, joint side (assumed)."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class LabFriction:
+    """Coulomb + viscous + Stribeck friction with different levels per direction."""
+
+    coulomb: FloatArray
+    viscous: FloatArray
+    stribeck: FloatArray
+    stribeck_speed: float = 0.05
+    asymmetry: float = 0.1
+
+    def torque(self, qd: FloatArray) -> FloatArray:
+        sgn = np.tanh(qd / 0.005)
+        level = self.coulomb * (1.0 + self.asymmetry * np.sign(qd))
+        bump = self.stribeck * np.exp(-((qd / self.stribeck_speed) ** 2))
+        out: FloatArray = (level + bump) * sgn + self.viscous * qd
+        return out
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Plant:
+    """How a robot turns commanded motion into logged signals."""
+
+    name: str
+    robot: Robot
+    friction: Friction
+    gear_efficiency: float = 1.0
+    torque_noise: tuple[float, ...] = (0.0,) * 6
+    speed_noise_deg_s: float = 0.0
+    tracking_hz: float | None = None
+
+
+def perturbed_robot(robot: Robot, rng: np.random.Generator) -> Robot:
+    """The robot with its link mass properties perturbed (masses ±8 %, COM ±4 mm, inertia ±10 %)."""
+    chain = robot.chain
+    n = chain.n_joints
+    ratio = 1.0 + 0.08 * rng.standard_normal(n)
+    ratio = np.clip(ratio, 0.8, 1.2)
+    masses = chain.masses * ratio
+    coms = chain.coms + 0.004 * rng.standard_normal((n, 3))
+    scale = ratio * np.clip(1.0 + 0.1 * rng.standard_normal(n), 0.75, 1.25)
+    inertias = chain.inertias * scale[:, None, None]
+    new = replace(chain, masses=masses, coms=coms, inertias=inertias)
+    return Robot(new, description=None, source=f"{robot.source} (perturbed)")
+
+
+def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
+    """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot)."""
+    nominal = CoulombViscousFriction(
+        coulomb=NOMINAL_COULOMB, viscous=NOMINAL_VISCOUS, smoothing=0.005
+    )
+    if name == "sim":
+        return Plant(name="sim", robot=robot, friction=nominal)
+    if name == "lab":
+        rng = np.random.default_rng(instance_seed)
+        real = perturbed_robot(robot, rng).with_payload(0.35, com=(0.0, 0.0, 0.025))
+        friction = LabFriction(
+            coulomb=1.35 * np.array(NOMINAL_COULOMB),
+            viscous=1.25 * np.array(NOMINAL_VISCOUS),
+            stribeck=0.4 * np.array(NOMINAL_COULOMB),
+        )
+        return Plant(
+            name="lab", robot=real, friction=friction, gear_efficiency=0.88,
+            torque_noise=(0.15, 0.15, 0.10, 0.03, 0.03, 0.02), speed_noise_deg_s=0.05,
+            tracking_hz=12.0,
+        )
+    raise InvalidInput(f"unknown plant {name!r}; use one of {', '.join(PLANTS)}")
+
+
+def _track(plan: MotionPlan, t: FloatArray, hz: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Actual motion: the command through ``w²/(s² + 2ws + w²)``, sampled at ``t``."""
+    step = 0.002
+    grid = np.arange(0.0, t[-1] + 2 * step, step)
+    q_c, qd_c, qdd_c = evaluate_plan(plan, grid)
+    w = 2 * np.pi * hz
+    b, a, _ = signal.cont2discrete(([w * w], [1.0, 2 * w, w * w]), step, method="bilinear")
+    b = np.ravel(b)
+    zi = signal.lfilter_zi(b, a)[:, None]
+    q = signal.lfilter(b, a, q_c, axis=0, zi=zi * q_c[:1])[0]
+    qd = signal.lfilter(b, a, qd_c, axis=0, zi=zi * 0.0)[0]
+    qdd = signal.lfilter(b, a, qdd_c, axis=0, zi=zi * 0.0)[0]
+
+    def at(x: FloatArray) -> FloatArray:
+        return np.column_stack([np.interp(t, grid, x[:, j]) for j in range(x.shape[1])])
+
+    return at(q), at(qd), at(qdd)
+
+
+@dataclass(frozen=True, slots=True)
+class Measured:
+    """Signals as the controller reports them, in SI units (before printing)."""
+
+    t: FloatArray
+    q: FloatArray
+    qd: FloatArray
+    qdd: FloatArray
+    tau: FloatArray
+
+
+def run_plant(plant: Plant, plan: MotionPlan, t: FloatArray, *, rng: np.random.Generator) -> Measured:
+    """Drive the plant along a plan and measure at times ``t``."""
+    if plant.tracking_hz is None:
+        q, qd, qdd = evaluate_plan(plan, t)
+    else:
+        q, qd, qdd = _track(plan, t, plant.tracking_hz)
+    tau = plant.robot.inverse_dynamics(q, qd, qdd) + plant.friction.torque(qd)
+    if plant.gear_efficiency != 1.0:
+        driving = tau * qd > 0
+        tau = np.where(driving, tau / plant.gear_efficiency, tau * plant.gear_efficiency)
+    noise = np.asarray(plant.torque_noise)
+    if np.any(noise > 0):
+        tau = tau + rng.standard_normal(tau.shape) * noise
+    qd_meas = qd
+    if plant.speed_noise_deg_s > 0:
+        qd_meas = qd + rng.standard_normal(qd.shape) * np.radians(plant.speed_noise_deg_s)
+    return Measured(t=t, q=q, qd=qd_meas, qdd=qdd, tau=tau)

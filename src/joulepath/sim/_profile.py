@@ -1,0 +1,79 @@
+"""Jerk-limited point-to-point profile of a normalised path parameter s: 0 -> 1.
+
+Velocity ramps are sin² shaped (acceleration continuous, jerk bounded), with a
+constant-speed cruise between them::
+
+    ds/dt = v sin²(pi tau / (2 ta))        0 <= tau < ta         (accelerate)
+    ds/dt = v                              ta <= tau < ta + tc   (cruise)
+    symmetric deceleration;                T = 2 ta + tc
+
+The peak acceleration is ``pi v / (2 ta)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+
+
+@dataclass(frozen=True, slots=True)
+class Profile:
+    """Ramp time ``ta``, cruise time ``tc`` and cruise speed ``v`` (1/s) of a unit move."""
+
+    ta: float
+    tc: float
+    v: float
+
+    @property
+    def duration(self) -> float:
+        return 2.0 * self.ta + self.tc
+
+
+def plan_profile(v_max: float, a_max: float) -> Profile:
+    """Fastest profile with ``ds/dt <= v_max`` and ``d²s/dt² <= a_max``."""
+    ta = np.pi * v_max / (2.0 * a_max)
+    if v_max * ta <= 1.0:
+        return Profile(ta=ta, tc=1.0 / v_max - ta, v=v_max)
+    v = np.sqrt(2.0 * a_max / np.pi)
+    return Profile(ta=1.0 / v, tc=0.0, v=v)
+
+
+def evaluate_profile(p: Profile, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``s, ds/dt, d²s/dt²`` at times ``tau`` (clipped to [0, T])."""
+    T = p.duration
+    tau = np.clip(tau, 0.0, T)
+    s = np.empty_like(tau)
+    sd = np.empty_like(tau)
+    sdd = np.empty_like(tau)
+    w = np.pi / p.ta
+    acc = tau < p.ta
+    dec = tau > p.ta + p.tc
+    cru = ~(acc | dec)
+    x = tau[acc]
+    s[acc] = p.v * (x / 2 - np.sin(w * x) / (2 * w))
+    sd[acc] = p.v * np.sin(w * x / 2) ** 2
+    sdd[acc] = p.v * w / 2 * np.sin(w * x)
+    s[cru] = p.v * (p.ta / 2 + (tau[cru] - p.ta))
+    sd[cru] = p.v
+    sdd[cru] = 0.0
+    y = T - tau[dec]
+    s[dec] = 1.0 - p.v * (y / 2 - np.sin(w * y) / (2 * w))
+    sd[dec] = p.v * np.sin(w * y / 2) ** 2
+    sdd[dec] = -p.v * w / 2 * np.sin(w * y)
+    return s, sd, sdd
+
+
+def time_at_fraction(p: Profile, fraction: float) -> float:
+    """The time at which ``s`` reaches ``fraction`` (bisection; s is monotone)."""
+    lo, hi = 0.0, p.duration
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        s, _, _ = evaluate_profile(p, np.array([mid]))
+        if s[0] < fraction:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)

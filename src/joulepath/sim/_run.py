@@ -1,0 +1,143 @@
+"""Simulated data collection: random moves -> controller -> plant -> controller log."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from joulepath._io import atomic_write_text
+from joulepath.data import controller_log_text, ingest, save_table, write_controller_log
+from joulepath.dynamics import Robot, load_robot
+from joulepath.export import Move, draw_moves
+from joulepath.sim._controller import ControllerConfig, MotionPlan, log_times, plan_moves
+from joulepath.sim._plants import Measured, make_plant, run_plant
+
+
+@dataclass(frozen=True, slots=True)
+class SimulatedLog:
+    """What a simulated run wrote."""
+
+    log: Path
+    moves: Path
+    n_rows: int
+    n_moves: int
+    duration_s: float
+
+
+def measure(
+    robot: Robot,
+    plant_name: str,
+    moves: Sequence[Move],
+    *,
+    rng: np.random.Generator,
+    config: ControllerConfig = ControllerConfig(),
+    start: np.ndarray | None = None,
+    instance_seed: int = 120,
+) -> tuple[MotionPlan, Measured]:
+    """Plan ``moves`` from ``start`` (default home) and measure them on a plant."""
+    q0 = robot.home if start is None else np.asarray(start, float)
+    plan = plan_moves(robot, q0, moves, config)
+    t = log_times(plan.end_time, config, rng=rng)
+    plant = make_plant(plant_name, robot, instance_seed=instance_seed)
+    return plan, run_plant(plant, plan, t, rng=rng)
+
+
+def log_text(robot: Robot, m: Measured) -> str:
+    """The measurement as the controller's CSV text."""
+    pose = robot.fk(m.q)
+    quat = pose.quaternion
+    euler = pose.euler_zyx_deg  # (z, y, x)
+    return controller_log_text(
+        m.t, np.degrees(m.q), np.degrees(m.qd), m.tau, pose.position_mm, quat, euler[:, ::-1]
+    )
+
+
+def moves_text(plan: MotionPlan) -> str:
+    """Sidecar CSV with the programmed moves (ground truth for tests and plots)."""
+    lines = ["move,t_start,t_end,speed,zone," + ",".join(f"j{i + 1}_deg" for i in range(plan.start.size))]
+    for k, seg in enumerate(plan.segments):
+        target = ",".join(f"{v:.5f}" for v in np.degrees(seg.move.target))
+        lines.append(f"{k},{seg.t0:.5f},{seg.t_end:.5f},{seg.move.speed},{seg.move.zone},{target}")
+    return "\n".join(lines) + "\n"
+
+
+def simulate(
+    out: str | os.PathLike[str],
+    *,
+    plant: str = "lab",
+    n_moves: int = 1000,
+    seed: int | np.random.SeedSequence = 0,
+    robot: str = "irb120",
+    range_set: str = "collection",
+    config: ControllerConfig = ControllerConfig(),
+) -> SimulatedLog:
+    """Run ``n_moves`` random moves (thesis Appendix D.1) on a plant and write the log.
+
+    Writes ``out`` (the controller CSV) and ``out`` with suffix ``.moves.csv``.
+    """
+    r = load_robot(robot)
+    rng = np.random.default_rng(seed)
+    moves = draw_moves(r, n_moves, range_set=range_set, rng=rng)
+    plan, measured = measure(r, plant, moves, rng=rng, config=config)
+    path = Path(out)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_controller_log(path, log_text(r, measured))
+    side = path.with_suffix(".moves.csv")
+    atomic_write_text(side, moves_text(plan))
+    return SimulatedLog(path, side, int(measured.t.size), len(plan.segments), float(measured.t[-1]))
+
+
+THESIS_PLAN = (("real", "lab", 1000), ("sim", "sim", 1000), ("micro", "lab", 100), ("test", "lab", 100))
+"""The thesis' datasets (§4.3.1): name, plant, number of moves."""
+
+
+def _plan_job(name: str, plant: str, n_moves: int, seed: np.random.SeedSequence, out: str,
+              robot: str) -> dict[str, object]:
+    out_dir = Path(out)
+    res = simulate(out_dir / "logs" / f"{name}.csv", plant=plant, n_moves=n_moves, seed=seed, robot=robot)
+    table = ingest([res.log], robot=load_robot(robot))
+    save_table(table, out_dir / f"{name}.parquet")
+    return {"name": name, "plant": plant, "moves": n_moves, "rows": res.n_rows,
+            "table_rows": len(table.frame), "table_moves": table.n_moves,
+            "duration_s": res.duration_s}
+
+
+def simulate_plan(
+    out: str | os.PathLike[str],
+    *,
+    seed: int = 0,
+    robot: str = "irb120",
+    plan: Sequence[tuple[str, str, int]] = THESIS_PLAN,
+    workers: int = 2,
+    progress: Callable[[dict[str, object]], None] | None = None,
+) -> list[dict[str, object]]:
+    """Simulate a dataset plan in parallel; write ``logs/<name>.csv`` and ``<name>.parquet``.
+
+    Each dataset draws from its own child of ``SeedSequence(seed)``, so the test
+    set never repeats the micro set's moves.
+    """
+    children = np.random.SeedSequence(seed).spawn(len(plan))
+    results: list[dict[str, object]] = []
+    Path(out).mkdir(parents=True, exist_ok=True)
+    if workers <= 1:
+        for (name, plant, n), child in zip(plan, children, strict=True):
+            results.append(_plan_job(name, plant, n, child, str(out), robot))
+            if progress:
+                progress(results[-1])
+        return results
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = [
+            pool.submit(_plan_job, name, plant, n, child, str(out), robot)
+            for (name, plant, n), child in zip(plan, children, strict=True)
+        ]
+        for fut in as_completed(futures):
+            results.append(fut.result())
+            if progress:
+                progress(results[-1])
+    order = [p[0] for p in plan]
+    return sorted(results, key=lambda r: order.index(str(r["name"])))
