@@ -50,13 +50,21 @@ def main() -> None:
             out[k] = pin.rnea(model, data, qf[k], qdf[k], qddf[k])
 
     rows = [
-        ("pinocchio batched (Robot.inverse_dynamics)",
-         median_time(lambda: robot.inverse_dynamics(q, qd, qdd), repeats=args.repeats)),
-        ("pinocchio loop, one pin.rnea call per sample (baseline)",
-         median_time(loop, repeats=max(3, args.repeats // 3))),
-        ("lagrange-euler, NumPy vectorized (cross-check)",
-         median_time(lambda: robot.inverse_dynamics(q, qd, qdd, method="lagrange-euler"),
-                     repeats=max(3, args.repeats // 3))),
+        (
+            "pinocchio batched (Robot.inverse_dynamics)",
+            median_time(lambda: robot.inverse_dynamics(q, qd, qdd), repeats=args.repeats),
+        ),
+        (
+            "pinocchio loop, one pin.rnea call per sample (baseline)",
+            median_time(loop, repeats=max(3, args.repeats // 3)),
+        ),
+        (
+            "lagrange-euler, NumPy vectorized (cross-check)",
+            median_time(
+                lambda: robot.inverse_dynamics(q, qd, qdd, method="lagrange-euler"),
+                repeats=max(3, args.repeats // 3),
+            ),
+        ),
     ]
     baseline = rows[1][1]
     lines = [
@@ -72,7 +80,10 @@ def main() -> None:
     for name, t in rows:
         lines.append(f"| {name} | {t * 1e3:.3f} ms | {n / t:,.0f} | {baseline / t:.2f}x |")
     fast = n / rows[0][1]
-    lines += ["", f"Fast path: {fast:,.0f} samples/s ({'meets' if fast >= 1e6 else 'MISSES'} the 1,000,000 target)."]
+    lines += [
+        "",
+        f"Fast path: {fast:,.0f} samples/s ({'meets' if fast >= 1e6 else 'MISSES'} the 1,000,000 target).",
+    ]
     text = "\n".join(lines)
     print(text)
     write_section("dynamics", text)

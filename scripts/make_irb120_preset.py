@@ -61,7 +61,7 @@ def expand_xacro() -> str:
         "<!-- ABB IRB 120-3/0.6 from ROS-Industrial abb_experimental (Apache-2.0), commit\n"
         "     20b9cf86ad274e4f98540b9c9efe59f94245d2d1, abb_irb120_support/urdf/"
         "irb120_3_58_macro.xacro,\n"
-        "     expanded with prefix=\"\" and meshes removed by scripts/make_irb120_preset.py."
+        '     expanded with prefix="" and meshes removed by scripts/make_irb120_preset.py.'
         " -->\n"
     )
     return header + text.strip() + "\n"
@@ -138,14 +138,23 @@ def main() -> None:
         base=Inertial.from_arrays(
             base["mass_kg"],
             base["com_xyz_m"],
-            [[bi["ixx"], bi["ixy"], bi["ixz"]], [bi["ixy"], bi["iyy"], bi["iyz"]],
-             [bi["ixz"], bi["iyz"], bi["izz"]]],
+            [
+                [bi["ixx"], bi["ixy"], bi["ixz"]],
+                [bi["ixy"], bi["iyy"], bi["iyz"]],
+                [bi["ixz"], bi["iyz"], bi["izz"]],
+            ],
         ),
         range_sets=(
-            RangeSet(name="lab", lower=tuple(a * DEG for a, _ in lab),
-                     upper=tuple(b * DEG for _, b in lab)),
-            RangeSet(name="collection", lower=tuple(a * DEG for a, _ in collection),
-                     upper=tuple(b * DEG for _, b in collection)),
+            RangeSet(
+                name="lab",
+                lower=tuple(a * DEG for a, _ in lab),
+                upper=tuple(b * DEG for _, b in lab),
+            ),
+            RangeSet(
+                name="collection",
+                lower=tuple(a * DEG for a, _ in collection),
+                upper=tuple(b * DEG for _, b in collection),
+            ),
         ),
     )
     (PRESETS / "irb120.irml").write_text(irml_string(desc))

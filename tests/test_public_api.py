@@ -9,8 +9,16 @@ import pytest
 import joulepath
 
 SRC = Path(joulepath.__file__).parent
-PACKAGES = ["joulepath", "joulepath.description", "joulepath.kinematics", "joulepath.dynamics",
-            "joulepath.trajectory", "joulepath.data", "joulepath.export", "joulepath.sim"]
+PACKAGES = [
+    "joulepath",
+    "joulepath.description",
+    "joulepath.kinematics",
+    "joulepath.dynamics",
+    "joulepath.trajectory",
+    "joulepath.data",
+    "joulepath.export",
+    "joulepath.sim",
+]
 
 
 @pytest.mark.parametrize("name", PACKAGES)

@@ -32,9 +32,7 @@ def run_demo(*, duration: float = 1.5) -> str:
     lines.append("")
     move = minimum_jerk(robot.home, other, duration)
     rigid = robot.path_energy(move.q, move.qd, move.qdd, SAMPLE_PERIOD)
-    friction = robot.path_energy(
-        move.q, move.qd, move.qdd, SAMPLE_PERIOD, friction=ElastoPlasticFriction()
-    )
+    friction = robot.path_energy(move.q, move.qd, move.qdd, SAMPLE_PERIOD, friction=ElastoPlasticFriction())
     lines.append(
         f"sample move: minimum-jerk from home to the pose above in {duration:g} s, "
         f"{move.t.size} samples at {1 / SAMPLE_PERIOD:g} Hz"
@@ -46,7 +44,6 @@ def run_demo(*, duration: float = 1.5) -> str:
             f"{friction.per_joint[i]:8.3f} J"
         )
     lines.append(
-        f"  total                          {float(rigid.total):8.3f} J    "
-        f"{float(friction.total):8.3f} J"
+        f"  total                          {float(rigid.total):8.3f} J    {float(friction.total):8.3f} J"
     )
     return "\n".join(lines)

@@ -77,8 +77,7 @@ def _dt(dt: float | ArrayLike, shape: tuple[int, ...]) -> FloatArray:
             np.broadcast_shapes(d.shape, shape)
         except ValueError as err:
             raise InvalidInput(
-                f"dt has shape {d.shape[:-1]}; expected a scalar or one value per sample "
-                f"{shape[:-1]}"
+                f"dt has shape {d.shape[:-1]}; expected a scalar or one value per sample {shape[:-1]}"
             ) from err
     return d
 
@@ -124,7 +123,8 @@ def total_energy(
     copper_loss: float | ArrayLike | None = None,
 ) -> FloatArray:
     """Per-sample energy summed over joints (the thesis' target ``E``), shape (...)."""
-    return joint_energy(tau, qd, dt, mode=mode, copper_loss=copper_loss).sum(axis=-1)
+    out: FloatArray = joint_energy(tau, qd, dt, mode=mode, copper_loss=copper_loss).sum(axis=-1)
+    return out
 
 
 @dataclass(frozen=True, slots=True)

@@ -49,7 +49,10 @@ def test_read_log_header_only(tmp_path):
 def test_read_log_wrong_header(tmp_path, sim_log):
     lines = _lines(sim_log)
     lines[0] = lines[0].replace("tau3", "torque3")
-    with pytest.raises(InvalidLog, match=r"line 1: not the controller log header \(field 10 is 'torque3', expected 'tau3'\)"):
+    with pytest.raises(
+        InvalidLog,
+        match=r"line 1: not the controller log header \(field 10 is 'torque3', expected 'tau3'\)",
+    ):
         read_log(_write(tmp_path, lines))
 
 

@@ -1,7 +1,13 @@
 import numpy as np
 import pytest
 
-from joulepath.description import Inertial, check_inertial, check_physical, preset_description, read_irml
+from joulepath.description import (
+    Inertial,
+    check_inertial,
+    check_physical,
+    preset_description,
+    read_irml,
+)
 
 
 def test_check_physical_bundled_irb120_has_no_errors():

@@ -75,18 +75,28 @@ def _break(text: str, old: str, new: str, count: int = 1) -> str:
     ("mutate", "pattern"),
     [
         (lambda t: _break(t, "<d>0.1</d>", ""), r"bad\.irml: joint 1 <kinematics>: missing <d>"),
-        (lambda t: _break(t, "<link-mass>1.5</link-mass>", "<link-mass>heavy</link-mass>"),
-         r"bad\.irml: joint 1 <dynamics> <link-mass>: 'heavy'.*write a number"),
-        (lambda t: _break(t, "<type>R</type>", "<type>X</type>"),
-         r"bad\.irml: joint 1 <type>: unknown joint type 'X'; use T .*R .*L"),
+        (
+            lambda t: _break(t, "<link-mass>1.5</link-mass>", "<link-mass>heavy</link-mass>"),
+            r"bad\.irml: joint 1 <dynamics> <link-mass>: 'heavy'.*write a number",
+        ),
+        (
+            lambda t: _break(t, "<type>R</type>", "<type>X</type>"),
+            r"bad\.irml: joint 1 <type>: unknown joint type 'X'; use T .*R .*L",
+        ),
         (lambda t: _break(t, 'id="2"', 'id="1"'), r"bad\.irml: joint 1: duplicate joint id"),
         (lambda t: _break(t, "<zz>0.01</zz>", ""), r"joint 1 <dynamics> <inertia>: missing <zz>"),
         (lambda t: _break(t, "<q>q1</q>", "<q>q3</q>"), r"joint 1 <kinematics> <q>: 'q3'"),
         (lambda t: _break(t, "<q>q1</q>", "<q>2*q1</q>"), r"is not ±q1 plus a constant offset"),
-        (lambda t: _break(t, "<xi>1</xi>", "<xi>0</xi>"), r"joint 1 <xi>: xi is 0 but the type is R"),
+        (
+            lambda t: _break(t, "<xi>1</xi>", "<xi>0</xi>"),
+            r"joint 1 <xi>: xi is 0 but the type is R",
+        ),
         (lambda t: _break(t, "<type>R</type>", "<type>L</type>"), r"linear \(prismatic\)"),
         (lambda t: _break(t, '<joint id="1">', "<joint>"), r"<joint>: has no id attribute"),
-        (lambda t: _break(t, '<joint id="1">', '<joint id="one">'), r"joint 'one': id is not an integer"),
+        (
+            lambda t: _break(t, '<joint id="1">', '<joint id="one">'),
+            r"joint 'one': id is not an integer",
+        ),
         (lambda t: _break(t, "<name>T</name>", ""), r"robot: missing <name>"),
         (lambda t: t[:-10], r"bad\.irml: line \d+, column \d+: not well-formed XML"),
         (lambda t: t.replace("robot>", "robt>"), r"the root element is <robt>"),
@@ -127,13 +137,17 @@ def test_read_irml_missing_file(tmp_path):
 
 
 def test_parse_irml_limits_and_range_sets():
-    text = good(1).replace(
-        "</joint>",
-        "<limits><lower>-pi</lower><upper>pi/2</upper><velocity>4</velocity></limits></joint>",
-    ).replace(
-        "</robot>",
-        '<range-set name="cell"><joint id="1"><lower>-1</lower><upper>1</upper></joint>'
-        "</range-set></robot>",
+    text = (
+        good(1)
+        .replace(
+            "</joint>",
+            "<limits><lower>-pi</lower><upper>pi/2</upper><velocity>4</velocity></limits></joint>",
+        )
+        .replace(
+            "</robot>",
+            '<range-set name="cell"><joint id="1"><lower>-1</lower><upper>1</upper></joint>'
+            "</range-set></robot>",
+        )
     )
     desc = parse_irml(text)
     j = desc.joints[0]
@@ -146,8 +160,7 @@ def test_parse_irml_limits_and_range_sets():
 def test_parse_irml_range_set_must_cover_all_joints():
     text = good(2).replace(
         "</robot>",
-        '<range-set name="cell"><joint id="1"><lower>-1</lower><upper>1</upper></joint>'
-        "</range-set></robot>",
+        '<range-set name="cell"><joint id="1"><lower>-1</lower><upper>1</upper></joint></range-set></robot>',
     )
     with pytest.raises(InvalidRobotDescription, match=r"range-set 'cell': has no range for joint\(s\) \[2\]"):
         parse_irml(text)
@@ -157,12 +170,8 @@ def test_preset_irb120_dh_matches_thesis_table_2_1():
     desc = preset_description("irb120")
     assert [j.d for j in desc.joints] == [0.29, 0, 0, 0.302, 0, 0.072]
     assert [j.r for j in desc.joints] == [0, 0.27, 0.07, 0, 0, 0]
-    np.testing.assert_allclose(
-        [j.alpha for j in desc.joints], np.array([-1, 0, -1, 1, -1, 0]) * math.pi / 2
-    )
-    np.testing.assert_allclose(
-        np.degrees([j.offset for j in desc.joints]), [0, -90, 0, 0, 0, 180]
-    )
+    np.testing.assert_allclose([j.alpha for j in desc.joints], np.array([-1, 0, -1, 1, -1, 0]) * math.pi / 2)
+    np.testing.assert_allclose(np.degrees([j.offset for j in desc.joints]), [0, -90, 0, 0, 0, 180])
     lab = desc.range_set("lab")
     np.testing.assert_allclose(np.degrees(lab.lower), [-90, -10, -100, -160, -120, -400])
     np.testing.assert_allclose(np.degrees(lab.upper), [90, 45, 40, 160, 120, 400])

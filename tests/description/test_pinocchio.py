@@ -4,11 +4,15 @@ import pytest
 from joulepath.description import chain_from_urdf, pinocchio_model, preset_path
 from joulepath.errors import InvalidRobotDescription
 
-LINK = '<link name="{n}"><inertial><mass value="1"/><origin xyz="0 0 0.1"/>' \
-       '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>'
-JOINT = '<joint name="j{i}" type="{t}"><parent link="l{p}"/><child link="l{i}"/>' \
-        '<origin xyz="0 0 0.2"/><axis xyz="{axis}"/>' \
-        '<limit lower="-1" upper="1" effort="10" velocity="2"/></joint>'
+LINK = (
+    '<link name="{n}"><inertial><mass value="1"/><origin xyz="0 0 0.1"/>'
+    '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>'
+)
+JOINT = (
+    '<joint name="j{i}" type="{t}"><parent link="l{p}"/><child link="l{i}"/>'
+    '<origin xyz="0 0 0.2"/><axis xyz="{axis}"/>'
+    '<limit lower="-1" upper="1" effort="10" velocity="2"/></joint>'
+)
 
 
 def urdf(tmp_path, n=6, types=None, axis="0 0 1"):
@@ -40,7 +44,10 @@ def test_chain_from_urdf_unaligned_axis(tmp_path):
     ("kwargs", "pattern"),
     [
         ({"n": 5}, r"has 5 movable joints; joulepath needs a serial arm with 6 revolute joints"),
-        ({"types": ["revolute"] * 5 + ["prismatic"]}, r"joint 'j6' is JointModelP.*use type=\"revolute\""),
+        (
+            {"types": ["revolute"] * 5 + ["prismatic"]},
+            r"joint 'j6' is JointModelP.*use type=\"revolute\"",
+        ),
         ({"types": ["continuous"] + ["revolute"] * 5}, r"joint 'j1' is JointModelRUB"),
     ],
 )

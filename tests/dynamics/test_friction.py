@@ -55,8 +55,12 @@ def test_friction_adds_to_inverse_dynamics(irb120):
 
 @pytest.mark.parametrize(
     "make",
-    [lambda: ElastoPlasticFriction(form="other"), lambda: ElastoPlasticFriction(mu_k=0.0),
-     lambda: CoulombViscousFriction(coulomb=-1.0), lambda: CoulombViscousFriction(smoothing=-1)],
+    [
+        lambda: ElastoPlasticFriction(form="other"),
+        lambda: ElastoPlasticFriction(mu_k=0.0),
+        lambda: CoulombViscousFriction(coulomb=-1.0),
+        lambda: CoulombViscousFriction(smoothing=-1),
+    ],
 )
 def test_friction_invalid_parameters(make):
     with pytest.raises(InvalidInput):

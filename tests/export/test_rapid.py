@@ -13,8 +13,13 @@ from joulepath.export import collection_module, collection_programs, measurement
 def check_structure(text: str) -> None:
     """MODULE/ENDMODULE, PROC/ENDPROC, FUNC/ENDFUNC, FOR/ENDFOR, WHILE/ENDWHILE balance; arrays sized."""
     code = "\n".join(line.split("!")[0] for line in text.splitlines())
-    for open_, close in (("MODULE", "ENDMODULE"), ("PROC", "ENDPROC"), ("FUNC", "ENDFUNC"),
-                         ("FOR", "ENDFOR"), ("WHILE", "ENDWHILE")):
+    for open_, close in (
+        ("MODULE", "ENDMODULE"),
+        ("PROC", "ENDPROC"),
+        ("FUNC", "ENDFUNC"),
+        ("FOR", "ENDFOR"),
+        ("WHILE", "ENDWHILE"),
+    ):
         opens = len(re.findall(rf"^\s*{open_}\b", code, re.M))
         closes = len(re.findall(rf"^\s*{close}\b", code, re.M))
         assert opens == closes, (open_, opens, closes)
@@ -29,7 +34,9 @@ def check_structure(text: str) -> None:
     assert code.count('"') % 2 == 0
     for line in code.splitlines():
         s = line.strip()
-        if s and not re.match(r"^(MODULE|ENDMODULE|PROC|ENDPROC|FUNC|ENDFUNC|FOR|ENDFOR|WHILE|ENDWHILE|ELSE)\b", s):
+        if s and not re.match(
+            r"^(MODULE|ENDMODULE|PROC|ENDPROC|FUNC|ENDFUNC|FOR|ENDFOR|WHILE|ENDWHILE|ELSE)\b", s
+        ):
             assert s.endswith((";", ",", "[")) or s.endswith("]") is False, line
 
 
@@ -70,8 +77,10 @@ def test_collection_rand_bounds_are_appendix_d1(irb120):
 def test_collection_module_refuses_bounds_outside_the_robot(irb120):
     with pytest.raises(LimitViolation, match=r"joint 2: bounds \[-55, 130\] deg leave the robot's range"):
         collection_module(
-            lower_deg=[-120, -55, -100, -160, -120, -400], upper_deg=[120, 130, 40, 160, 120, 400],
-            nominal=irb120.joint_ranges(), n_moves=10,
+            lower_deg=[-120, -55, -100, -160, -120, -400],
+            upper_deg=[120, 130, 40, 160, 120, 400],
+            nominal=irb120.joint_ranges(),
+            n_moves=10,
         )
 
 

@@ -6,7 +6,13 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import joulepath
-from joulepath.description import Inertial, JointDescription, RobotDescription, irml_string, parse_irml
+from joulepath.description import (
+    Inertial,
+    JointDescription,
+    RobotDescription,
+    irml_string,
+    parse_irml,
+)
 
 ROBOT = joulepath.load_robot("irb120")
 batch_shapes = hnp.array_shapes(min_dims=0, max_dims=3, min_side=1, max_side=4)
@@ -45,14 +51,23 @@ def descriptions(draw):
         lower = draw(st.one_of(st.none(), finite))
         joints.append(
             JointDescription(
-                id=i + 1, type=draw(st.sampled_from("TR")), xi=1, variable=f"q{i + 1}",
-                sign=draw(st.sampled_from([1.0, -1.0])), offset=draw(finite),
-                d=draw(finite), r=draw(finite), alpha=draw(finite),
+                id=i + 1,
+                type=draw(st.sampled_from("TR")),
+                xi=1,
+                variable=f"q{i + 1}",
+                sign=draw(st.sampled_from([1.0, -1.0])),
+                offset=draw(finite),
+                d=draw(finite),
+                r=draw(finite),
+                alpha=draw(finite),
                 inertial=Inertial(mass=draw(finite), com=com, inertia=inertia),
-                lower=lower, velocity=draw(st.one_of(st.none(), finite)),
+                lower=lower,
+                velocity=draw(st.one_of(st.none(), finite)),
             )
         )
-    info = tuple((f"k{i}", draw(st.text("abc xyz-0123", max_size=8)).strip()) for i in range(draw(st.integers(0, 3))))
+    info = tuple(
+        (f"k{i}", draw(st.text("abc xyz-0123", max_size=8)).strip()) for i in range(draw(st.integers(0, 3)))
+    )
     return RobotDescription(name="R", manufacturer="M", info=info, joints=tuple(joints))
 
 

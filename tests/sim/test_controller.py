@@ -70,8 +70,12 @@ def test_tcp_speed_bounds_the_duration(irb120):
 def test_zones_blend_the_corner(irb120):
     a = np.radians([40, 10, 0, 0, 0, 0])
     b = np.radians([40, 10, 0, 0, 0, 90])
-    fine = plan_moves(irb120, irb120.home, [Move(tuple(a), "v1000", "fine"), Move(tuple(b), "v1000", "fine")], CFG)
-    blend = plan_moves(irb120, irb120.home, [Move(tuple(a), "v1000", "z200"), Move(tuple(b), "v1000", "fine")], CFG)
+    fine = plan_moves(
+        irb120, irb120.home, [Move(tuple(a), "v1000", "fine"), Move(tuple(b), "v1000", "fine")], CFG
+    )
+    blend = plan_moves(
+        irb120, irb120.home, [Move(tuple(a), "v1000", "z200"), Move(tuple(b), "v1000", "fine")], CFG
+    )
     assert blend.end_time < fine.end_time
     corner = blend.segments[0].t_end - 1e-3
     _, qd, _ = evaluate_plan(blend, np.array([corner]))
@@ -80,7 +84,12 @@ def test_zones_blend_the_corner(irb120):
 
 def test_plan_moves_refuses_targets_outside_the_ranges(irb120):
     with pytest.raises(LimitViolation, match=r"move 0: joint 2 target 120\.00 deg is outside"):
-        plan_moves(irb120, irb120.home, [Move(tuple(np.radians([0, 120, 0, 0, 0, 0])), "v100", "fine")], CFG)
+        plan_moves(
+            irb120,
+            irb120.home,
+            [Move(tuple(np.radians([0, 120, 0, 0, 0, 0])), "v100", "fine")],
+            CFG,
+        )
     with pytest.raises(InvalidInput, match="unknown speeddata 'v42'"):
         plan_moves(irb120, irb120.home, [Move((0.1,) * 6, "v42", "fine")], CFG)
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from joulepath.data import LOG_COLUMNS, ingest, read_log
+from joulepath.data import LOG_COLUMNS, ingest
 from joulepath.errors import InvalidInput
 from joulepath.sim import make_plant, simulate
 

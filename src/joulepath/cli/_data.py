@@ -45,14 +45,18 @@ def simulate(
     workers: int = typer.Option(2, min=1, help="Processes for --plan."),
 ) -> int:
     """Simulate data collection: random moves on the sim or lab plant, logged like the controller."""
-    from joulepath.sim import simulate as run, simulate_plan
+    from joulepath.sim import simulate as run
+    from joulepath.sim import simulate_plan
 
     if plan:
         if plan != "thesis":
             raise typer.BadParameter(f"unknown plan {plan!r}; the only plan is 'thesis'", param_hint="--plan")
         with console.status("simulating the thesis' datasets (real, sim, micro, test)..."):
             results = simulate_plan(
-                out, seed=seed, robot=robot, workers=workers,
+                out,
+                seed=seed,
+                robot=robot,
+                workers=workers,
                 progress=lambda r: console.print(
                     f"  {r['name']:>5}: {r['moves']} {r['plant']} moves, {r['rows']:,} log rows, "
                     f"{r['table_rows']:,} table rows in {r['table_moves']} moves"
@@ -64,8 +68,7 @@ def simulate(
     with console.status(f"simulating {moves} moves on the {plant} plant..."):
         res = run(target, plant=plant, n_moves=moves, seed=seed, robot=robot)
     console.print(
-        f"wrote {res.log} ({res.n_rows:,} rows, {res.n_moves} moves, {res.duration_s:.1f} s) "
-        f"and {res.moves}"
+        f"wrote {res.log} ({res.n_rows:,} rows, {res.n_moves} moves, {res.duration_s:.1f} s) and {res.moves}"
     )
     return 0
 
@@ -74,12 +77,14 @@ def ingest(
     logs: list[Path] = typer.Argument(..., help="Controller logs (App. D.2) or generic joint CSVs."),
     out: Path = typer.Option(..., "--out", help="Energy table to write (.parquet)."),
     robot: str = typer.Option(
-        "", help="Robot of the logs: checks controller logs' TCP columns, gives generic logs the full 40 features."
+        "",
+        help="Robot of the logs: checks controller logs' TCP, gives generic logs all 40 features.",
     ),
 ) -> int:
     """Turn joint logs into the 40-feature energy table (or the joint-only one)."""
     from joulepath import load_robot
-    from joulepath.data import ingest as run, save_table
+    from joulepath.data import ingest as run
+    from joulepath.data import save_table
 
     r = load_robot(robot) if robot else None
     table = run([str(p) for p in logs], robot=r, progress=lambda p: console.print(f"read {p}"))

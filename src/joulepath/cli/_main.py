@@ -8,8 +8,8 @@ from collections.abc import Sequence
 import typer
 
 from joulepath.cli._data import ingest, rapid_app, simulate
-from joulepath.cli._robot import robot_app
 from joulepath.cli._demo import demo
+from joulepath.cli._robot import robot_app
 from joulepath.errors import JoulepathError
 
 app = typer.Typer(

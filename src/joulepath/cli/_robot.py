@@ -23,8 +23,7 @@ def show(
     x, y, z = home.position_mm
     w, qx, qy, qz = home.quaternion
     console.print(
-        f"tool0 at home: ({x:.1f}, {y:.1f}, {z:.1f}) mm, "
-        f"quaternion ({w:.5f}, {qx:.5f}, {qy:.5f}, {qz:.5f})"
+        f"tool0 at home: ({x:.1f}, {y:.1f}, {z:.1f}) mm, quaternion ({w:.5f}, {qx:.5f}, {qy:.5f}, {qz:.5f})"
     )
     findings = r.check_physical()
     errors = [f for f in findings if f.severity == "error"]

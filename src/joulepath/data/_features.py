@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from scipy.signal import find_peaks
 
 from joulepath._typing import FloatArray
 from joulepath.data._logs import JointLog
@@ -19,16 +20,15 @@ CORNER_TURN_DEG = 30.0
 """... or a dip where the direction of joint motion turns by more than this angle."""
 
 
-def segment_moves(
-    t: FloatArray, qd: FloatArray, *, speed_scale: FloatArray | None = None
-) -> np.ndarray:
+def segment_moves(t: FloatArray, qd: FloatArray, *, speed_scale: FloatArray | None = None) -> np.ndarray:
     """Label each sample with the move it belongs to; -1 for idle samples before the first move.
 
     A move starts where the arm sets off after standing still (all joints below
     :data:`REST_SPEED`), or at a blended corner (zone ``z1..z200``): a local minimum
-    of the normalised joint speed ``max_i |qd_i| / speed_scale_i`` that either dips
-    below :data:`CORNER_DIP` of the peaks on both sides, or dips at all while the
-    direction of joint motion turns by more than :data:`CORNER_TURN_DEG` between
+    of the normalised joint speed ``max_i |qd_i| / speed_scale_i`` (with a
+    prominence of at least 1 % of the stretch's top speed) that either dips below
+    :data:`CORNER_DIP` of the peaks on both sides, or dips below 95 % of them while
+    the direction of joint motion turns by more than :data:`CORNER_TURN_DEG` between
     those peaks (a joint-interpolated move never turns). A move keeps its trailing rest.
 
     Parameters
@@ -45,35 +45,37 @@ def segment_moves(
     """
     n = t.size
     moving = np.abs(qd).max(axis=1) > REST_SPEED
-    scale = np.ones(qd.shape[1]) if speed_scale is None else np.where(
-        np.isfinite(speed_scale) & (speed_scale > 0), speed_scale, 1.0
+    scale = (
+        np.ones(qd.shape[1])
+        if speed_scale is None
+        else np.where(np.isfinite(speed_scale) & (speed_scale > 0), speed_scale, 1.0)
     )
     vel = qd / scale
     speed = np.abs(vel).max(axis=1)
     starts = np.nonzero(moving & ~np.r_[False, moving[:-1]])[0]
     stops = np.nonzero(moving & ~np.r_[moving[1:], False])[0]
     cos_turn = np.cos(np.radians(CORNER_TURN_DEG))
-    corners = []
-    # blended corners inside each moving stretch (stretch k runs from starts[k] to stops[k])
+    corners: list[int] = []
+    # blended corners inside each moving stretch (stretch k runs from starts[k] to stops[k]);
+    # candidate minima need a prominence of 1 % of the stretch's top speed (not sensor noise)
     for s, e in zip(starts, stops, strict=True):
         seg = speed[s : e + 1]
         if seg.size < 5:
             continue
-        d = np.diff(seg)
-        minima = np.nonzero((d[:-1] < 0) & (d[1:] >= 0))[0] + 1
+        minima = find_peaks(-seg, prominence=0.01 * seg.max())[0]
         last = 0
         for k, m in enumerate(minima):
             right_end = minima[k + 1] if k + 1 < minima.size else seg.size
             pl = last + int(np.argmax(seg[last:m]))
-            pr = m + int(np.argmax(seg[m:right_end]))
+            pr = int(m) + int(np.argmax(seg[m:right_end]))
             peak = min(seg[pl], seg[pr])
             if not seg[m] < 0.95 * peak:
                 continue
             a, b = vel[s + pl], vel[s + pr]
             turn = a @ b < cos_turn * np.linalg.norm(a) * np.linalg.norm(b)
             if seg[m] < CORNER_DIP * peak or turn:
-                corners.append(s + m)
-                last = m
+                corners.append(int(s + m))
+                last = int(m)
     bounds = np.zeros(n, dtype=bool)
     bounds[starts] = True
     bounds[np.asarray(corners, dtype=np.int64)] = True
@@ -104,7 +106,8 @@ def sample_lengths(t: FloatArray) -> FloatArray:
     if t.size < 2:
         return np.zeros_like(t)
     dt = np.diff(t)
-    return np.r_[dt, dt[-1]]
+    out: FloatArray = np.r_[dt, dt[-1]]
+    return out
 
 
 def log_to_frame(
@@ -142,7 +145,7 @@ def log_to_frame(
     q, qd, tau = log.q[idx], log.qd[idx], log.tau[idx]
     first = np.r_[True, labels[1:] != labels[:-1]]
     last = np.r_[labels[1:] != labels[:-1], True]
-    cols: dict[str, FloatArray] = {"move_id": labels + move_offset, "t": t}
+    cols: dict[str, np.ndarray] = {"move_id": labels + move_offset, "t": t}
     qdd = log.qdd[idx] if log.qdd is not None else _differentiate(qd, t, first, last)
     for i in range(N_JOINTS):
         cols[f"q{i + 1}"] = q[:, i]

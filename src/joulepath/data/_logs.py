@@ -95,8 +95,7 @@ def _read_header(path: Path, source: str) -> list[str]:
         raise InvalidLog(f"{source}: line 1: not UTF-8 text; is this a CSV log?") from err
     if not first.strip():
         raise InvalidLog(
-            f"{source}: is empty; a log starts with a header line such as "
-            f"'{','.join(LOG_COLUMNS[:4])},...'"
+            f"{source}: is empty; a log starts with a header line such as '{','.join(LOG_COLUMNS[:4])},...'"
         )
     return [h.strip() for h in first.strip().split(",")]
 
@@ -167,7 +166,9 @@ def _parse(path: Path, source: str, header: list[str]) -> dict[str, np.ndarray]:
     if "move" in header:
         types["move"] = pa.int64()
     convert = pacsv.ConvertOptions(
-        column_types=types, null_values=[], strings_can_be_null=False,
+        column_types=types,
+        null_values=[],
+        strings_can_be_null=False,
         quoted_strings_can_be_null=False,
     )
     read = pacsv.ReadOptions(block_size=_BLOCK)
@@ -208,8 +209,10 @@ def _check_rows(cols: dict[str, np.ndarray], header: list[str], source: str) -> 
     if back.size:
         raise _fail(
             source,
-            [f"line {k + 3}: t = {t[k + 1]:g} s does not increase (line {k + 2}: t = {t[k]:g} s)"
-             for k in back],
+            [
+                f"line {k + 3}: t = {t[k + 1]:g} s does not increase (line {k + 2}: t = {t[k]:g} s)"
+                for k in back
+            ],
             "time must strictly increase; are two logs concatenated?",
         )
 
@@ -252,12 +255,13 @@ def _check_units(q: FloatArray, qd: FloatArray, t: FloatArray, source: str, kind
     if kind == "generic":
         big = np.nonzero(np.abs(q).max(axis=0) > 4 * np.pi)[0]
         problems += [
-            f"column q{j + 1} reaches {np.abs(q[:, j]).max():.1f}, more than 4π: degrees in a "
-            "radian log?" for j in big
+            f"column q{j + 1} reaches {np.abs(q[:, j]).max():.1f}, more than 4π: degrees in a radian log?"
+            for j in big
         ]
     if problems:
         fix = (
-            "controller logs are in deg and deg/s" if unit == "deg"
+            "controller logs are in deg and deg/s"
+            if unit == "deg"
             else "generic logs are in rad and rad/s: convert the columns"
         )
         raise _fail(source, problems, fix)
@@ -293,7 +297,12 @@ def read_log(path: str | os.PathLike[str]) -> JointLog:
                 [f"line {k + 2}: quaternion e1..e4 has norm {norms[k]:.4f}, not 1" for k in bad],
             )
         return JointLog(
-            source=source, kind=kind, t=t, q=q * DEG, qd=qd * DEG, tau=tau,
+            source=source,
+            kind=kind,
+            t=t,
+            q=q * DEG,
+            qd=qd * DEG,
+            tau=tau,
             tcp_position=np.column_stack([cols["x"], cols["y"], cols["z"]]) * MM,
             tcp_quaternion=quat,
             tcp_euler=np.column_stack([cols["phi"], cols["theta"], cols["psi"]]) * DEG,

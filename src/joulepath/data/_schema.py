@@ -30,12 +30,22 @@ N_JOINTS = 6
 LOG_COLUMNS: tuple[str, ...] = (
     "t",
     *(f"{p}{i}" for i in range(1, N_JOINTS + 1) for p in ("q", "dq", "tau")),
-    "x", "y", "z", "e1", "e2", "e3", "e4", "psi", "theta", "phi",
+    "x",
+    "y",
+    "z",
+    "e1",
+    "e2",
+    "e3",
+    "e4",
+    "psi",
+    "theta",
+    "phi",
 )
 """Columns of the controller log of thesis Appendix D.2 (deg, deg/s, N·m, mm, quaternion, deg)."""
 
 GENERIC_REQUIRED: tuple[str, ...] = (
-    "t", *(f"{p}{i}" for i in range(1, N_JOINTS + 1) for p in ("q", "dq", "tau")),
+    "t",
+    *(f"{p}{i}" for i in range(1, N_JOINTS + 1) for p in ("q", "dq", "tau")),
 )
 """Required columns of the generic joint log (s, rad, rad/s, N·m); optional ``ddq{i}`` and ``move``."""
 
@@ -44,14 +54,29 @@ JOINT_ACC = tuple(f"ddq{i}" for i in range(1, N_JOINTS + 1))
 
 FEATURES_FULL: tuple[str, ...] = (
     *JOINT_STATE,
-    "x", "y", "z",
-    "qx", "qy", "qz", "qw",
-    "yaw", "pitch", "roll",
+    "x",
+    "y",
+    "z",
+    "qx",
+    "qy",
+    "qz",
+    "qw",
+    "yaw",
+    "pitch",
+    "roll",
     *JOINT_ACC,
-    "dx", "dy", "dz",
-    "dphi", "dtheta", "dpsi",
-    "ddx", "ddy", "ddz",
-    "ddphi", "ddtheta", "ddpsi",
+    "dx",
+    "dy",
+    "dz",
+    "dphi",
+    "dtheta",
+    "dpsi",
+    "ddx",
+    "ddy",
+    "ddz",
+    "ddphi",
+    "ddtheta",
+    "ddpsi",
 )
 """The 40 model inputs of thesis Appendix F, in its order."""
 
@@ -74,5 +99,3 @@ SCHEMA_VERSION = 1
 def table_columns(feature_set: str) -> tuple[str, ...]:
     """All columns of a table holding ``feature_set``, in order."""
     return (*META, *FEATURE_SETS[feature_set], *TARGETS, "dt")
-
-

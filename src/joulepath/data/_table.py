@@ -192,15 +192,22 @@ def ingest(
         frame = log_to_frame(log, feature_set=feature_set, tcp=tcp, speed_scale=scale, move_offset=offset)
         n_moves = int(frame["move_id"].nunique())
         sources.append(
-            {"file": Path(log.source).name, "kind": log.kind, "rows": len(frame),
-             "moves": n_moves, "first_move_id": offset}
+            {
+                "file": Path(log.source).name,
+                "kind": log.kind,
+                "rows": len(frame),
+                "moves": n_moves,
+                "first_move_id": offset,
+            }
         )
         offset += n_moves
         frames.append(frame)
     frame = pd.concat(frames, ignore_index=True)
     return EnergyTable(
-        frame=frame, feature_set=feature_set,
-        robot=robot.name if robot is not None else None, sources=tuple(sources),
+        frame=frame,
+        feature_set=feature_set,
+        robot=robot.name if robot is not None else None,
+        sources=tuple(sources),
     )
 
 

@@ -18,9 +18,7 @@ def rot_z(theta: float) -> FloatArray:
 def dh_link(d: float, r: float, alpha: float) -> FloatArray:
     """Constant part of a standard DH transform: ``Tz(d) @ Tx(r) @ Rx(alpha)``."""
     ca, sa = np.cos(alpha), np.sin(alpha)
-    return np.array(
-        [[1.0, 0.0, 0.0, r], [0.0, ca, -sa, 0.0], [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]]
-    )
+    return np.array([[1.0, 0.0, 0.0, r], [0.0, ca, -sa, 0.0], [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]])
 
 
 def dh_transform(theta: float, d: float, r: float, alpha: float) -> FloatArray:

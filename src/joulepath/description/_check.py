@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from joulepath._typing import FloatArray
 from joulepath.description._model import Inertial, RobotDescription
 
 
@@ -30,7 +29,7 @@ class Finding:
         return f"{self.severity}: {self.where}: {self.message}"
 
 
-def _fmt(a: FloatArray) -> str:
+def _fmt(a: np.ndarray) -> str:
     return "[" + ", ".join(f"{x:.4g}" for x in np.ravel(a)) + "]"
 
 
@@ -152,21 +151,15 @@ def check_physical(desc: RobotDescription) -> list[Finding]:
                 )
                 break
         if j.lower is not None and j.upper is not None and not j.lower < j.upper:
-            out.append(
-                Finding("error", f"joint {j.id} <limits>", f"lower {j.lower} ≥ upper {j.upper}")
-            )
+            out.append(Finding("error", f"joint {j.id} <limits>", f"lower {j.lower} ≥ upper {j.upper}"))
         if j.velocity is not None and not j.velocity > 0:
-            out.append(
-                Finding("error", f"joint {j.id} <limits> <velocity>", "must be positive")
-            )
+            out.append(Finding("error", f"joint {j.id} <limits> <velocity>", "must be positive"))
         if j.effort is not None and not j.effort > 0:
             out.append(Finding("error", f"joint {j.id} <limits> <effort>", "must be positive"))
     for rs in desc.range_sets:
         for j, lo, hi in zip(desc.joints, rs.lower, rs.upper, strict=True):
             if not lo < hi:
-                out.append(
-                    Finding("error", f"range-set {rs.name!r} joint {j.id}", f"{lo} ≥ {hi}")
-                )
+                out.append(Finding("error", f"range-set {rs.name!r} joint {j.id}", f"{lo} ≥ {hi}"))
             if j.lower is not None and j.upper is not None and (lo < j.lower or hi > j.upper):
                 out.append(
                     Finding(
@@ -192,8 +185,7 @@ def check_physical(desc: RobotDescription) -> list[Finding]:
                 Finding(
                     "error",
                     "<manipulator-mass>",
-                    f"the masses sum to {total:.3f} kg ({parts}), more than the "
-                    f"robot's {spec:g} kg",
+                    f"the masses sum to {total:.3f} kg ({parts}), more than the robot's {spec:g} kg",
                 )
             )
         elif total < spec * 0.9:

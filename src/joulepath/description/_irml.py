@@ -32,6 +32,7 @@ from pathlib import Path
 import defusedxml
 import defusedxml.ElementTree as DET
 
+from joulepath._io import atomic_write_text
 from joulepath.description._expr import (
     ExpressionError,
     evaluate,
@@ -46,7 +47,6 @@ from joulepath.description._model import (
     RangeSet,
     RobotDescription,
 )
-from joulepath._io import atomic_write_text
 from joulepath.errors import InvalidRobotDescription
 
 _STRUCTURAL = {"joint", "range-set", "payload", "base", "name", "manufacturer"}
@@ -164,7 +164,12 @@ def _joint(el: ET.Element, ctx: _Ctx) -> JointDescription:
     kw = f"{where} <kinematics>"
     dyn = _child(el, "dynamics", ctx, where)
     lim = _children(el, "limits")
-    limits: dict[str, float | None] = {"lower": None, "upper": None, "velocity": None, "effort": None}
+    limits: dict[str, float | None] = {
+        "lower": None,
+        "upper": None,
+        "velocity": None,
+        "effort": None,
+    }
     if lim:
         for key in limits:
             limits[key] = _optional_number(lim[0], key, ctx, f"{where} <limits>")
@@ -234,7 +239,8 @@ def parse_irml(data: str | bytes, *, source: str = "<string>") -> RobotDescripti
         root = DET.fromstring(data, forbid_dtd=True)
     except defusedxml.DefusedXmlException as err:
         raise ctx.fail(
-            "XML", f"refused ({type(err).__name__}): entities and DTDs are not allowed in IRML",
+            "XML",
+            f"refused ({type(err).__name__}): entities and DTDs are not allowed in IRML",
             "remove the <!DOCTYPE>/<!ENTITY> declarations",
         ) from err
     except ET.ParseError as err:

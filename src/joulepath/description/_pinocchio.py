@@ -59,7 +59,7 @@ def chain_from_urdf(path: str | os.PathLike[str], *, tool_frame: str | None = No
     if n != 6:
         raise InvalidRobotDescription(
             f"{p}: has {n} movable joints; joulepath needs a serial arm with 6 revolute joints "
-            "(fix the other joints, type=\"fixed\")"
+            '(fix the other joints, type="fixed")'
         )
     axes = np.empty((n, 3))
     for i in range(1, n + 1):
@@ -73,7 +73,7 @@ def chain_from_urdf(path: str | os.PathLike[str], *, tool_frame: str | None = No
         else:
             raise InvalidRobotDescription(
                 f"{p}: joint {name!r} is {short}, not a single-axis revolute joint with limits; "
-                "use type=\"revolute\""
+                'use type="revolute"'
             )
         if model.parents[i] != i - 1:
             raise InvalidRobotDescription(
@@ -121,9 +121,7 @@ def pinocchio_model(chain: Chain) -> Any:
         short = next((k for k, v in _AXES.items() if np.allclose(axis, v, atol=0.0)), None)
         jm = getattr(pin, short)() if short else pin.JointModelRevoluteUnaligned(axis.copy())
         parent = model.addJoint(parent, jm, placement, chain.joint_names[i])
-        body = pin.Inertia(
-            float(chain.masses[i]), chain.coms[i].copy(), chain.inertias[i].copy()
-        )
+        body = pin.Inertia(float(chain.masses[i]), chain.coms[i].copy(), chain.inertias[i].copy())
         model.appendBodyToJoint(parent, body, pin.SE3.Identity())
     tool = pin.SE3(chain.tool[:3, :3].copy(), chain.tool[:3, 3].copy())
     model.addFrame(pin.Frame("tool0", parent, tool, pin.FrameType.OP_FRAME))

@@ -35,7 +35,7 @@ class _Addable:
             return NotImplemented
         left = self.terms if isinstance(self, FrictionSum) else (self,)
         right = other.terms if isinstance(other, FrictionSum) else (other,)
-        return FrictionSum(terms=(*left, *right))  # type: ignore[arg-type]
+        return FrictionSum(terms=(*left, *right))
 
 
 def _param(value: PerJoint, name: str) -> FloatArray:

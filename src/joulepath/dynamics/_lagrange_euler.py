@@ -60,9 +60,10 @@ def _jacobians(chain: Chain, q: FloatArray) -> tuple[FloatArray, FloatArray, Flo
 def mass_matrix_le(chain: Chain, q: FloatArray) -> FloatArray:
     """Joint-space inertia matrix ``D(q)`` (eq. 2.20), shape (N, n, n) for q (N, n)."""
     a, b, _, dw = _jacobians(chain, q)
-    return np.einsum("Nkia,Nkja,k->Nij", a, a, chain.masses) + np.einsum(
+    out: FloatArray = np.einsum("Nkia,Nkja,k->Nij", a, a, chain.masses) + np.einsum(
         "Nkia,Nkab,Nkjb->Nij", b, dw, b
     )
+    return out
 
 
 def lagrange_euler(chain: Chain, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
@@ -77,9 +78,10 @@ def lagrange_euler(chain: Chain, q: FloatArray, qd: FloatArray, qdd: FloatArray)
     # dA[N, l, k, j] = z_l x A[k, j] for l <= j ;  z_j x A[k, l] for j < l
     zl = z[:, :, None, None, :]
     d_a = np.cross(zl, a[:, None, :, :, :]) * le_lj[None, :, None, :, None]
-    d_a += np.cross(
-        z[:, None, None, :, :], np.swapaxes(a, 1, 2)[:, :, :, None, :]
-    ) * lt_lj.T[None, :, None, :, None]
+    d_a += (
+        np.cross(z[:, None, None, :, :], np.swapaxes(a, 1, 2)[:, :, :, None, :])
+        * lt_lj.T[None, :, None, :, None]
+    )
     # dB[N, l, k, j] = z_l x B[k, j] for l < j
     d_b = np.cross(zl, b[:, None, :, :, :]) * lt_lj[None, :, None, :, None]
     # dDw[N, l, k] = S(z_l) Dw_k - Dw_k S(z_l) for l <= k
@@ -93,9 +95,7 @@ def lagrange_euler(chain: Chain, q: FloatArray, qd: FloatArray, qdd: FloatArray)
         + np.einsum("Nkia,Nkab,Nlkjb->Nlij", b, dw, d_b)
     )
     # C^i_kj = dD_ij/dq_k - 1/2 dD_kj/dq_i ; d_mass[N, l, i, j] = dD_ij / dq_l
-    coupling = np.einsum("Nkij,Nk,Nj->Ni", d_mass, qd, qd) - 0.5 * np.einsum(
-        "Nikj,Nk,Nj->Ni", d_mass, qd, qd
-    )
+    coupling = np.einsum("Nkij,Nk,Nj->Ni", d_mass, qd, qd) - 0.5 * np.einsum("Nikj,Nk,Nj->Ni", d_mass, qd, qd)
     gravity = -np.einsum("Nkia,k,a->Ni", a, m, chain.gravity)
     out: FloatArray = np.einsum("Nij,Nj->Ni", mass, qdd) + coupling + gravity
     return out

@@ -30,9 +30,7 @@ class PinocchioRnea:
             self._local.pool = pool
         return pool
 
-    def __call__(
-        self, q: FloatArray, qd: FloatArray, qdd: FloatArray, *, n_threads: int = 1
-    ) -> FloatArray:
+    def __call__(self, q: FloatArray, qd: FloatArray, qdd: FloatArray, *, n_threads: int = 1) -> FloatArray:
         """Torques for ``q, qd, qdd`` of shape (N, n); returns (N, n)."""
         import pinocchio as pin
 

@@ -250,9 +250,7 @@ class Robot:
         else:
             from joulepath.description import combine_inertials, transform_inertial
 
-            base = Inertial.from_arrays(
-                self.chain.masses[-1], self.chain.coms[-1], self.chain.inertias[-1]
-            )
+            base = Inertial.from_arrays(self.chain.masses[-1], self.chain.coms[-1], self.chain.inertias[-1])
             last = combine_inertials(base, transform_inertial(load, self.chain.tool))
             masses = self.chain.masses.copy()
             coms = self.chain.coms.copy()
@@ -286,9 +284,7 @@ class Robot:
         lines.append("joint        lower°    upper°   speed°/s   mass kg")
         for i, name in enumerate(self.joint_names):
             lo, hi, v = np.degrees([self.chain.lower[i], self.chain.upper[i], self.chain.velocity[i]])
-            lines.append(
-                f"{name:<10} {lo:8.1f}  {hi:8.1f}  {v:8.1f}  {self.chain.masses[i]:8.3f}"
-            )
+            lines.append(f"{name:<10} {lo:8.1f}  {hi:8.1f}  {v:8.1f}  {self.chain.masses[i]:8.3f}")
         lines.append(f"moving mass {self.chain.masses.sum():.3f} kg")
         if self.payload is not None:
             lines.append(f"payload {self.payload.mass:.3f} kg at {self.payload.com} m (tool0)")
@@ -323,9 +319,7 @@ def load_robot(name_or_path: str | os.PathLike[str], *, tool_frame: str | None =
         return Robot(chain_from_description(desc), description=desc, source=str(path))
     if suffix == ".urdf":
         return Robot(chain_from_urdf(path, tool_frame=tool_frame), source=str(path))
-    raise InvalidRobotDescription(
-        f"{path}: unknown robot file type {suffix!r}; use .irml or .urdf"
-    )
+    raise InvalidRobotDescription(f"{path}: unknown robot file type {suffix!r}; use .irml or .urdf")
 
 
 __all__ = ["HOME", "METHODS", "Robot", "load_robot"]

@@ -35,10 +35,7 @@ def random_moves(
     targets = lower + u * (upper - lower)
     si = np.round(rng.random(n_moves) * (len(speeds) - 1)).astype(int)
     zi = np.round(rng.random(n_moves) * (len(zones) - 1)).astype(int)
-    return [
-        Move(tuple(float(x) for x in targets[k]), speeds[si[k]], zones[zi[k]])
-        for k in range(n_moves)
-    ]
+    return [Move(tuple(float(x) for x in targets[k]), speeds[si[k]], zones[zi[k]]) for k in range(n_moves)]
 
 
 def draw_moves(

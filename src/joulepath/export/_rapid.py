@@ -37,7 +37,9 @@ def _num(value: float) -> str:
     return "0" if text in ("-0", "") else text
 
 
-def _check_bounds(lower_deg: FloatArray, upper_deg: FloatArray, nominal: tuple[FloatArray, FloatArray]) -> None:
+def _check_bounds(
+    lower_deg: FloatArray, upper_deg: FloatArray, nominal: tuple[FloatArray, FloatArray]
+) -> None:
     lo, hi = (np.degrees(x) for x in nominal)
     for j in range(N_JOINTS):
         if not lower_deg[j] < upper_deg[j]:
@@ -62,12 +64,12 @@ def _array(decl: str, name: str, items: Sequence[str], per_line: int) -> list[st
 
 def collection_module(
     *,
-    lower_deg: Sequence[float],
-    upper_deg: Sequence[float],
+    lower_deg: Sequence[float] | FloatArray,
+    upper_deg: Sequence[float] | FloatArray,
     nominal: tuple[FloatArray, FloatArray],
     n_moves: int = 1000,
     mode: str = "rand",
-    moves: Sequence[tuple[Sequence[float], str, str]] | None = None,
+    moves: Sequence[tuple[Sequence[float] | FloatArray, str, str]] | None = None,
     rand_seed: int = 12345,
     name: str = "JPCollect",
 ) -> str:
@@ -265,7 +267,15 @@ def collection_programs(
         drawn = draw_moves(robot, n_moves, range_set=range_set, rng=np.random.default_rng(seed))
         moves = [(np.degrees(m.target), m.speed, m.zone) for m in drawn]
     collect = collection_module(
-        lower_deg=np.degrees(lower), upper_deg=np.degrees(upper), nominal=robot.joint_ranges(),
-        n_moves=n_moves, mode=mode, moves=moves, rand_seed=seed,
+        lower_deg=np.degrees(lower),
+        upper_deg=np.degrees(upper),
+        nominal=robot.joint_ranges(),
+        n_moves=n_moves,
+        mode=mode,
+        moves=moves,
+        rand_seed=seed,
     )
-    return {"JPCollect.mod": collect, "JPMeasure.mod": measurement_module(sample_period=sample_period)}
+    return {
+        "JPCollect.mod": collect,
+        "JPMeasure.mod": measurement_module(sample_period=sample_period),
+    }

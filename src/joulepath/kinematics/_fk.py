@@ -25,8 +25,7 @@ def check_q(q: ArrayLike, n: int, name: str = "q") -> FloatArray:
     arr = np.asarray(q, dtype=float)
     if arr.ndim == 0 or arr.shape[-1] != n:
         raise InvalidInput(
-            f"{name} has shape {arr.shape}, but the robot has {n} joints: "
-            f"expected shape (..., {n})"
+            f"{name} has shape {arr.shape}, but the robot has {n} joints: expected shape (..., {n})"
         )
     if not np.all(np.isfinite(arr)):
         raise InvalidInput(f"{name} contains NaN or infinite values")

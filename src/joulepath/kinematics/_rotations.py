@@ -14,12 +14,11 @@ def axis_angle_matrix(axis: FloatArray, angle: FloatArray) -> FloatArray:
     -------
     ndarray of shape (..., 3, 3)
     """
-    k = np.array(
-        [[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]]
-    )
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
     s = np.sin(angle)[..., None, None]
     c = np.cos(angle)[..., None, None]
-    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+    out: FloatArray = np.eye(3) + s * k + (1.0 - c) * (k @ k)
+    return out
 
 
 def rotation_to_quaternion(rot: FloatArray) -> FloatArray:

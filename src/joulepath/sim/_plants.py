@@ -83,9 +83,7 @@ def perturbed_robot(robot: Robot, rng: np.random.Generator) -> Robot:
 
 def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
     """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot)."""
-    nominal = CoulombViscousFriction(
-        coulomb=NOMINAL_COULOMB, viscous=NOMINAL_VISCOUS, smoothing=0.005
-    )
+    nominal = CoulombViscousFriction(coulomb=NOMINAL_COULOMB, viscous=NOMINAL_VISCOUS, smoothing=0.005)
     if name == "sim":
         return Plant(name="sim", robot=robot, friction=nominal)
     if name == "lab":
@@ -97,8 +95,12 @@ def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
             stribeck=0.4 * np.array(NOMINAL_COULOMB),
         )
         return Plant(
-            name="lab", robot=real, friction=friction, gear_efficiency=0.88,
-            torque_noise=(0.15, 0.15, 0.10, 0.03, 0.03, 0.02), speed_noise_deg_s=0.05,
+            name="lab",
+            robot=real,
+            friction=friction,
+            gear_efficiency=0.88,
+            torque_noise=(0.15, 0.15, 0.10, 0.03, 0.03, 0.02),
+            speed_noise_deg_s=0.05,
             tracking_hz=12.0,
         )
     raise InvalidInput(f"unknown plant {name!r}; use one of {', '.join(PLANTS)}")

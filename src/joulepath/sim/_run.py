@@ -35,12 +35,13 @@ def measure(
     moves: Sequence[Move],
     *,
     rng: np.random.Generator,
-    config: ControllerConfig = ControllerConfig(),
+    config: ControllerConfig | None = None,
     start: np.ndarray | None = None,
     instance_seed: int = 120,
 ) -> tuple[MotionPlan, Measured]:
     """Plan ``moves`` from ``start`` (default home) and measure them on a plant."""
     q0 = robot.home if start is None else np.asarray(start, float)
+    config = config or ControllerConfig()
     plan = plan_moves(robot, q0, moves, config)
     t = log_times(plan.end_time, config, rng=rng)
     plant = make_plant(plant_name, robot, instance_seed=instance_seed)
@@ -74,7 +75,7 @@ def simulate(
     seed: int | np.random.SeedSequence = 0,
     robot: str = "irb120",
     range_set: str = "collection",
-    config: ControllerConfig = ControllerConfig(),
+    config: ControllerConfig | None = None,
 ) -> SimulatedLog:
     """Run ``n_moves`` random moves (thesis Appendix D.1) on a plant and write the log.
 
@@ -92,19 +93,31 @@ def simulate(
     return SimulatedLog(path, side, int(measured.t.size), len(plan.segments), float(measured.t[-1]))
 
 
-THESIS_PLAN = (("real", "lab", 1000), ("sim", "sim", 1000), ("micro", "lab", 100), ("test", "lab", 100))
+THESIS_PLAN = (
+    ("real", "lab", 1000),
+    ("sim", "sim", 1000),
+    ("micro", "lab", 100),
+    ("test", "lab", 100),
+)
 """The thesis' datasets (§4.3.1): name, plant, number of moves."""
 
 
-def _plan_job(name: str, plant: str, n_moves: int, seed: np.random.SeedSequence, out: str,
-              robot: str) -> dict[str, object]:
+def _plan_job(
+    name: str, plant: str, n_moves: int, seed: np.random.SeedSequence, out: str, robot: str
+) -> dict[str, object]:
     out_dir = Path(out)
     res = simulate(out_dir / "logs" / f"{name}.csv", plant=plant, n_moves=n_moves, seed=seed, robot=robot)
     table = ingest([res.log], robot=load_robot(robot))
     save_table(table, out_dir / f"{name}.parquet")
-    return {"name": name, "plant": plant, "moves": n_moves, "rows": res.n_rows,
-            "table_rows": len(table.frame), "table_moves": table.n_moves,
-            "duration_s": res.duration_s}
+    return {
+        "name": name,
+        "plant": plant,
+        "moves": n_moves,
+        "rows": res.n_rows,
+        "table_rows": len(table.frame),
+        "table_moves": table.n_moves,
+        "duration_s": res.duration_s,
+    }
 
 
 def simulate_plan(

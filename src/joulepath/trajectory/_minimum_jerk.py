@@ -46,10 +46,9 @@ def sample_times(duration: float, dt: float = SAMPLE_PERIOD) -> FloatArray:
     n = round(duration / dt)
     if n < 1 or abs(n * dt - duration) > 1e-9:
         raise InvalidInput(
-            f"duration {duration} s is not a whole number of {dt} s samples; "
-            f"use e.g. {max(n, 1) * dt:.3f} s"
+            f"duration {duration} s is not a whole number of {dt} s samples; use e.g. {max(n, 1) * dt:.3f} s"
         )
-    return np.arange(n + 1) * dt
+    return np.arange(n + 1, dtype=np.float64) * float(dt)
 
 
 def minimum_jerk(
