@@ -48,6 +48,8 @@ ALLOWED = {
     "data": {"dynamics"},  # annotations only (TYPE_CHECKING); robot passed in by the caller
     "export": {"description", "kinematics", "dynamics", "trajectory", "data"},
     "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb"},
+    "learn": {"data", "dynamics"},
+    "evolve": set(),
     "energy": set(),
     "units": set(),
     "abb": set(),

@@ -8,6 +8,7 @@ derives from the matching built-in so that ``except ValueError`` keeps working::
     ├── InvalidInput (ValueError)              arrays or arguments of the wrong shape or range
     ├── InvalidLog (ValueError)                a joint log or energy table that cannot be used
     ├── LimitViolation (ValueError)            a result that would drive a joint past a limit
+    ├── InvalidModel (ValueError)              a model file refused, or a table it cannot read
     └── MissingDependency (ImportError)        an optional extra is not installed
 
 Messages say what was received, what was expected and how to fix it.
@@ -34,6 +35,10 @@ class InvalidLog(JoulepathError, ValueError):
 
 class LimitViolation(JoulepathError, ValueError):
     """A trajectory or program would drive a joint past its range, speed or torque."""
+
+
+class InvalidModel(JoulepathError, ValueError):
+    """A model file is refused (unknown types, bad card) or does not fit the table given."""
 
 
 class MissingDependency(JoulepathError, ImportError):

@@ -9,6 +9,7 @@ import typer
 
 from joulepath.cli._data import ingest, rapid_app, simulate
 from joulepath.cli._demo import demo
+from joulepath.cli._learn import importance, train
 from joulepath.cli._robot import robot_app
 from joulepath.errors import JoulepathError
 
@@ -23,6 +24,8 @@ app.add_typer(robot_app, name="robot")
 app.add_typer(rapid_app, name="rapid")
 app.command("simulate")(simulate)
 app.command("ingest")(ingest)
+app.command("train")(train)
+app.command("importance")(importance)
 app.command("demo")(demo)
 
 

@@ -1,6 +1,7 @@
 """Rigid-body dynamics: the :class:`Robot`, two inverse-dynamics implementations, friction."""
 
 from joulepath.dynamics._friction import (
+    NOMINAL_FRICTION,
     CoulombViscousFriction,
     ElastoPlasticFriction,
     Friction,
@@ -16,6 +17,7 @@ __all__ = [
     "Friction",
     "FrictionSum",
     "METHODS",
+    "NOMINAL_FRICTION",
     "PinocchioRnea",
     "Robot",
     "lagrange_euler",

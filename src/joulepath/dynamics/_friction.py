@@ -122,3 +122,15 @@ class FrictionSum(_Addable):
         for term in self.terms:
             total = total + term.torque(qd)
         return total
+
+
+NOMINAL_FRICTION = CoulombViscousFriction(
+    coulomb=(0.9, 1.1, 0.7, 0.25, 0.25, 0.15),
+    viscous=(0.6, 0.7, 0.4, 0.08, 0.08, 0.04),
+    smoothing=0.005,
+)
+"""Nominal joint friction assumed for the IRB 120 (N·m, N·m·s/rad, joint side).
+
+No identified friction of the IRB 120 is public; these values are of the size
+reported for robots of its class. The ``sim`` plant uses them, the ``lab`` plant
+departs from them, and the physics baseline of the energy models uses them."""

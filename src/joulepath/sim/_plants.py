@@ -24,16 +24,14 @@ import numpy as np
 from scipy import signal
 
 from joulepath._typing import FloatArray
-from joulepath.dynamics import CoulombViscousFriction, Friction, Robot
+from joulepath.dynamics import NOMINAL_FRICTION, Friction, Robot
 from joulepath.errors import InvalidInput
 from joulepath.sim._controller import MotionPlan, evaluate_plan
 
 PLANTS = ("sim", "lab")
 
-NOMINAL_COULOMB = (0.9, 1.1, 0.7, 0.25, 0.25, 0.15)
-"""N·m, joint side (assumed)."""
-NOMINAL_VISCOUS = (0.6, 0.7, 0.4, 0.08, 0.08, 0.04)
-"""N·m·s/rad, joint side (assumed)."""
+NOMINAL_COULOMB = np.atleast_1d(np.asarray(NOMINAL_FRICTION.coulomb, dtype=float))
+NOMINAL_VISCOUS = np.atleast_1d(np.asarray(NOMINAL_FRICTION.viscous, dtype=float))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -83,16 +81,15 @@ def perturbed_robot(robot: Robot, rng: np.random.Generator) -> Robot:
 
 def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
     """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot)."""
-    nominal = CoulombViscousFriction(coulomb=NOMINAL_COULOMB, viscous=NOMINAL_VISCOUS, smoothing=0.005)
     if name == "sim":
-        return Plant(name="sim", robot=robot, friction=nominal)
+        return Plant(name="sim", robot=robot, friction=NOMINAL_FRICTION)
     if name == "lab":
         rng = np.random.default_rng(instance_seed)
         real = perturbed_robot(robot, rng).with_payload(0.35, com=(0.0, 0.0, 0.025))
         friction = LabFriction(
-            coulomb=1.35 * np.array(NOMINAL_COULOMB),
-            viscous=1.25 * np.array(NOMINAL_VISCOUS),
-            stribeck=0.4 * np.array(NOMINAL_COULOMB),
+            coulomb=1.35 * NOMINAL_COULOMB,
+            viscous=1.25 * NOMINAL_VISCOUS,
+            stribeck=0.4 * NOMINAL_COULOMB,
         )
         return Plant(
             name="lab",

@@ -1,5 +1,15 @@
 """Joint trajectories over a fixed duration, sampled at the data rate."""
 
 from joulepath.trajectory._minimum_jerk import Trajectory, minimum_jerk, sample_times
+from joulepath.trajectory._polynomial import GRID_HIGH, GRID_LOW, GRID_STEP, rest_to_rest, thesis_quintic
 
-__all__ = ["Trajectory", "minimum_jerk", "sample_times"]
+__all__ = [
+    "GRID_HIGH",
+    "GRID_LOW",
+    "GRID_STEP",
+    "Trajectory",
+    "minimum_jerk",
+    "rest_to_rest",
+    "sample_times",
+    "thesis_quintic",
+]

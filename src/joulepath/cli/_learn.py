@@ -1,0 +1,104 @@
+"""``joulepath train`` and ``joulepath importance``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from joulepath.cli._common import console
+
+
+def _split(
+    text: str, option: str, allowed: tuple[str, ...], all_value: tuple[str, ...] | None = None
+) -> tuple[str, ...]:
+    items = tuple(t.strip() for t in text.split(",") if t.strip())
+    if all_value is not None and items == ("all",):
+        return all_value
+    bad = [t for t in items if t not in allowed]
+    if bad or not items:
+        raise typer.BadParameter(
+            f"{', '.join(bad) or 'nothing'} not allowed; use any of {', '.join(allowed)}"
+            + (" or all" if all_value else ""),
+            param_hint=option,
+        )
+    return items
+
+
+def train(
+    data: Path = typer.Option(..., "--data", help="Training energy table (.parquet)."),
+    test: Path = typer.Option(..., "--test", help="Test table of other moves (.parquet)."),
+    family: str = typer.Option("all", help="mlp, svr, par, xgb (comma separated) or all."),
+    target: str = typer.Option("E", help="Targets: E, E1..E6 (comma separated) or all."),
+    grid: str = typer.Option("quick", help="quick, or thesis (Tables 2.2-2.5)."),
+    cv: int = typer.Option(5, min=2, help="Folds."),
+    inputs: str = typer.Option("physics", help="physics (raw + nominal model terms) or thesis (raw)."),
+    out: Path = typer.Option(..., "--out", help="Folder for models and reports."),
+    seed: int = typer.Option(0),
+    jobs: int = typer.Option(1, min=1, help="Local processes for the grid search."),
+    scheduler: str = typer.Option("", help="Dask scheduler address (tcp://HOST:PORT) for the grid search."),
+    robot: str = typer.Option("irb120", help="Robot of the data."),
+) -> int:
+    """Tune (grid search + CV), refit and test energy models; save them with cards and reports."""
+    from joulepath.data import TARGETS, load_table
+    from joulepath.learn import FAMILIES, TrainConfig
+    from joulepath.learn import train as run
+
+    config = TrainConfig(
+        families=_split(family, "--family", FAMILIES, FAMILIES),
+        targets=_split(target, "--target", TARGETS, TARGETS),
+        grid=grid,
+        cv=cv,
+        inputs=inputs,
+        seed=seed,
+        n_jobs=jobs,
+        scheduler=scheduler or None,
+        robot=robot,
+    )
+    train_table, test_table = load_table(data), load_table(test)
+    with console.status("training...") as status:
+        report = run(train_table, test_table, config, out, progress=lambda m: status.update(m))
+    cols = [
+        "family",
+        "target",
+        "cv_grouped_r2",
+        "cv_shuffled_r2",
+        "test_r2",
+        "test_mae",
+        "path_median_pct",
+        "path_p95_pct",
+        "best_params",
+    ]
+    console.print(
+        report.results[cols].to_string(index=False, float_format=lambda v: f"{v:.4f}"), markup=False
+    )
+    for b in report.baselines:
+        s = b["scores"]["E"]
+        console.print(
+            f"{b['label']}: R² {s['r2']:.4f}, MAE {s['mae']:.4f} J, path error median "
+            f"{s['path_median_pct']:.1f} %, {b['latency_per_row_s_batch'] * 1e6:.2f} µs/row",
+            markup=False,
+        )
+    console.print(f"models, results.csv, report.json and plots in {out}")
+    return 0
+
+
+def importance(
+    data: Path = typer.Option(..., "--data", help="Energy table (.parquet)."),
+    target: str = typer.Option("E", help="Target: E or E1..E6."),
+    out: Path = typer.Option(..., "--out", help="Folder for importance.csv and the plot."),
+    seed: int = typer.Option(0),
+) -> int:
+    """Rank the inputs (and joints) by their influence on the energy (thesis Figs 4.1-4.2)."""
+    from joulepath._io import atomic_write_text
+    from joulepath.data import load_table
+    from joulepath.learn import feature_importance, plot_importance, rank_joints
+
+    table = load_table(data)
+    imp = feature_importance(table, target, seed=seed)
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out / f"importance_{target}.csv", imp.to_csv())
+    plot_importance(imp, out / f"importance_{target}.png", title=f"Feature importance for {target}")
+    console.print(imp.head(12).to_string(float_format=lambda v: f"{v:.3f}"), markup=False)
+    console.print(f"joints by influence on {target}: {rank_joints(imp)}")
+    return 0

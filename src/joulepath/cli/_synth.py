@@ -1,0 +1,91 @@
+"""``joulepath synth`` and ``joulepath compare`` (register with ``app.command("synth")(synth)``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from joulepath.cli._common import console
+
+
+def synth(
+    method: str = typer.Option("tvae", "--method", help="copula, ctgan, copulagan or tvae (SDV)."),
+    source: Path | None = typer.Option(
+        None, "--from", help="Real energy table (.parquet) to learn, e.g. the micro set."
+    ),
+    rows: int = typer.Option(75000, "--rows", min=1, help="Synthetic rows to sample."),
+    out: Path = typer.Option(..., "--out", help="Synthetic energy table to write (.parquet)."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the fit and the sample."),
+    epochs: int = typer.Option(300, "--epochs", min=1, help="Training epochs (neural methods)."),
+    batch_size: int = typer.Option(500, "--batch-size", min=2, help="Rows per training batch."),
+    repair_kinematics: bool = typer.Option(
+        False, "--repair-kinematics", help="Recompute the TCP columns from q (and their derivatives)."
+    ),
+    robot: str = typer.Option("irb120", "--robot", help="Robot for --repair-kinematics."),
+    save_model: Path | None = typer.Option(
+        None, "--save-model", help="Also save the fitted synthesizer (a pickle + SHA-256 sidecar)."
+    ),
+    model: Path | None = typer.Option(
+        None, "--model", help="Sample from a synthesizer saved with --save-model instead of fitting."
+    ),
+    progress: bool = typer.Option(True, "--progress/--no-progress", help="Show per-epoch progress."),
+) -> int:
+    """Grow a small real energy table into a synthetic one (SDV; thesis §3.4)."""
+    from joulepath import load_robot
+    from joulepath.data import load_table, save_table
+    from joulepath.errors import InvalidInput
+    from joulepath.synth import SynthConfig, Synthesizer, synthesize
+    from joulepath.synth import repair_kinematics as repair
+
+    both = "give exactly one of --from TABLE (fit a synthesizer) or --model FILE (sample a saved one)"
+    if model is not None:
+        if source is not None:
+            raise InvalidInput(both)
+        synthesizer = Synthesizer.load(model)
+        console.print(f"loaded {model} ({synthesizer.config.method})")
+        table = synthesizer.sample(rows, progress=console.print)
+        if repair_kinematics:
+            table = repair(table, load_robot(robot))
+    elif source is not None:
+        config = SynthConfig(method=method, epochs=epochs, batch_size=batch_size, seed=seed, verbose=progress)
+        table = synthesize(
+            load_table(source),
+            n_rows=rows,
+            config=config,
+            repair=load_robot(robot) if repair_kinematics else None,
+            model_path=save_model,
+            progress=console.print,
+        )
+    else:
+        raise InvalidInput(both)
+    save_table(table, out)
+    console.print(
+        f"wrote {out}: {len(table.frame):,} synthetic rows, feature set {table.feature_set}"
+        + (", TCP columns recomputed from q" if repair_kinematics else "")
+    )
+    return 0
+
+
+def compare(
+    tables: list[Path] = typer.Argument(..., help="Energy tables (.parquet); the first is the reference."),
+    out: Path = typer.Option(Path("compare"), "--out", help="Folder for the distribution plots (PNG)."),
+    quality: bool = typer.Option(False, "--quality", help="Score each table against the first (SDMetrics)."),
+    robot: str = typer.Option(
+        "", "--robot", help="Also report the share of rows within 5 mm of this robot's FK(q)."
+    ),
+) -> int:
+    """Print per-column statistics of energy tables and write distribution overlays."""
+    from joulepath.data import load_table
+    from joulepath.synth import compare as run
+
+    named = {}
+    for path in tables:
+        name = path.stem
+        k = 2
+        while name in named:
+            name, k = f"{path.stem}-{k}", k + 1
+        named[name] = load_table(path)
+    result = run(named, out_dir=out, quality=quality, robot=robot or None)
+    console.print(result.to_text(), markup=False)
+    return 0

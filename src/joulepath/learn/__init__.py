@@ -1,0 +1,50 @@
+"""Energy models (thesis §2.2, §4.3): pipelines, resumable grid search, safe files, importance."""
+
+from joulepath.learn._evaluate import Scores, path_errors, physics_baseline, physics_predict, score
+from joulepath.learn._families import (
+    FAMILIES,
+    GRIDS,
+    QUICK_GRIDS,
+    SUBSTITUTIONS,
+    THESIS_GRIDS,
+    grid_for,
+    make_pipeline,
+)
+from joulepath.learn._features import INPUTS, PhysicsFeatures, input_columns, physics_transform
+from joulepath.learn._importance import feature_importance, plot_importance, rank_joints
+from joulepath.learn._model import TRUSTED_TYPES, EnergyModel
+from joulepath.learn._search import CandidateResult, SearchResult, grid_search, make_splits
+from joulepath.learn._train import TrainConfig, TrainingReport, best_model, load_models, train
+
+__all__ = [
+    "CandidateResult",
+    "EnergyModel",
+    "FAMILIES",
+    "GRIDS",
+    "INPUTS",
+    "PhysicsFeatures",
+    "QUICK_GRIDS",
+    "SUBSTITUTIONS",
+    "Scores",
+    "SearchResult",
+    "THESIS_GRIDS",
+    "TRUSTED_TYPES",
+    "TrainConfig",
+    "TrainingReport",
+    "best_model",
+    "feature_importance",
+    "grid_for",
+    "grid_search",
+    "input_columns",
+    "load_models",
+    "make_pipeline",
+    "make_splits",
+    "path_errors",
+    "physics_baseline",
+    "physics_predict",
+    "physics_transform",
+    "plot_importance",
+    "rank_joints",
+    "score",
+    "train",
+]

@@ -1,0 +1,106 @@
+"""Model inputs: the thesis' raw features, or raw features plus the nominal physics.
+
+``inputs="thesis"`` feeds a model the table's feature set (the 40 inputs of
+Appendix F, or the 18 joint-only ones) unchanged. ``inputs="physics"`` (grey box)
+adds, through :class:`PhysicsFeatures`, the per-joint mechanical energy the
+*nominal* model predicts for the row (``|tau_i qd_i| dt``, their sum, ``tau_i qd_i
+dt``, with ``tau = RNEA(q, qd, qdd)`` plus the nominal friction of
+:data:`joulepath.dynamics.NOMINAL_FRICTION`) and the friction bases ``|qd_i| dt``,
+``qd_i² dt``: the learned
+model then only has to learn how the real robot departs from its nominal model
+(friction, gear losses, mass errors). ``dt`` becomes an input in that case.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from sklearn.base import BaseEstimator, TransformerMixin
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+from joulepath._typing import FloatArray
+from joulepath.data import FEATURE_SETS
+
+INPUTS = ("thesis", "physics")
+N_JOINTS = 6
+
+
+def input_columns(feature_set: str, inputs: str) -> tuple[str, ...]:
+    """Table columns a model reads, in order."""
+    base = FEATURE_SETS[feature_set]
+    return (*base, "dt") if inputs == "physics" else base
+
+
+class PhysicsFeatures(TransformerMixin, BaseEstimator):  # type: ignore[misc]
+    """Append the nominal model's per-joint energy terms to the raw inputs.
+
+    Parameters
+    ----------
+    robot : str, default="irb120"
+        Bundled robot name or path to an .irml/.urdf file.
+    columns : tuple of str or None
+        Names of the input columns, in order; must contain ``q{i}``, ``dq{i}``,
+        ``ddq{i}`` for i = 1..6 and ``dt``. None: the physics inputs of ``full40``.
+    """
+
+    def __init__(self, robot: str = "irb120", columns: tuple[str, ...] | None = None) -> None:
+        self.robot = robot
+        self.columns = columns
+
+    def _cols(self) -> tuple[str, ...]:
+        return self.columns if self.columns is not None else input_columns("full40", "physics")
+
+    def fit(self, X: Any, y: Any = None) -> PhysicsFeatures:
+        X = validate_data(self, X, reset=True, dtype=np.float64)
+        cols = self._cols()
+        if len(cols) != X.shape[1]:
+            raise ValueError(f"X has {X.shape[1]} columns but `columns` names {len(cols)}")
+        need = [f"{p}{i}" for p in ("q", "dq", "ddq") for i in range(1, N_JOINTS + 1)] + ["dt"]
+        missing = [c for c in need if c not in cols]
+        if missing:
+            raise ValueError(f"PhysicsFeatures needs columns {missing} among its inputs")
+        self.index_ = {c: cols.index(c) for c in need}
+        return self
+
+    def _robot(self) -> Any:
+        robot = getattr(self, "_robot_cache", None)
+        if robot is None:
+            from joulepath.dynamics import load_robot
+
+            robot = load_robot(self.robot)
+            self._robot_cache = robot
+        return robot
+
+    def transform(self, X: Any) -> FloatArray:
+        check_is_fitted(self, "index_")
+        X = validate_data(self, X, reset=False, dtype=np.float64)
+        return physics_transform(np.asarray(X), self.index_, self._robot())
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state.pop("_robot_cache", None)
+        return state
+
+    def __sklearn_tags__(self) -> Any:
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = False
+        return tags
+
+
+def physics_transform(X: FloatArray, index: dict[str, int], robot: Any) -> FloatArray:
+    """The pure function behind :class:`PhysicsFeatures` (X of shape (n, n_inputs))."""
+    j = range(1, N_JOINTS + 1)
+    q = X[:, [index[f"q{i}"] for i in j]]
+    qd = X[:, [index[f"dq{i}"] for i in j]]
+    qdd = X[:, [index[f"ddq{i}"] for i in j]]
+    dt = X[:, index["dt"]][:, None]
+    from joulepath.dynamics import NOMINAL_FRICTION
+
+    tau = robot.inverse_dynamics(q, qd, qdd, friction=NOMINAL_FRICTION)
+    energy = np.abs(tau * qd) * dt
+    out: FloatArray = np.concatenate(
+        [X, energy, energy.sum(axis=1, keepdims=True), tau * qd * dt, np.abs(qd) * dt, qd * qd * dt],
+        axis=1,
+    )
+    return out

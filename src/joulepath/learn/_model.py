@@ -1,0 +1,254 @@
+"""A fitted energy model: fast batch prediction, safe files, and a card that says what it is.
+
+Files (one folder per model):
+
+* ``model.skops`` — scikit-learn pipelines, written with skops; loading checks the
+  file's types against an allowlist first and refuses anything else, so it never
+  runs code from the file;
+* ``model.json`` — XGBoost boosters in XGBoost's own JSON format (no pickle);
+* ``card.json`` — feature names in order, feature set and inputs, units, target,
+  training-data hash, CV and test metrics, hyperparameters, library versions.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from sklearn.pipeline import Pipeline
+
+from joulepath._io import atomic_write_text
+from joulepath._typing import FloatArray
+from joulepath.errors import InvalidModel, MissingDependency
+from joulepath.learn._features import PhysicsFeatures, physics_transform
+
+CARD_VERSION = 1
+TRUSTED_TYPES = frozenset(
+    {
+        "joulepath.learn._features.PhysicsFeatures",
+        "sklearn.neural_network._stochastic_optimizers.AdamOptimizer",
+        "sklearn.neural_network._stochastic_optimizers.SGDOptimizer",
+    }
+)
+"""Types outside scikit-learn/NumPy that a model file may contain."""
+
+_ACTIVATIONS: dict[str, Callable[[FloatArray], FloatArray]] = {
+    "identity": lambda z: z,
+    "relu": lambda z: np.maximum(z, 0.0),
+    "tanh": np.tanh,
+    "logistic": lambda z: 1.0 / (1.0 + np.exp(-z)),
+}
+
+
+def library_versions() -> dict[str, str]:
+    import sklearn
+
+    out = {"python": platform.python_version(), "numpy": np.__version__, "scikit-learn": sklearn.__version__}
+    try:
+        import xgboost
+
+        out["xgboost"] = xgboost.__version__
+    except ImportError:
+        pass
+    try:
+        import skops
+
+        out["skops"] = skops.__version__
+    except ImportError:
+        pass
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class _Forward:
+    """The fitted arrays of an MLP pipeline, for a NumPy forward pass."""
+
+    physics: PhysicsFeatures | None
+    mean: FloatArray
+    scale: FloatArray
+    weights: tuple[FloatArray, ...]
+    biases: tuple[FloatArray, ...]
+    activation: str
+
+
+class EnergyModel:
+    """A fitted pipeline that predicts one energy target (J per row) from table rows.
+
+    Attributes
+    ----------
+    pipeline : sklearn Pipeline
+    card : dict
+        ``family``, ``target``, ``feature_set``, ``inputs``, ``input_columns``,
+        ``robot``, metrics and versions (see the module docstring).
+    """
+
+    def __init__(self, pipeline: Pipeline, card: dict[str, Any]) -> None:
+        self.pipeline = pipeline
+        self.card = card
+        self._forward = self._mlp_forward()
+
+    @property
+    def target(self) -> str:
+        return str(self.card["target"])
+
+    @property
+    def family(self) -> str:
+        return str(self.card["family"])
+
+    @property
+    def input_columns(self) -> tuple[str, ...]:
+        return tuple(self.card["input_columns"])
+
+    @property
+    def n_inputs(self) -> int:
+        return len(self.input_columns)
+
+    def _mlp_forward(self) -> _Forward | None:
+        steps = dict(self.pipeline.steps)
+        model = steps.get("model")
+        if self.card.get("family") != "mlp" or model is None or not hasattr(model, "coefs_"):
+            return None
+        scaler = steps["scale"]
+        return _Forward(
+            physics=steps.get("physics"),
+            mean=np.asarray(scaler.mean_, float),
+            scale=np.asarray(scaler.scale_, float),
+            weights=tuple(np.asarray(w, float) for w in model.coefs_),
+            biases=tuple(np.asarray(b, float) for b in model.intercepts_),
+            activation=model.activation,
+        )
+
+    # ----------------------------------------------------------- prediction
+    def check_frame(self, frame: pd.DataFrame, *, source: str = "table") -> None:
+        """Refuse a table whose columns lack this model's inputs, naming what is missing."""
+        missing = [c for c in self.input_columns if c not in frame.columns]
+        if missing:
+            raise InvalidModel(
+                f"{source}: lacks column(s) {', '.join(missing)} that the {self.family} model for "
+                f"{self.target} was trained on (feature set {self.card['feature_set']!r}, inputs "
+                f"{self.card['inputs']!r})"
+            )
+
+    def predict(self, frame: pd.DataFrame) -> FloatArray:
+        """Predict from an energy-table DataFrame (columns checked by name)."""
+        self.check_frame(frame)
+        return self.predict_rows(frame[list(self.input_columns)].to_numpy(dtype=np.float64))
+
+    def predict_rows(self, X: FloatArray) -> FloatArray:
+        """Predict from a float array of shape (n_rows, n_inputs) in ``input_columns`` order.
+
+        No pandas and no validation beyond the shape: this is the optimizer's hot
+        path. For an MLP it is a plain NumPy forward pass of the fitted weights.
+        """
+        X = np.asarray(X, dtype=np.float64)
+        if X.ndim != 2 or X.shape[1] != self.n_inputs:
+            raise InvalidModel(
+                f"X has shape {X.shape}, but the model expects (n_rows, {self.n_inputs}) inputs: "
+                f"{', '.join(self.input_columns)}"
+            )
+        f = self._forward
+        if f is not None:
+            if f.physics is not None:
+                X = physics_transform(X, f.physics.index_, f.physics._robot())
+            z = (X - f.mean) / f.scale
+            act = _ACTIVATIONS[f.activation]
+            for w, b in zip(f.weights[:-1], f.biases[:-1], strict=True):
+                z = act(z @ w + b)
+            out: FloatArray = (z @ f.weights[-1] + f.biases[-1])[:, 0]
+            return out
+        if self.family == "xgb":
+            steps = dict(self.pipeline.steps)
+            if "physics" in steps:
+                X = steps["physics"].transform(X)
+            booster = steps["model"].get_booster()
+            return np.asarray(booster.inplace_predict(X), dtype=np.float64)
+        return np.asarray(self.pipeline.predict(X), dtype=np.float64)
+
+    # ---------------------------------------------------------- persistence
+    def save(self, folder: str | os.PathLike[str]) -> Path:
+        """Write the model and its card into ``folder`` (created if needed)."""
+        out = Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        card = dict(self.card)
+        card["card_version"] = CARD_VERSION
+        if self.family == "xgb":
+            steps = dict(self.pipeline.steps)
+            tmp = out / ".tmp.model.json"
+            steps["model"].save_model(tmp)
+            os.replace(tmp, out / "model.json")
+            card["file"] = "model.json"
+        else:
+            try:
+                import skops.io as sio
+            except ImportError as err:
+                raise MissingDependency("skops is not installed: pip install 'joulepath[ml]'") from err
+            tmp = out / ".model.skops.tmp"
+            sio.dump(self.pipeline, tmp)
+            os.replace(tmp, out / "model.skops")
+            card["file"] = "model.skops"
+        atomic_write_text(out / "card.json", json.dumps(card, indent=2, default=str))
+        return out
+
+    @classmethod
+    def load(cls, folder: str | os.PathLike[str]) -> EnergyModel:
+        """Load a model folder written by :meth:`save`; never executes code from the files.
+
+        Raises
+        ------
+        InvalidModel
+            No card, unknown card version or file, or types outside the allowlist.
+        """
+        src = Path(folder)
+        card_path = src / "card.json"
+        if not card_path.is_file():
+            raise InvalidModel(f"{src}: no card.json; is this a joulepath model folder?")
+        try:
+            card = json.loads(card_path.read_text())
+        except json.JSONDecodeError as err:
+            raise InvalidModel(f"{card_path}: not valid JSON ({err})") from err
+        for key in ("family", "target", "input_columns", "feature_set", "inputs", "file"):
+            if key not in card:
+                raise InvalidModel(f"{card_path}: the card lacks {key!r}")
+        file = src / str(card["file"])
+        if card["family"] == "xgb":
+            if file.suffix != ".json":
+                raise InvalidModel(f"{file}: an XGBoost model must be a .json booster")
+            from xgboost import XGBRegressor
+
+            model = XGBRegressor()
+            try:
+                model.load_model(file)
+            except Exception as err:  # xgboost raises its own XGBoostError
+                raise InvalidModel(f"{file}: not a readable XGBoost JSON model ({err})") from err
+            steps: list[tuple[str, Any]] = []
+            if card["inputs"] == "physics":
+                cols = tuple(card["input_columns"])
+                phys = PhysicsFeatures(robot=card.get("robot_source", "irb120"), columns=cols)
+                phys.fit(np.zeros((1, len(cols))))
+                steps.append(("physics", phys))
+            steps.append(("model", model))
+            return cls(Pipeline(steps), card)
+        if file.suffix != ".skops":
+            raise InvalidModel(f"{file}: scikit-learn models are read from .skops files only")
+        import skops.io as sio
+
+        try:
+            untrusted = sio.get_untrusted_types(file=file)
+        except Exception as err:
+            raise InvalidModel(f"{file}: not a readable skops file ({err})") from err
+        unknown = sorted(set(untrusted) - TRUSTED_TYPES)
+        if unknown:
+            raise InvalidModel(
+                f"{file}: refused, it contains types outside the allowlist: {', '.join(unknown)}"
+            )
+        pipeline = sio.load(file, trusted=sorted(set(untrusted)))
+        if not isinstance(pipeline, Pipeline):
+            raise InvalidModel(f"{file}: holds a {type(pipeline).__name__}, not a Pipeline")
+        return cls(pipeline, card)

@@ -1,0 +1,295 @@
+"""Train, tune and test energy models (thesis §4.3): ``joulepath train`` in library form."""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from sklearn.exceptions import ConvergenceWarning
+
+from joulepath._io import atomic_write_text
+from joulepath.data import TARGETS, EnergyTable
+from joulepath.errors import InvalidInput, InvalidModel
+from joulepath.learn._evaluate import physics_baseline, score
+from joulepath.learn._families import FAMILIES, GRIDS, SUBSTITUTIONS, grid_for, make_pipeline
+from joulepath.learn._features import INPUTS, input_columns
+from joulepath.learn._model import EnergyModel, library_versions
+from joulepath.learn._search import cross_validate_candidate, grid_search, make_splits
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrainConfig:
+    """Settings of :func:`train`.
+
+    Attributes
+    ----------
+    families : tuple of {"mlp", "svr", "par", "xgb"}
+    targets : tuple of {"E", "E1", ..., "E6"}
+    grid : {"quick", "thesis"}
+        Hyperparameter grids (``thesis``: Tables 2.2–2.5).
+    cv : int
+        Folds.
+    inputs : {"physics", "thesis"}
+        Raw table features (``thesis``) or raw plus the nominal model's energy terms.
+    seed : int
+    n_jobs : int
+        Local processes for the grid search.
+    scheduler : str or None
+        Dask scheduler address; the grid search then runs on that cluster.
+    robot : str
+        Robot of the data (for ``inputs="physics"`` and the physics baseline).
+    """
+
+    families: tuple[str, ...] = FAMILIES
+    targets: tuple[str, ...] = ("E",)
+    grid: str = "quick"
+    cv: int = 5
+    inputs: str = "physics"
+    seed: int = 0
+    n_jobs: int = 1
+    scheduler: str | None = None
+    robot: str = "irb120"
+
+    def __post_init__(self) -> None:
+        bad = [f for f in self.families if f not in FAMILIES]
+        if bad or not self.families:
+            raise InvalidInput(f"families {bad or '()'} unknown; use any of {', '.join(FAMILIES)} or all")
+        badt = [t for t in self.targets if t not in TARGETS]
+        if badt or not self.targets:
+            raise InvalidInput(f"targets {badt or '()'} unknown; use any of {', '.join(TARGETS)}")
+        if self.grid not in GRIDS:
+            raise InvalidInput(f"grid must be one of {GRIDS}, got {self.grid!r}")
+        if self.inputs not in INPUTS:
+            raise InvalidInput(f"inputs must be one of {INPUTS}, got {self.inputs!r}")
+        if self.cv < 2:
+            raise InvalidInput(f"cv needs at least 2 folds, got {self.cv}")
+
+
+@dataclass(frozen=True, slots=True)
+class TrainingReport:
+    """What :func:`train` produced: one row per (family, target), baselines, files."""
+
+    results: pd.DataFrame
+    baselines: list[dict[str, Any]]
+    out_dir: Path
+    models: dict[str, Path] = field(default_factory=dict)
+
+
+def _progress(say: Callable[[str], None], family: str, target: str) -> Callable[[int, int], None]:
+    def report(done: int, total: int) -> None:
+        say(f"{family} {target}: {done}/{total} candidates")
+
+    return report
+
+
+def _fmt_params(params: dict[str, Any]) -> str:
+    return ", ".join(f"{k.removeprefix('model__')}={v}" for k, v in sorted(params.items()))
+
+
+def train(
+    train_table: EnergyTable,
+    test_table: EnergyTable,
+    config: TrainConfig,
+    out_dir: str | os.PathLike[str],
+    *,
+    progress: Callable[[str], None] | None = None,
+) -> TrainingReport:
+    """Grid-search, cross-validate, refit and test every (family, target); save models and reports.
+
+    Writes ``<out>/<family>-<target>/`` (model + card), ``results.csv`` (thesis
+    Tables 4.1–4.4 layout plus the honest metrics), ``report.json`` and bar plots
+    of the test scores (thesis Figs 4.11–4.17).
+    """
+    from joulepath.dynamics import NOMINAL_FRICTION, load_robot
+
+    if train_table.feature_set != test_table.feature_set:
+        raise InvalidInput(
+            f"train table has feature set {train_table.feature_set!r}, test table "
+            f"{test_table.feature_set!r}; ingest both the same way"
+        )
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    cols = input_columns(train_table.feature_set, config.inputs)
+    X = train_table.frame[list(cols)].to_numpy(dtype=np.float64)
+    groups = train_table.frame["move_id"].to_numpy()
+    rows: list[dict[str, Any]] = []
+    saved: dict[str, Path] = {}
+    say = progress or (lambda _msg: None)
+    for family in config.families:
+        for target in config.targets:
+            y = train_table.frame[target].to_numpy(dtype=np.float64)
+            pipeline = make_pipeline(
+                family, seed=config.seed, inputs=config.inputs, columns=cols, robot=config.robot
+            )
+            grid = grid_for(family, config.grid)
+            t0 = time.perf_counter()
+            search = grid_search(
+                pipeline,
+                grid,
+                X,
+                y,
+                groups,
+                family=family,
+                split="grouped",
+                n_splits=config.cv,
+                seed=config.seed,
+                cache_dir=out / ".gridcache" / f"{family}-{target}",
+                n_jobs=config.n_jobs,
+                scheduler=config.scheduler,
+                progress=_progress(say, family, target),
+            )
+            best = search.best
+            shuffled = make_splits(len(y), groups, split="shuffled", n_splits=config.cv, seed=config.seed)
+            r2_s, mae_s, _ = cross_validate_candidate(pipeline, best.params, X, y, shuffled)
+            model_pipe = pipeline.set_params(**best.params)
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", ConvergenceWarning)
+                model_pipe.fit(X, y)
+            card = {
+                "family": family,
+                "target": target,
+                "feature_set": train_table.feature_set,
+                "inputs": config.inputs,
+                "input_columns": list(cols),
+                "robot": train_table.robot,
+                "robot_source": config.robot,
+                "units": {"inputs": "SI (rad, rad/s, rad/s^2, m, m/s, s)", "target": "J per row"},
+                "training_data_sha256": train_table.fingerprint(),
+                "training_rows": len(y),
+                "training_moves": int(np.unique(groups).size),
+                "grid": config.grid,
+                "best_params": {k: repr(v) for k, v in best.params.items()},
+                "cv_grouped": {
+                    "r2_mean": best.r2_mean,
+                    "r2_std": best.r2_std,
+                    "mae_mean": best.mae_mean,
+                    "mae_std": best.mae_std,
+                    "folds": config.cv,
+                },
+                "cv_shuffled": {
+                    "r2_mean": float(np.mean(r2_s)),
+                    "r2_std": float(np.std(r2_s)),
+                    "mae_mean": float(np.mean(mae_s)),
+                    "mae_std": float(np.std(mae_s)),
+                },
+                "seed": config.seed,
+                "versions": library_versions(),
+            }
+            if family in SUBSTITUTIONS:
+                card["substitution"] = SUBSTITUTIONS[family]
+            model = EnergyModel(model_pipe, card)
+            test_scores = score(test_table, target, model.predict(test_table.frame))
+            card["test"] = test_scores.as_dict()
+            model.card = card
+            folder = model.save(out / f"{family}-{target}")
+            saved[f"{family}-{target}"] = folder
+            rows.append(
+                {
+                    "family": family,
+                    "target": target,
+                    "cv_grouped_r2": best.r2_mean,
+                    "cv_grouped_r2_std": best.r2_std,
+                    "cv_grouped_mae": best.mae_mean,
+                    "cv_grouped_mae_std": best.mae_std,
+                    "cv_shuffled_r2": float(np.mean(r2_s)),
+                    "cv_shuffled_r2_std": float(np.std(r2_s)),
+                    "cv_shuffled_mae": float(np.mean(mae_s)),
+                    "cv_shuffled_mae_std": float(np.std(mae_s)),
+                    "test_r2": test_scores.r2,
+                    "test_mae": test_scores.mae,
+                    "path_median_pct": test_scores.path_median_pct,
+                    "path_p95_pct": test_scores.path_p95_pct,
+                    "best_params": _fmt_params(best.params),
+                    "candidates": len(search.candidates),
+                    "fitted_now": search.n_fitted,
+                    "search_s": time.perf_counter() - t0,
+                }
+            )
+            say(f"{family} {target}: grouped CV R² {best.r2_mean:.4f}, test R² {test_scores.r2:.4f}")
+    robot = load_robot(config.robot)
+    baselines = [
+        physics_baseline(test_table, robot, friction=None, label="dynamics model, no friction"),
+        physics_baseline(
+            test_table, robot, friction=NOMINAL_FRICTION, label="dynamics model + nominal friction"
+        ),
+    ]
+    results = pd.DataFrame(rows)
+    atomic_write_text(out / "results.csv", results.to_csv(index=False))
+    report = {
+        "config": asdict(config),
+        "train": {
+            "rows": len(train_table.frame),
+            "moves": train_table.n_moves,
+            "sha256": train_table.fingerprint(),
+        },
+        "test": {"rows": len(test_table.frame), "moves": test_table.n_moves},
+        "results": rows,
+        "baselines": baselines,
+        "substitutions": {f: SUBSTITUTIONS[f] for f in config.families if f in SUBSTITUTIONS},
+    }
+    atomic_write_text(out / "report.json", json.dumps(report, indent=2, default=str))
+    plot_test_scores(results, baselines, out)
+    return TrainingReport(results=results, baselines=baselines, out_dir=out, models=saved)
+
+
+def plot_test_scores(results: pd.DataFrame, baselines: Sequence[dict[str, Any]], out: Path) -> list[Path]:
+    """Bar plots of test R² and MAE per family for each target (thesis Figs 4.11–4.17)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    paths = []
+    for target, group in results.groupby("target"):
+        fig, axes = plt.subplots(1, 2, figsize=(8, 3.2))
+        labels = list(group["family"]) + ["physics", "physics+fr"]
+        r2 = list(group["test_r2"]) + [b["scores"][target]["r2"] for b in baselines]
+        mae = list(group["test_mae"]) + [b["scores"][target]["mae"] for b in baselines]
+        axes[0].bar(labels, r2, color="tab:blue")
+        axes[0].set_ylabel("R² (test moves)")
+        axes[0].set_ylim(min(0.0, min(r2)), 1.0)
+        axes[1].bar(labels, mae, color="tab:orange")
+        axes[1].set_ylabel("MAE (J per row)")
+        fig.suptitle(f"Test scores for {target}")
+        fig.tight_layout()
+        path = out / f"test_scores_{target}.png"
+        tmp = out / f".test_scores_{target}.tmp.png"
+        fig.savefig(tmp, dpi=110)
+        plt.close(fig)
+        os.replace(tmp, path)
+        paths.append(path)
+    return paths
+
+
+def load_models(folder: str | os.PathLike[str]) -> dict[str, EnergyModel]:
+    """All models of a training output folder, keyed ``<family>-<target>``."""
+    root = Path(folder)
+    found = {p.parent.name: EnergyModel.load(p.parent) for p in sorted(root.glob("*/card.json"))}
+    if not found:
+        raise InvalidModel(f"{root}: no models (folders with card.json); run `joulepath train` first")
+    return found
+
+
+def best_model(
+    folder: str | os.PathLike[str], target: str = "E", *, family: str | None = None
+) -> EnergyModel:
+    """The model for ``target`` with the best grouped-CV R² (optionally of one family)."""
+    models = [
+        m
+        for m in load_models(folder).values()
+        if m.target == target and (family is None or m.family == family)
+    ]
+    if not models:
+        raise InvalidModel(
+            f"{folder}: no model for target {target!r}" + (f" of family {family!r}" if family else "")
+        )
+    return max(models, key=lambda m: float(m.card["cv_grouped"]["r2_mean"]))

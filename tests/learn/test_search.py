@@ -1,0 +1,67 @@
+"""Grid search: resumable from its cache, grouped folds keep moves together, Dask backend."""
+
+import numpy as np
+import pytest
+
+from joulepath.errors import InvalidInput
+from joulepath.learn import grid_search, input_columns, make_pipeline, make_splits
+
+
+@pytest.fixture(scope="module")
+def xy(lab_tables):
+    train, _ = lab_tables
+    cols = input_columns("full40", "physics")
+    return (
+        train.frame[list(cols)].to_numpy(),
+        train.frame["E"].to_numpy(),
+        train.frame["move_id"].to_numpy(),
+        cols,
+    )
+
+
+GRID = {"model__eta0": [0.01, 0.1], "model__learning_rate": ["pa1", "pa2"], "model__epsilon": [0.005]}
+
+
+def test_make_splits_grouped_keeps_moves_together(xy):
+    _, y, groups, _ = xy
+    for train, test in make_splits(len(y), groups, split="grouped", n_splits=3, seed=0):
+        assert not set(groups[train]) & set(groups[test])
+    with pytest.raises(InvalidInput, match="cannot make 1000 grouped folds"):
+        make_splits(len(y), groups, split="grouped", n_splits=1000, seed=0)
+
+
+def test_interrupted_search_resumes_without_refitting(xy, tmp_path):
+    X, y, groups, cols = xy
+    pipe = make_pipeline("par", seed=0, columns=cols)
+    first = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3, cache_dir=tmp_path)
+    assert first.n_fitted == 4
+    files = sorted(tmp_path.glob("*.json"))
+    assert len(files) == 4
+    for f in files[:2]:  # the search was interrupted before these two finished
+        f.unlink()
+    second = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3, cache_dir=tmp_path)
+    assert second.n_fitted == 2
+    assert second.best.params == first.best.params
+    np.testing.assert_allclose([c.r2_mean for c in second.candidates], [c.r2_mean for c in first.candidates])
+    third = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3, cache_dir=tmp_path)
+    assert third.n_fitted == 0
+
+
+def test_grid_search_on_a_dask_local_cluster(xy):
+    distributed = pytest.importorskip("distributed")
+    X, y, groups, cols = xy
+    pipe = make_pipeline("par", seed=0, columns=cols)
+    with distributed.LocalCluster(
+        n_workers=1,
+        threads_per_worker=1,
+        processes=False,
+        host="127.0.0.1",
+        protocol="tcp://",
+        dashboard_address=None,
+    ) as cluster:
+        res = grid_search(
+            pipe, GRID, X, y, groups, family="par", n_splits=3, scheduler=cluster.scheduler_address
+        )
+    local = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3)
+    assert res.n_fitted == 4
+    np.testing.assert_allclose([c.r2_mean for c in res.candidates], [c.r2_mean for c in local.candidates])

@@ -1,0 +1,76 @@
+"""Training: every family's quick grid learns the lab energy; reports and honest splits."""
+
+import json
+
+import numpy as np
+import pytest
+
+from joulepath.errors import InvalidInput
+from joulepath.learn import FAMILIES, TrainConfig, best_model, load_models
+
+
+def test_quick_grid_of_each_family_reaches_r2_on_held_out_moves(trained):
+    res = trained.results.set_index("family")
+    assert set(res.index) == set(FAMILIES)
+    for family in FAMILIES:
+        assert res.loc[family, "test_r2"] >= 0.95, (family, res.loc[family, "test_r2"])
+
+
+def test_grouped_cv_is_the_honest_headline(trained):
+    res = trained.results
+    # shuffled row folds leak neighbouring rows of the same move: never less optimistic
+    assert (res["cv_shuffled_r2"] >= res["cv_grouped_r2"] - 0.01).all()
+    assert res["path_p95_pct"].notna().all() and (res["path_median_pct"] >= 0).all()
+
+
+def test_reports_and_files(trained):
+    out = trained.out_dir
+    assert (out / "results.csv").exists() and (out / "test_scores_E.png").exists()
+    report = json.loads((out / "report.json").read_text())
+    assert "par" in report["substitutions"] and "SGDRegressor" in report["substitutions"]["par"]
+    labels = [b["label"] for b in report["baselines"]]
+    assert labels == ["dynamics model, no friction", "dynamics model + nominal friction"]
+    for family in FAMILIES:
+        card = json.loads((out / f"{family}-E" / "card.json").read_text())
+        assert card["input_columns"][:2] == ["q1", "dq1"] and card["target"] == "E"
+        assert len(card["training_data_sha256"]) == 64
+        assert set(card["cv_grouped"]) == {"r2_mean", "r2_std", "mae_mean", "mae_std", "folds"}
+        assert "scikit-learn" in card["versions"]
+
+
+def test_load_models_and_best_model(trained):
+    models = load_models(trained.out_dir)
+    assert set(models) == {f"{f}-E" for f in FAMILIES}
+    best = best_model(trained.out_dir, "E")
+    assert best.card["cv_grouped"]["r2_mean"] == max(m.card["cv_grouped"]["r2_mean"] for m in models.values())
+
+
+def test_physics_baseline_gains_from_friction(trained):
+    no_fr, with_fr = trained.baselines
+    assert with_fr["scores"]["E"]["r2"] > no_fr["scores"]["E"]["r2"]
+    assert with_fr["latency_per_row_s_batch"] < 1e-3
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "pattern"),
+    [
+        ({"families": ("knn",)}, "families"),
+        ({"targets": ("F",)}, "targets"),
+        ({"grid": "huge"}, "grid must be one of"),
+        ({"inputs": "raw"}, "inputs must be one of"),
+        ({"cv": 1}, "cv"),
+    ],
+)
+def test_train_config_validation(kwargs, pattern):
+    with pytest.raises(InvalidInput, match=pattern):
+        TrainConfig(**kwargs)
+
+
+def test_thesis_grid_sizes():
+    from sklearn.model_selection import ParameterGrid
+
+    from joulepath.learn import THESIS_GRIDS
+
+    sizes = {f: len(ParameterGrid(g)) for f, g in THESIS_GRIDS.items()}
+    assert sizes == {"mlp": 3456, "svr": 384, "par": 192, "xgb": 58320}
+    assert np.prod([len(v) for v in THESIS_GRIDS["xgb"].values()]) == 58320
