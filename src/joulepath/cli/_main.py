@@ -10,7 +10,9 @@ import typer
 from joulepath.cli._data import ingest, rapid_app, simulate
 from joulepath.cli._demo import demo
 from joulepath.cli._learn import importance, train
+from joulepath.cli._optimize import bench_optimizers, optimize
 from joulepath.cli._robot import robot_app
+from joulepath.cli._synth import compare, synth
 from joulepath.errors import JoulepathError
 
 app = typer.Typer(
@@ -26,6 +28,10 @@ app.command("simulate")(simulate)
 app.command("ingest")(ingest)
 app.command("train")(train)
 app.command("importance")(importance)
+app.command("synth")(synth)
+app.command("compare")(compare)
+app.command("optimize")(optimize)
+app.command("bench-optimizers")(bench_optimizers)
 app.command("demo")(demo)
 
 

@@ -6,6 +6,7 @@ from joulepath.export._rapid import (
     collection_module,
     collection_programs,
     measurement_module,
+    path_module,
 )
 
 __all__ = [
@@ -15,5 +16,6 @@ __all__ = [
     "collection_programs",
     "draw_moves",
     "measurement_module",
+    "path_module",
     "random_moves",
 ]

@@ -23,6 +23,8 @@ from joulepath._typing import FloatArray
 from joulepath.data import FEATURE_SETS
 
 INPUTS = ("thesis", "physics")
+PHYSICS_VERSION = 2
+"""Version of the physics inputs; a model card records it and loading refuses another."""
 N_JOINTS = 6
 
 

@@ -27,7 +27,7 @@ from sklearn.pipeline import Pipeline
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
 from joulepath.errors import InvalidModel, MissingDependency
-from joulepath.learn._features import PhysicsFeatures, physics_transform
+from joulepath.learn._features import PHYSICS_VERSION, PhysicsFeatures, physics_transform
 
 CARD_VERSION = 1
 TRUSTED_TYPES = frozenset(
@@ -216,6 +216,11 @@ class EnergyModel:
         for key in ("family", "target", "input_columns", "feature_set", "inputs", "file"):
             if key not in card:
                 raise InvalidModel(f"{card_path}: the card lacks {key!r}")
+        if card["inputs"] == "physics" and card.get("physics_version") != PHYSICS_VERSION:
+            raise InvalidModel(
+                f"{card_path}: trained with physics inputs version {card.get('physics_version')}, this "
+                f"joulepath computes version {PHYSICS_VERSION}; train the model again"
+            )
         file = src / str(card["file"])
         if card["family"] == "xgb":
             if file.suffix != ".json":

@@ -20,7 +20,7 @@ from joulepath.data import TARGETS, EnergyTable
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._evaluate import physics_baseline, score
 from joulepath.learn._families import FAMILIES, GRIDS, SUBSTITUTIONS, grid_for, make_pipeline
-from joulepath.learn._features import INPUTS, input_columns
+from joulepath.learn._features import INPUTS, PHYSICS_VERSION, input_columns
 from joulepath.learn._model import EnergyModel, library_versions
 from joulepath.learn._search import cross_validate_candidate, grid_search, make_splits
 
@@ -159,6 +159,7 @@ def train(
                 "target": target,
                 "feature_set": train_table.feature_set,
                 "inputs": config.inputs,
+                "physics_version": PHYSICS_VERSION,
                 "input_columns": list(cols),
                 "robot": train_table.robot,
                 "robot_source": config.robot,
@@ -215,6 +216,13 @@ def train(
                 }
             )
             say(f"{family} {target}: grouped CV R² {best.r2_mean:.4f}, test R² {test_scores.r2:.4f}")
+    from joulepath.learn._importance import feature_importance, plot_importance, rank_joints
+
+    imp = feature_importance(train_table, "E", max_rows=5000, seed=config.seed)
+    atomic_write_text(out / "importance_E.csv", imp.to_csv())
+    plot_importance(imp, out / "importance_E.png", title="Feature importance for E (training data)")
+    joints = rank_joints(imp)
+    atomic_write_text(out / "joints.json", json.dumps({"target": "E", "joints_by_influence": joints}))
     robot = load_robot(config.robot)
     baselines = [
         physics_baseline(test_table, robot, friction=None, label="dynamics model, no friction"),
@@ -235,6 +243,7 @@ def train(
         "results": rows,
         "baselines": baselines,
         "substitutions": {f: SUBSTITUTIONS[f] for f in config.families if f in SUBSTITUTIONS},
+        "joints_by_influence": joints,
     }
     atomic_write_text(out / "report.json", json.dumps(report, indent=2, default=str))
     plot_test_scores(results, baselines, out)

@@ -1,0 +1,95 @@
+"""Model inputs for whole populations of sampled paths, computed like ingestion computes them."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import Robot
+from joulepath.trajectory import Trajectory
+
+_TCP = {
+    "x",
+    "y",
+    "z",
+    "qx",
+    "qy",
+    "qz",
+    "qw",
+    "yaw",
+    "pitch",
+    "roll",
+    "dx",
+    "dy",
+    "dz",
+    "dphi",
+    "dtheta",
+    "dpsi",
+    "ddx",
+    "ddy",
+    "ddz",
+    "ddphi",
+    "ddtheta",
+    "ddpsi",
+}
+
+
+def _time_derivative(values: FloatArray, dt: float) -> FloatArray:
+    """d/dt along axis 1 (time) of (P, n, k): central inside, one-sided at both ends."""
+    out = np.empty_like(values)
+    out[:, 1:-1] = (values[:, 2:] - values[:, :-2]) / (2 * dt)
+    out[:, 0] = (values[:, 1] - values[:, 0]) / dt
+    out[:, -1] = (values[:, -1] - values[:, -2]) / dt
+    return out
+
+
+def path_features(robot: Robot, traj: Trajectory, columns: tuple[str, ...]) -> FloatArray:
+    """Rows of model inputs for every sample of every path.
+
+    Joint signals come from the trajectory (analytic); TCP pose from forward
+    kinematics; TCP velocities and accelerations, like the energy table's, are
+    finite differences along each path at the sample period.
+
+    Parameters
+    ----------
+    robot : Robot
+    traj : Trajectory
+        q, qd, qdd of shape (P, n_steps, 6).
+    columns : tuple of str
+        Input names in the model's order (see ``EnergyModel.input_columns``).
+
+    Returns
+    -------
+    ndarray of shape (P * n_steps, len(columns))
+    """
+    q, qd, qdd = traj.q, traj.qd, traj.qdd
+    if q.ndim == 2:
+        q, qd, qdd = q[None], qd[None], qdd[None]
+    P, n, _ = q.shape
+    dt = traj.dt
+    cols: dict[str, FloatArray] = {"dt": np.full((P, n), dt)}
+    for i in range(6):
+        cols[f"q{i + 1}"] = q[..., i]
+        cols[f"dq{i + 1}"] = qd[..., i]
+        cols[f"ddq{i + 1}"] = qdd[..., i]
+    if _TCP.intersection(columns):
+        pose = robot.fk(q)
+        pos = pose.position_m
+        quat = pose.quaternion
+        eul = np.unwrap(pose.euler_zyx, axis=1)
+        vel = _time_derivative(pos, dt)
+        acc = _time_derivative(vel, dt)
+        rate = _time_derivative(eul, dt)
+        rate_acc = _time_derivative(rate, dt)
+        wrapped = (eul + np.pi) % (2 * np.pi) - np.pi
+        for k, name in enumerate(("x", "y", "z")):
+            cols[name], cols[f"d{name}"], cols[f"dd{name}"] = pos[..., k], vel[..., k], acc[..., k]
+        for k, name in enumerate(("qw", "qx", "qy", "qz")):
+            cols[name] = quat[..., k]
+        for k, (name, dname) in enumerate((("yaw", "phi"), ("pitch", "theta"), ("roll", "psi"))):
+            cols[name], cols[f"d{dname}"], cols[f"dd{dname}"] = (
+                wrapped[..., k],
+                rate[..., k],
+                rate_acc[..., k],
+            )
+    return np.stack([cols[c] for c in columns], axis=-1).reshape(P * n, len(columns))

@@ -1,0 +1,151 @@
+"""The energy-optimal trajectory problem: chromosomes -> paths -> fitness, with limits.
+
+Fitness kinds (each one call for the whole population):
+
+* ``"surrogate"`` — a learned model of the total energy ``E`` summed over the path's rows;
+* ``"surrogate-joints"`` — the sum of six per-joint models ``E1..E6`` (the thesis'
+  multi-objective variant);
+* ``"physics"`` — the dynamics model (nominal parameters and friction):
+  ``Σ |tau_i qd_i| dt``.
+
+Limits: every candidate's joint positions are checked against the robot's ranges
+and its joint speeds against the speed limits (and, for the physics fitness, its
+torques against the effort limits where the robot states them). Penalty rule: the
+fitness becomes ``E + PENALTY * v`` with ``v`` the sum over joints of the largest
+excursion beyond the range (rad) plus the largest relative overspeed
+(``max(|qd| / v_max) - 1``) plus the relative overtorque: any violating path is
+worse than every feasible path of reasonable energy, and less violation ranks better.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import NOMINAL_FRICTION, Robot
+from joulepath.errors import InvalidInput
+from joulepath.optimize._features import path_features
+from joulepath.trajectory import GRID_HIGH, GRID_LOW, Trajectory, rest_to_rest, thesis_quintic
+
+PARAMETRIZATIONS = ("rest_to_rest", "thesis")
+FITNESS = ("surrogate", "surrogate-joints", "physics")
+PENALTY = 1000.0
+"""J per unit of limit violation (see the module docstring)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Violation:
+    """Limit violations of each path: range (rad), overspeed and overtorque (relative)."""
+
+    range: FloatArray
+    speed: FloatArray
+    torque: FloatArray
+
+    @property
+    def total(self) -> FloatArray:
+        out: FloatArray = self.range + self.speed + self.torque
+        return out
+
+
+def limit_violation(robot: Robot, traj: Trajectory, tau: FloatArray | None = None) -> Violation:
+    """Violations of paths q, qd (and torques tau) of shape (P, n, 6)."""
+    q = traj.q if traj.q.ndim == 3 else traj.q[None]
+    qd = traj.qd if traj.qd.ndim == 3 else traj.qd[None]
+    lo, hi = robot.joint_ranges()
+    lo = np.where(np.isfinite(lo), lo, -np.inf)
+    hi = np.where(np.isfinite(hi), hi, np.inf)
+    over = np.maximum(q - hi, 0.0) + np.maximum(lo - q, 0.0)
+    rng_v = over.max(axis=1).sum(axis=1)
+    vmax = robot.velocity_limit
+    ratio = np.abs(qd) / np.where(np.isfinite(vmax), vmax, np.inf)
+    spd_v = np.maximum(ratio.max(axis=1) - 1.0, 0.0).sum(axis=1)
+    trq_v = np.zeros_like(rng_v)
+    emax = robot.effort_limit
+    if tau is not None and np.any(np.isfinite(emax)):
+        t = tau if tau.ndim == 3 else tau[None]
+        r = np.abs(t) / np.where(np.isfinite(emax), emax, np.inf)
+        trq_v = np.maximum(r.max(axis=1) - 1.0, 0.0).sum(axis=1)
+    return Violation(range=rng_v, speed=spd_v, torque=trq_v)
+
+
+def physics_energy(
+    robot: Robot, traj: Trajectory, *, friction: Any = NOMINAL_FRICTION
+) -> tuple[FloatArray, FloatArray]:
+    """Per-path energy ``Σ |tau qd| dt`` (J) and the torques, for paths (P, n, 6)."""
+    tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=friction)
+    e = (np.abs(tau * traj.qd) * traj.dt).sum(axis=(-1, -2))
+    return np.atleast_1d(e), tau
+
+
+@dataclass(eq=False)
+class TrajectoryProblem:
+    """Chromosomes (flattened (6, 6) coefficient matrices) to penalized path energy.
+
+    Implements :class:`joulepath.evolve.Problem`.
+    """
+
+    robot: Robot
+    q_start: FloatArray
+    q_end: FloatArray
+    duration: float
+    fitness: str = "physics"
+    models: tuple[Any, ...] = ()
+    parametrization: str = "rest_to_rest"
+    dt: float = 0.025
+    n_evaluated: int = field(default=0, init=False)
+
+    def __post_init__(self) -> None:
+        if self.parametrization not in PARAMETRIZATIONS:
+            raise InvalidInput(
+                f"parametrization must be one of {PARAMETRIZATIONS}, got {self.parametrization!r}"
+            )
+        if self.fitness not in FITNESS:
+            raise InvalidInput(f"fitness must be one of {FITNESS}, got {self.fitness!r}")
+        need = {"surrogate": 1, "surrogate-joints": 6, "physics": 0}[self.fitness]
+        if len(self.models) != need:
+            raise InvalidInput(f"fitness {self.fitness!r} needs {need} model(s), got {len(self.models)}")
+        self.q_start = np.asarray(self.q_start, dtype=float)
+        self.q_end = np.asarray(self.q_end, dtype=float)
+
+    @property
+    def n_var(self) -> int:
+        return 36
+
+    @property
+    def xl(self) -> FloatArray:
+        return np.full(36, GRID_LOW)
+
+    @property
+    def xu(self) -> FloatArray:
+        return np.full(36, GRID_HIGH)
+
+    def trajectory(self, X: FloatArray) -> Trajectory:
+        """Paths of chromosomes X (P, 36) or (36,)."""
+        chrom = np.asarray(X, dtype=float).reshape(-1, 6, 6)
+        build = rest_to_rest if self.parametrization == "rest_to_rest" else thesis_quintic
+        return build(chrom, self.q_start, self.q_end, self.duration, dt=self.dt)
+
+    def energy(self, traj: Trajectory) -> tuple[FloatArray, FloatArray | None]:
+        """Unpenalized fitness energy of paths (J) and torques where computed."""
+        if self.fitness == "physics":
+            return physics_energy(self.robot, traj)
+        P, n = traj.q.shape[0], traj.q.shape[1]
+        total = np.zeros(P)
+        cache: dict[tuple[str, ...], FloatArray] = {}
+        for model in self.models:
+            cols = model.input_columns
+            if cols not in cache:
+                cache[cols] = path_features(self.robot, traj, cols)
+            total += model.predict_rows(cache[cols]).reshape(P, n).sum(axis=1)
+        return total, None
+
+    def evaluate(self, X: FloatArray) -> FloatArray:
+        traj = self.trajectory(X)
+        energy, tau = self.energy(traj)
+        self.n_evaluated += energy.size
+        viol = limit_violation(self.robot, traj, tau)
+        out: FloatArray = energy + PENALTY * viol.total
+        return out
