@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import typer
 
 from joulepath.cli._common import console, parse_joints
@@ -35,6 +37,13 @@ def _models(
     if jf.exists():
         joints = tuple(int(j) for j in json.loads(jf.read_text())["joints_by_influence"])
     return models, joints
+
+
+def _status(status: object, label: str) -> Callable[[int, int], None]:
+    def update(done: int, total: int) -> None:
+        status.update(f"{label}: {done}/{total} runs")  # type: ignore[attr-defined]
+
+    return update
 
 
 def optimize(
@@ -70,11 +79,14 @@ def optimize(
     )
     models, joints = _models(model, fitness, family, r.name)
     with console.status(f"optimizing with {algo} on the {fitness} fitness..."):
-        result = optimize_move(r, q0, qf, duration, config, models=models, joints_ranked=joints)
+        result = optimize_move(
+            r, np.array(q0), np.array(qf), duration, config, models=models, joints_ranked=joints
+        )
     files = write_run(result, r, out)
     s = result.summary
     console.print(
-        f"default path {s['energy_default_physics_J']:.3f} J, optimized {s['energy_optimized_physics_J']:.3f} J "
+        f"default path {s['energy_default_physics_J']:.3f} J, "
+        f"optimized {s['energy_optimized_physics_J']:.3f} J "
         f"on physics: {s['improvement_physics_pct']:.1f} % saved at equal cycle time "
         f"({s['generations']} generations, {s['evaluations']:,} evaluations, {s['wall_s']:.2f} s)"
     )
@@ -122,7 +134,7 @@ def bench_optimizers(
                 seed=seed,
                 n_jobs=jobs,
                 scheduler=scheduler or None,
-                progress=lambda d, t: status.update(f"{kind}-objective ({fitness}): {d}/{t} runs"),
+                progress=_status(status, f"{kind}-objective ({fitness})"),
             )
         atomic_write_text(out / f"optimizers_{kind}.csv", frame.to_csv(index=False))
         console.print(f"{kind}-objective, fitness {fitness}:")

@@ -1,0 +1,60 @@
+import numpy as np
+import pytest
+
+from joulepath.errors import InvalidInput
+from joulepath.optimize import PENALTY, TrajectoryProblem, limit_violation, path_features, physics_energy
+from joulepath.trajectory import minimum_jerk
+
+Q0 = np.radians([-60, 10, -30, 40, 20, 0])
+QF = np.radians([70, 30, 10, -50, -40, 90])
+
+
+@pytest.fixture(scope="module")
+def problem(irb120):
+    return TrajectoryProblem(robot=irb120, q_start=Q0, q_end=QF, duration=1.5)
+
+
+def test_zero_chromosome_is_the_default_path(problem, irb120):
+    traj = problem.trajectory(np.zeros(36))
+    default = minimum_jerk(Q0, QF, 1.5)
+    np.testing.assert_allclose(traj.q[0], default.q, atol=1e-12)
+    f = problem.evaluate(np.zeros((1, 36)))
+    e, _ = physics_energy(irb120, default)
+    np.testing.assert_allclose(f, e)
+
+
+def test_evaluate_population_in_one_call(problem, rng):
+    X = rng.uniform(-2, 2, size=(20, 36))
+    F = problem.evaluate(X)
+    assert F.shape == (20,) and np.all(np.isfinite(F))
+    np.testing.assert_allclose(F[3], problem.evaluate(X[3:4])[0])
+
+
+def test_limit_violation_is_penalized(problem, irb120):
+    X = np.zeros((2, 36))
+    X[1, 6:12] = 10.0  # a 2 rad bulge on joint 2 drives it past its +110 deg limit
+    traj = problem.trajectory(X)
+    viol = limit_violation(irb120, traj)
+    assert viol.total[0] == 0 and viol.total[1] > 0
+    F = problem.evaluate(X)
+    assert F[1] > F[0] + PENALTY * 0.9 * viol.total[1]
+
+
+def test_path_features_match_kinematics(irb120):
+    traj = minimum_jerk(np.stack([Q0, QF]), np.stack([QF, Q0]), 1.0)
+    cols = ("q1", "dq1", "x", "y", "z", "qw", "dx", "ddq3", "dt")
+    rows = path_features(irb120, traj, cols)
+    assert rows.shape == (2 * 41, len(cols))
+    pose = irb120.fk(traj.q)
+    np.testing.assert_allclose(rows[:, 2].reshape(2, 41), pose.position_m[..., 0])
+    np.testing.assert_allclose(rows[:, -1], 0.025)
+    # TCP speed by central differences, as ingestion computes it
+    vx = np.gradient(pose.position_m[0, :, 0], 0.025)
+    np.testing.assert_allclose(rows[1:40, 6], vx[1:40], atol=1e-12)
+
+
+def test_problem_validation(irb120):
+    with pytest.raises(InvalidInput, match="fitness 'surrogate' needs 1 model"):
+        TrajectoryProblem(robot=irb120, q_start=Q0, q_end=QF, duration=1.0, fitness="surrogate")
+    with pytest.raises(InvalidInput, match="parametrization must be one of"):
+        TrajectoryProblem(robot=irb120, q_start=Q0, q_end=QF, duration=1.0, parametrization="spline")

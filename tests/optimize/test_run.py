@@ -1,0 +1,94 @@
+import json
+
+import numpy as np
+import pytest
+
+from joulepath.errors import InvalidInput, LimitViolation
+from joulepath.export import path_module
+from joulepath.optimize import OptimizeConfig, optimize_move, write_run
+
+Q0 = np.radians([-60, 10, -30, 40, 20, 0])
+QF = np.radians([70, 30, 10, -50, -40, 90])
+
+
+@pytest.fixture(scope="module")
+def result(irb120):
+    return optimize_move(irb120, Q0, QF, 1.5, OptimizeConfig(algorithm="ga", max_gen=25, pop_size=40, seed=3))
+
+
+def test_short_optimization_beats_the_default_path_on_physics(result):
+    s = result.summary
+    assert s["energy_optimized_physics_J"] < s["energy_default_physics_J"]
+    assert s["improvement_physics_pct"] > 2.0
+    assert s["limits_ok"]
+    # the optimized path keeps the cycle time and starts and ends at rest
+    np.testing.assert_allclose(result.optimized.t[-1], 1.5)
+    np.testing.assert_allclose(result.optimized.q[[0, -1]], [Q0, QF], atol=1e-12)
+    np.testing.assert_allclose(result.optimized.qd[[0, -1]], 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("algorithm", ["de", "ma-random", "ma-informed"])
+def test_algorithms_run_and_seed_reproduces(irb120, algorithm):
+    cfg = OptimizeConfig(algorithm=algorithm, max_gen=4, pop_size=12, n_local=50, seed=5)
+    a = optimize_move(irb120, Q0, QF, 1.0, cfg)
+    b = optimize_move(irb120, Q0, QF, 1.0, cfg)
+    np.testing.assert_array_equal(a.chromosome, b.chromosome)
+    assert a.summary["energy_optimized_physics_J"] <= a.summary["energy_default_physics_J"] + 1e-12
+
+
+def test_write_run_files(result, irb120, tmp_path):
+    files = write_run(result, irb120, tmp_path)
+    assert {"result.json", "path.csv", "convergence.csv", "path.mod", "joints.png", "power.png"} <= set(files)
+    summary = json.loads((tmp_path / "result.json").read_text())
+    for key in (
+        "robot",
+        "start_rad",
+        "end_rad",
+        "duration_s",
+        "algorithm",
+        "seed",
+        "chromosome",
+        "energy_default_physics_J",
+        "energy_optimized_physics_J",
+        "energy_optimized_surrogate_J",
+        "improvement_physics_pct",
+        "limits_ok",
+        "generations",
+        "evaluations",
+        "wall_s",
+    ):
+        assert key in summary
+    assert np.array(summary["chromosome"]).shape == (6, 6)
+    path = np.loadtxt(tmp_path / "path.csv", delimiter=",", skiprows=1)
+    assert path.shape == (61, 19)
+    np.testing.assert_allclose(path[:, 0], np.arange(61) * 0.025)
+    assert (tmp_path / "path.csv").read_text().startswith("t,q1,q2,q3,q4,q5,q6,qd1")
+    mod = (tmp_path / "path.mod").read_text()
+    assert "MoveAbsJ GOAL, v7000 \\T:=MOVE_TIME, fine, tool0;" in mod and "START" in mod
+
+
+def test_path_module_refuses_violations(irb120, result):
+    q = result.optimized.q.copy()
+    q[10, 1] = np.radians(130)  # joint 2 past its +110 deg limit
+    with pytest.raises(LimitViolation, match=r"sample 10: joint 2 at 130\.00 deg leaves its range"):
+        path_module(irb120, q, result.optimized.qd, 1.5)
+    qd = result.optimized.qd.copy()
+    qd[5, 0] = 10.0
+    with pytest.raises(LimitViolation, match="joint 1 speed 573.0 deg/s exceeds its limit 250.0"):
+        path_module(irb120, result.optimized.q, qd, 1.5)
+
+
+def test_write_run_refuses_rapid_for_violating_path(result, irb120, tmp_path):
+    from dataclasses import replace
+
+    bad = replace(result, summary={**result.summary, "limits_ok": False})
+    files = write_run(bad, irb120, tmp_path)
+    assert "path.mod" not in files and not (tmp_path / "path.mod").exists()
+    assert json.loads((tmp_path / "result.json").read_text())["rapid"] is None
+
+
+def test_optimize_move_refuses_start_outside_the_range(irb120):
+    with pytest.raises(LimitViolation, match=r"start joint 2 = 120\.00 deg is outside its range"):
+        optimize_move(irb120, np.radians([0, 120, 0, 0, 0, 0]), QF, 1.0, OptimizeConfig())
+    with pytest.raises(InvalidInput, match="algorithm must be one of"):
+        OptimizeConfig(algorithm="pso")
