@@ -16,7 +16,7 @@ $(STAMP): $(BIN)/python pyproject.toml constraints.txt
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/joulepath demo
+	$(BIN)/joulepath demo --out demo-out
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks scripts

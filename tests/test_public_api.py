@@ -65,7 +65,7 @@ ALLOWED = {
     "energy": set(),
     "units": set(),
     "abb": set(),
-    "demo": {"description", "kinematics", "dynamics", "trajectory", "energy"},
+    "demo": None,  # orchestrates every stage, like the CLI
     "cli": None,  # may import anything
 }
 FOUNDATION = {"_typing", "_rng", "_io", "errors", "units", "abb", "__version__"}

@@ -1,6 +1,8 @@
-"""``joulepath demo``: what the bundled IRB 120 model gives, in one screen."""
+"""``joulepath demo``: the whole method on the bundled IRB 120, small and fast."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import typer
 
@@ -8,11 +10,11 @@ from joulepath.cli._common import console
 
 
 def demo(
-    duration: float = typer.Option(1.5, help="Duration of the sample move, s."),
+    out: Path = typer.Option(Path("demo-out"), "--out", help="Folder for the demo's data, models and run."),
+    quick: bool = typer.Option(False, help="Smaller data, two model families, fewer generations."),
 ) -> int:
-    """Show the IRB 120: summary, tool0 poses, and the energy of one sample move."""
+    """Robot, data, energy models and one optimized move, end to end."""
     from joulepath.demo import run_demo
 
-    report = run_demo(duration=duration)
-    console.print(report, markup=False)
+    run_demo(out, quick=quick, say=lambda text: console.print(text, markup=False))
     return 0
