@@ -26,6 +26,10 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/dynamics.py
 	$(BIN)/python benchmarks/data.py
+	$(BIN)/python benchmarks/evolve.py
+	$(BIN)/python benchmarks/learn.py
+	$(BIN)/python benchmarks/optimizers.py
+	$(BIN)/python benchmarks/synth.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks scripts
