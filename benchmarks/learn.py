@@ -7,7 +7,7 @@
 * ``predict_rows`` latency for 4,000 rows (target <= 1 ms for the MLP), against
   ``pipeline.predict`` on a DataFrame as the baseline;
 * grouped-CV and path-level figures of each family's best quick model on simulated
-  lab data (train: 300 lab moves, test: 100 other lab moves), both input kinds.
+  lab data (train: 100 lab moves, test: 50 other lab moves), both input kinds.
 
 Usage: python benchmarks/learn.py
 """
@@ -48,8 +48,8 @@ def main() -> None:
     rng = np.random.default_rng(0)
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
-        tr = ingest([simulate(d / "tr.csv", plant="lab", n_moves=300, seed=21).log], robot=robot)
-        te = ingest([simulate(d / "te.csv", plant="lab", n_moves=100, seed=22).log], robot=robot)
+        tr = ingest([simulate(d / "tr.csv", plant="lab", n_moves=100, seed=21).log], robot=robot)
+        te = ingest([simulate(d / "te.csv", plant="lab", n_moves=50, seed=22).log], robot=robot)
         lines = [
             "## Energy models (benchmarks/learn.py)",
             "",
@@ -57,7 +57,7 @@ def main() -> None:
             f"Data: simulated lab robot, train {len(tr.frame):,} rows / {tr.n_moves} moves, "
             f"test {len(te.frame):,} rows / {te.n_moves} other moves; target E.",
             "",
-            "### Quick grids, 5 grouped folds (headline) and the thesis' shuffled folds",
+            "### Quick grids, 3 grouped folds (headline) and the thesis' shuffled folds",
             "",
             "| inputs | family | grouped CV R² | shuffled CV R² | test R² | test MAE (J/row) | "
             "path error median % | path error p95 % | search wall s |",
@@ -66,7 +66,7 @@ def main() -> None:
         folders = {}
         for inputs in ("physics", "thesis"):
             t0 = time.perf_counter()
-            rep = train(tr, te, TrainConfig(cv=5, inputs=inputs), d / inputs)
+            rep = train(tr, te, TrainConfig(cv=3, inputs=inputs), d / inputs)
             folders[inputs] = rep.models
             for r in rep.results.itertuples():
                 lines.append(
@@ -99,16 +99,16 @@ def main() -> None:
                 lines.append(f"| {family} ({inputs} inputs) | {fast * 1e3:.3f} ms | {slow * 1e3:.3f} ms | "
                              f"{slow / fast:.1f}x | {size / 1e3:.0f} kB |")
         lines += ["", "### The thesis grids (Tables 2.2–2.5): size and estimated cost here", "",
-                  "| family | candidates | fits (5 folds) | median s per fit (sample of 6 candidates) | "
+                  "| family | candidates | fits (5 folds) | median s per fit (sample of 3 candidates) | "
                   "estimated single-core hours |", "|---|---|---|---|---|"]
         cols = input_columns("full40", "thesis")
-        sub = tr.frame.sample(n=min(20000, len(tr.frame)), random_state=0)
+        sub = tr.frame.sample(n=min(3000, len(tr.frame)), random_state=0)
         X = sub[list(cols)].to_numpy()
         y = sub["E"].to_numpy()
         splits = make_splits(len(y), sub["move_id"].to_numpy(), split="grouped", n_splits=5, seed=0)[:1]
         for family, grid in THESIS_GRIDS.items():
             points = list(ParameterGrid(grid))
-            pick = rng.choice(len(points), size=min(6, len(points)), replace=False)
+            pick = rng.choice(len(points), size=min(3, len(points)), replace=False)
             pipe = make_pipeline(family, seed=0, inputs="thesis", columns=cols)
             times = [cross_validate_candidate(pipe, points[i], X, y, splits)[2] for i in pick]
             per_fit = float(np.median(times))

@@ -73,7 +73,7 @@ def run_demo(
     say("== 1. robot ==")
     say(robot_section())
     robot = load_robot("irb120")
-    n_train, n_test, generations = (20, 8, 20) if quick else (80, 25, 120)
+    n_train, n_test, generations = (20, 8, 20) if quick else (40, 15, 100)
     families = ("par", "xgb") if quick else ("mlp", "svr", "par", "xgb")
     say(f"\n== 2. data: {n_train} + {n_test} random moves on the emulated lab robot ==")
     tables = {}
