@@ -84,9 +84,13 @@ def main() -> None:
                 f"{b['latency_single_prediction_s'] * 1e3:.2f} ms for a single prediction, "
                 f"description file {b['size_bytes'] / 1e3:.1f} kB"
             )
-        lines += ["", "### predict_rows latency, 4,000 rows", "",
-                  "| model | predict_rows | DataFrame predict (baseline) | speed vs baseline | model files |",
-                  "|---|---|---|---|---|"]
+        lines += [
+            "",
+            "### predict_rows latency, 4,000 rows",
+            "",
+            "| model | predict_rows | DataFrame predict (baseline) | speed vs baseline | model files |",
+            "|---|---|---|---|---|",
+        ]
         rows = te.frame.iloc[:4000]
         for inputs in ("thesis", "physics"):
             for family in FAMILIES:
@@ -94,13 +98,22 @@ def main() -> None:
                 model = EnergyModel.load(folder)
                 X = rows[list(model.input_columns)].to_numpy()
                 fast = median_time(lambda m=model, x=X: m.predict_rows(x), repeats=30)
-                slow = median_time(lambda m=model: m.pipeline.predict(rows[list(m.input_columns)]), repeats=10)
+                slow = median_time(
+                    lambda m=model: m.pipeline.predict(rows[list(m.input_columns)]), repeats=10
+                )
                 size = sum(p.stat().st_size for p in Path(folder).iterdir())
-                lines.append(f"| {family} ({inputs} inputs) | {fast * 1e3:.3f} ms | {slow * 1e3:.3f} ms | "
-                             f"{slow / fast:.1f}x | {size / 1e3:.0f} kB |")
-        lines += ["", "### The thesis grids (Tables 2.2–2.5): size and estimated cost here", "",
-                  "| family | candidates | fits (5 folds) | median s per fit (sample of 3 candidates) | "
-                  "estimated single-core hours |", "|---|---|---|---|---|"]
+                lines.append(
+                    f"| {family} ({inputs} inputs) | {fast * 1e3:.3f} ms | {slow * 1e3:.3f} ms | "
+                    f"{slow / fast:.1f}x | {size / 1e3:.0f} kB |"
+                )
+        lines += [
+            "",
+            "### The thesis grids (Tables 2.2–2.5): size and estimated cost here",
+            "",
+            "| family | candidates | fits (5 folds) | median s per fit (sample of 3 candidates) | "
+            "estimated single-core hours |",
+            "|---|---|---|---|---|",
+        ]
         cols = input_columns("full40", "thesis")
         sub = tr.frame.sample(n=min(3000, len(tr.frame)), random_state=0)
         X = sub[list(cols)].to_numpy()
@@ -113,8 +126,13 @@ def main() -> None:
             times = [cross_validate_candidate(pipe, points[i], X, y, splits)[2] for i in pick]
             per_fit = float(np.median(times))
             fits = 5 * len(points)
-            lines.append(f"| {family} | {len(points):,} | {fits:,} | {per_fit:.2f} | {fits * per_fit / 3600:.1f} |")
-        lines += ["", f"(cost sampled on {len(y):,} training rows; the thesis' 75k-row sets cost more per fit)"]
+            lines.append(
+                f"| {family} | {len(points):,} | {fits:,} | {per_fit:.3f} | {fits * per_fit / 3600:.1f} |"
+            )
+        lines += [
+            "",
+            f"(cost sampled on {len(y):,} training rows; the thesis' 75k-row sets cost more per fit)",
+        ]
     text = "\n".join(lines)
     print(text)
     write_section("learn", text)

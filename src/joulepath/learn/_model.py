@@ -113,17 +113,32 @@ class EnergyModel:
     def _mlp_forward(self) -> _Forward | None:
         steps = dict(self.pipeline.steps)
         model = steps.get("model")
-        if self.card.get("family") != "mlp" or model is None or not hasattr(model, "coefs_"):
+        scaler = steps.get("scale")
+        if model is None or scaler is None:
             return None
-        scaler = steps["scale"]
-        return _Forward(
-            physics=steps.get("physics"),
-            mean=np.asarray(scaler.mean_, float),
-            scale=np.asarray(scaler.scale_, float),
-            weights=tuple(np.asarray(w, float) for w in model.coefs_),
-            biases=tuple(np.asarray(b, float) for b in model.intercepts_),
-            activation=model.activation,
-        )
+        common = {
+            "physics": steps.get("physics"),
+            "mean": np.asarray(scaler.mean_, float),
+            "scale": np.asarray(scaler.scale_, float),
+        }
+        family = self.card.get("family")
+        if family == "mlp" and hasattr(model, "coefs_"):
+            return _Forward(
+                **common,
+                weights=tuple(np.asarray(w, float) for w in model.coefs_),
+                biases=tuple(np.asarray(b, float) for b in model.intercepts_),
+                activation=model.activation,
+            )
+        linear = family == "par" or (family == "svr" and getattr(model, "kernel", None) == "linear")
+        if linear and hasattr(model, "coef_"):  # a linear model is a one-layer identity network
+            coef = np.asarray(model.coef_, float).reshape(-1, 1)
+            return _Forward(
+                **common,
+                weights=(coef,),
+                biases=(np.asarray(model.intercept_, float).reshape(1),),
+                activation="identity",
+            )
+        return None
 
     # ----------------------------------------------------------- prediction
     def check_frame(self, frame: pd.DataFrame, *, source: str = "table") -> None:
@@ -145,7 +160,8 @@ class EnergyModel:
         """Predict from a float array of shape (n_rows, n_inputs) in ``input_columns`` order.
 
         No pandas and no validation beyond the shape: this is the optimizer's hot
-        path. For an MLP it is a plain NumPy forward pass of the fitted weights.
+        path. For an MLP it is a plain NumPy forward pass of the fitted weights (and
+        for linear models — PAR, linear-kernel SVR — one matrix-vector product).
         """
         X = np.asarray(X, dtype=np.float64)
         if X.ndim != 2 or X.shape[1] != self.n_inputs:
