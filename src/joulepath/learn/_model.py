@@ -116,15 +116,15 @@ class EnergyModel:
         scaler = steps.get("scale")
         if model is None or scaler is None:
             return None
-        common = {
-            "physics": steps.get("physics"),
-            "mean": np.asarray(scaler.mean_, float),
-            "scale": np.asarray(scaler.scale_, float),
-        }
+        physics = steps.get("physics")
+        mean = np.asarray(scaler.mean_, float)
+        scale = np.asarray(scaler.scale_, float)
         family = self.card.get("family")
         if family == "mlp" and hasattr(model, "coefs_"):
             return _Forward(
-                **common,
+                physics=physics,
+                mean=mean,
+                scale=scale,
                 weights=tuple(np.asarray(w, float) for w in model.coefs_),
                 biases=tuple(np.asarray(b, float) for b in model.intercepts_),
                 activation=model.activation,
@@ -133,7 +133,9 @@ class EnergyModel:
         if linear and hasattr(model, "coef_"):  # a linear model is a one-layer identity network
             coef = np.asarray(model.coef_, float).reshape(-1, 1)
             return _Forward(
-                **common,
+                physics=physics,
+                mean=mean,
+                scale=scale,
                 weights=(coef,),
                 biases=(np.asarray(model.intercept_, float).reshape(1),),
                 activation="identity",
