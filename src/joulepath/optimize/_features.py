@@ -5,33 +5,12 @@ from __future__ import annotations
 import numpy as np
 
 from joulepath._typing import FloatArray
+from joulepath.data import FEATURES_FULL, FEATURES_JOINT
 from joulepath.dynamics import Robot
 from joulepath.trajectory import Trajectory
 
-_TCP = {
-    "x",
-    "y",
-    "z",
-    "qx",
-    "qy",
-    "qz",
-    "qw",
-    "yaw",
-    "pitch",
-    "roll",
-    "dx",
-    "dy",
-    "dz",
-    "dphi",
-    "dtheta",
-    "dpsi",
-    "ddx",
-    "ddy",
-    "ddz",
-    "ddphi",
-    "ddtheta",
-    "ddpsi",
-}
+_TCP = frozenset(FEATURES_FULL) - frozenset(FEATURES_JOINT)
+"""The inputs that need the TCP pose (forward kinematics)."""
 
 
 def _time_derivative(values: FloatArray, dt: float) -> FloatArray:
