@@ -66,6 +66,7 @@ ALLOWED = {
     "units": set(),
     "abb": set(),
     "demo": None,  # orchestrates every stage, like the CLI
+    "experiment": None,  # idem
     "cli": None,  # may import anything
 }
 FOUNDATION = {"_typing", "_rng", "_io", "errors", "units", "abb", "__version__"}

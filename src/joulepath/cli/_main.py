@@ -9,6 +9,7 @@ import typer
 
 from joulepath.cli._data import ingest, rapid_app, simulate
 from joulepath.cli._demo import demo
+from joulepath.cli._experiment import run
 from joulepath.cli._learn import importance, train
 from joulepath.cli._optimize import bench_optimizers, optimize
 from joulepath.cli._robot import robot_app
@@ -32,6 +33,7 @@ app.command("synth")(synth)
 app.command("compare")(compare)
 app.command("optimize")(optimize)
 app.command("bench-optimizers")(bench_optimizers)
+app.command("run")(run)
 app.command("demo")(demo)
 
 
