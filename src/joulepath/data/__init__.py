@@ -1,6 +1,6 @@
 """Data: joint logs (controller and generic), the energy-table schema, ingestion."""
 
-from joulepath.data._features import segment_moves
+from joulepath.data._features import segment_moves, tcp_columns
 from joulepath.data._logs import JointLog, controller_log_text, read_log, write_controller_log
 from joulepath.data._schema import (
     FEATURE_SETS,
@@ -30,5 +30,6 @@ __all__ = [
     "save_table",
     "segment_moves",
     "table_columns",
+    "tcp_columns",
     "write_controller_log",
 ]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pandas as pd
 from scipy.signal import find_peaks
@@ -101,6 +103,34 @@ def _differentiate(values: FloatArray, t: FloatArray, first: np.ndarray, last: n
     return out
 
 
+def tcp_columns(
+    position: FloatArray,
+    quaternion: FloatArray,
+    euler_unwrapped: FloatArray,
+    derivative: Callable[[FloatArray], FloatArray],
+) -> dict[str, FloatArray]:
+    """The 22 TCP inputs of the ``full40`` set from position, quaternion and EulerZYX.
+
+    ``derivative`` differentiates along time (the caller's sampling and move
+    boundaries); Euler angles come in unwrapped along time and are reported wrapped
+    to (-pi, pi], their rates from the unwrapped signal. Arrays are ``(..., 3)``,
+    ``(..., 4)`` (w first) and ``(..., 3)`` (z, y, x).
+    """
+    vel = derivative(position)
+    acc = derivative(vel)
+    rate = derivative(euler_unwrapped)
+    rate_acc = derivative(rate)
+    wrapped = (euler_unwrapped + np.pi) % (2 * np.pi) - np.pi
+    cols: dict[str, FloatArray] = {}
+    for k, name in enumerate(("x", "y", "z")):
+        cols[name], cols[f"d{name}"], cols[f"dd{name}"] = position[..., k], vel[..., k], acc[..., k]
+    for k, name in enumerate(("qw", "qx", "qy", "qz")):
+        cols[name] = quaternion[..., k]
+    for k, (name, dname) in enumerate((("yaw", "phi"), ("pitch", "theta"), ("roll", "psi"))):
+        cols[name], cols[f"d{dname}"], cols[f"dd{dname}"] = wrapped[..., k], rate[..., k], rate_acc[..., k]
+    return cols
+
+
 def sample_lengths(t: FloatArray) -> FloatArray:
     """Length of each sample, s: ``t[k+1] - t[k]``; the last sample repeats the previous one."""
     if t.size < 2:
@@ -157,22 +187,9 @@ def log_to_frame(
                 raise ValueError("full40 needs TCP signals")
             tcp = (log.tcp_position, log.tcp_quaternion, log.tcp_euler)
         pos, quat, eul = (a[idx] for a in tcp)
-        eul = np.unwrap(eul, axis=0)
-        vel = _differentiate(pos, t, first, last)
-        acc = _differentiate(vel, t, first, last)
-        rate = _differentiate(eul, t, first, last)
-        rate_acc = _differentiate(rate, t, first, last)
-        wrapped = (eul + np.pi) % (2 * np.pi) - np.pi
-        for k, name in enumerate(("x", "y", "z")):
-            cols[name] = pos[:, k]
-            cols[f"d{name}"] = vel[:, k]
-            cols[f"dd{name}"] = acc[:, k]
-        for k, name in enumerate(("qw", "qx", "qy", "qz")):
-            cols[name] = quat[:, k]
-        for k, (name, dname) in enumerate((("yaw", "phi"), ("pitch", "theta"), ("roll", "psi"))):
-            cols[name] = wrapped[:, k]
-            cols[f"d{dname}"] = rate[:, k]
-            cols[f"dd{dname}"] = rate_acc[:, k]
+        cols.update(
+            tcp_columns(pos, quat, np.unwrap(eul, axis=0), lambda v: _differentiate(v, t, first, last))
+        )
     energy = np.abs(tau * qd) * dt[:, None]
     for i in range(N_JOINTS):
         cols[f"E{i + 1}"] = energy[:, i]

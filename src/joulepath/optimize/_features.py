@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from joulepath._typing import FloatArray
-from joulepath.data import FEATURES_FULL, FEATURES_JOINT
+from joulepath.data import FEATURES_FULL, FEATURES_JOINT, tcp_columns
 from joulepath.dynamics import Robot
 from joulepath.trajectory import Trajectory
 
@@ -53,22 +53,12 @@ def path_features(robot: Robot, traj: Trajectory, columns: tuple[str, ...]) -> F
         cols[f"ddq{i + 1}"] = qdd[..., i]
     if _TCP.intersection(columns):
         pose = robot.fk(q)
-        pos = pose.position_m
-        quat = pose.quaternion
-        eul = np.unwrap(pose.euler_zyx, axis=1)
-        vel = _time_derivative(pos, dt)
-        acc = _time_derivative(vel, dt)
-        rate = _time_derivative(eul, dt)
-        rate_acc = _time_derivative(rate, dt)
-        wrapped = (eul + np.pi) % (2 * np.pi) - np.pi
-        for k, name in enumerate(("x", "y", "z")):
-            cols[name], cols[f"d{name}"], cols[f"dd{name}"] = pos[..., k], vel[..., k], acc[..., k]
-        for k, name in enumerate(("qw", "qx", "qy", "qz")):
-            cols[name] = quat[..., k]
-        for k, (name, dname) in enumerate((("yaw", "phi"), ("pitch", "theta"), ("roll", "psi"))):
-            cols[name], cols[f"d{dname}"], cols[f"dd{dname}"] = (
-                wrapped[..., k],
-                rate[..., k],
-                rate_acc[..., k],
+        cols.update(
+            tcp_columns(
+                pose.position_m,
+                pose.quaternion,
+                np.unwrap(pose.euler_zyx, axis=1),
+                lambda v: _time_derivative(v, dt),
             )
+        )
     return np.stack([cols[c] for c in columns], axis=-1).reshape(P * n, len(columns))

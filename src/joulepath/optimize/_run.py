@@ -104,14 +104,8 @@ def rank_joints_by_energy(robot: Robot, path: Trajectory) -> tuple[int, ...]:
     return tuple(int(j) + 1 for j in np.argsort(-per_joint))
 
 
-def _lab_energy(robot: Robot, traj: Trajectory) -> float | None:
-    try:
-        from joulepath.sim import make_plant
-    except ImportError:  # pragma: no cover - sim ships with joulepath
-        return None
-    plant = make_plant("lab", robot)
-    tau = plant.robot.inverse_dynamics(traj.q, traj.qd, traj.qdd) + plant.friction.torque(traj.qd)
-    tau = np.where(tau * traj.qd > 0, tau / plant.gear_efficiency, tau * plant.gear_efficiency)
+def _plant_energy(plant: Any, traj: Trajectory) -> float:
+    tau = plant.drive_torque(traj.q, traj.qd, traj.qdd)
     return float((np.abs(tau * traj.qd) * traj.dt).sum())
 
 
@@ -191,7 +185,10 @@ def optimize_move(
             "energy_default_surrogate_J": float(e_sur[0]),
             "energy_optimized_surrogate_J": float(e_sur[1]),
         }
-    e_lab_def, e_lab_opt = _lab_energy(robot, default), _lab_energy(robot, optimized)
+    from joulepath.sim import make_plant
+
+    lab = make_plant("lab", robot)
+    e_lab_def, e_lab_opt = _plant_energy(lab, default), _plant_energy(lab, optimized)
     summary: dict[str, Any] = {
         "robot": robot.name,
         "start_rad": q0.tolist(),

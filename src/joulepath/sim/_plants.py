@@ -64,6 +64,15 @@ class Plant:
     speed_noise_deg_s: float = 0.0
     tracking_hz: float | None = None
 
+    def drive_torque(self, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
+        """Noise-free motor torque (joint side, N·m) the plant needs for a motion."""
+        tau = self.robot.inverse_dynamics(q, qd, qdd) + self.friction.torque(qd)
+        if self.gear_efficiency != 1.0:
+            driving = tau * qd > 0
+            tau = np.where(driving, tau / self.gear_efficiency, tau * self.gear_efficiency)
+        out: FloatArray = tau
+        return out
+
 
 def perturbed_robot(robot: Robot, rng: np.random.Generator) -> Robot:
     """The robot with its link mass properties perturbed (masses ±8 %, COM ±4 mm, inertia ±10 %)."""
@@ -139,10 +148,7 @@ def run_plant(plant: Plant, plan: MotionPlan, t: FloatArray, *, rng: np.random.G
         q, qd, qdd = evaluate_plan(plan, t)
     else:
         q, qd, qdd = _track(plan, t, plant.tracking_hz)
-    tau = plant.robot.inverse_dynamics(q, qd, qdd) + plant.friction.torque(qd)
-    if plant.gear_efficiency != 1.0:
-        driving = tau * qd > 0
-        tau = np.where(driving, tau / plant.gear_efficiency, tau * plant.gear_efficiency)
+    tau = plant.drive_torque(q, qd, qdd)
     noise = np.asarray(plant.torque_noise)
     if np.any(noise > 0):
         tau = tau + rng.standard_normal(tau.shape) * noise
