@@ -31,3 +31,65 @@ def appendix_c_path() -> Path:
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(20251125)
+
+
+# The bundled demo experiment at a tiny scale: every stage, in well under a minute.
+TINY_DEMO = {
+    "jobs": "1",
+    "train_moves": "12",
+    "test_moves": "5",
+    "micro_moves": "4",
+    "sim_moves": "6",
+    "methods": '["copula"]',
+    "rows": "300",
+    "families": '["par", "mlp"]',
+    "cv": "2",
+    "max_rows": "400",
+    "targets": '["E", "E1"]',
+    "tasks": "2",
+    "generations": "5",
+    "population": "12",
+}
+
+
+def _tiny_demo_toml(out_dir: Path, **changes: str) -> Path:
+    """demo.toml with every size shrunk (``TINY_DEMO``, then ``changes``), written to ``out_dir``."""
+    import re
+    from importlib import resources
+
+    text = (resources.files("joulepath.experiment") / "presets" / "demo.toml").read_text()
+    section = ""
+    lines = []
+    for line in text.splitlines():
+        m = re.match(r"^\[(\w+)\]", line)
+        if m:
+            section = m[1]
+        key = line.split("=")[0].strip()
+        values = {**TINY_DEMO, **changes}
+        if "=" in line and not line.lstrip().startswith("#"):
+            value = values.get(f"{section}.{key}", values.get(key))
+            if value is not None and not (
+                section == "train" and key == "targets" and "train.targets" not in values
+            ):
+                line = f"{key} = {value}"
+        lines.append(line)
+    path = out_dir / "tiny-demo.toml"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.fixture
+def tiny_demo_toml():
+    """``tiny_demo_toml(folder, **changes) -> Path``: the bundled demo.toml shrunk to seconds."""
+    return _tiny_demo_toml
+
+
+@pytest.fixture(scope="session")
+def tiny_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The tiny demo run through the CLI (``joulepath run FILE --out DIR --quiet``); its folder."""
+    from joulepath.cli import main
+
+    base = tmp_path_factory.mktemp("tiny-demo")
+    toml = _tiny_demo_toml(base, **{"train.targets": '["E", "E1"]'})
+    assert main(["run", str(toml), "--out", str(base / "run"), "--quiet"]) == 0
+    return base / "run"

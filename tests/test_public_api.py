@@ -18,6 +18,8 @@ PACKAGES = [
     "joulepath.data",
     "joulepath.export",
     "joulepath.sim",
+    "joulepath.experiment",
+    "joulepath.report",
 ]
 
 
@@ -65,8 +67,8 @@ ALLOWED = {
     "energy": set(),
     "units": set(),
     "abb": set(),
-    "demo": None,  # orchestrates every stage, like the CLI
-    "experiment": None,  # idem
+    "report": set(),  # reads a run folder's files only
+    "experiment": None,  # orchestrates every stage, like the CLI
     "cli": None,  # may import anything
 }
 FOUNDATION = {"_typing", "_rng", "_io", "errors", "units", "abb", "__version__"}

@@ -52,12 +52,6 @@ def test_main_robot_fk_bad_joints(capsys):
     assert main(["robot", "fk", "irb120", "--q", "a,b,c,d,e,f"]) == 2
 
 
-def test_main_demo_quick(capsys, tmp_path):
-    assert main(["demo", "--quick", "--out", str(tmp_path)]) == 0
-    out = capsys.readouterr().out
-    assert "tool0 at home (q = 0)" in out and "saved at equal cycle time" in out
-    assert (tmp_path / "run" / "result.json").exists() and (tmp_path / "models" / "results.csv").exists()
-
 
 def test_main_version_and_unknown_command(capsys):
     assert main(["--version"]) == 0

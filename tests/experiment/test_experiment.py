@@ -1,12 +1,17 @@
 """Experiment files: validation up front, stages cached, the CLI."""
 
 import json
+import shutil
 
+import numpy as np
+import pandas as pd
 import pytest
 
 from joulepath.cli import main
 from joulepath.errors import InvalidInput
 from joulepath.experiment import load_experiment, run_experiment
+
+STAGES = ("data", "synth", "train", "importance", "optimize", "bench")
 
 TINY = """
 name = "tiny"
@@ -38,15 +43,40 @@ def _write(tmp_path, text, name="exp.toml"):
             lambda t: t.replace('families = ["par"]', 'families = "par"'),
             r"\[train\] families must be a list of strings",
         ),
-        (lambda t: t.replace("tasks = 2", 'tasks = "two"'), r"\[optimize\] tasks must be a int"),
+        (lambda t: t.replace("tasks = 2", 'tasks = "two"'), r"\[optimize\] tasks must be an integer"),
         (
             lambda t: t.replace("[optimize]", '[optimize]\nalgorithm = "pso"'),
             r"algorithm = 'pso' is not allowed; use one of ga, de",
         ),
-        (lambda t: t + "\n[report]\nx = 1\n", r"unknown section \[report\]"),
+        (lambda t: t + "\n[plots]\nx = 1\n", r"unknown section \[plots\]; allowed: \[data\], \[synth\]"),
         (lambda t: t.replace('name = "tiny"', ""), r"missing key 'name'"),
         (lambda t: t.replace("[data]", "[data"), "not valid TOML"),
-        (lambda t: t.replace("tasks = 2", "tasks = 0"), r"\[optimize\] tasks must be ≥ 1"),
+        (lambda t: t.replace("cv = 3", "cv = 0"), r"\[train\] cv must be ≥ 2"),
+        (lambda t: t + '[synth]\nmethods = ["gan"]\n', r"\[synth\] methods has 'gan', which is not allowed"),
+        (
+            lambda t: t + '[synth]\nmethods = ["copula"]\n',
+            r"source = 'micro' needs \[data\] micro_moves ≥ 1",
+        ),
+        (lambda t: t + "[synth]\nrepair = 1\n", r"\[synth\] repair must be true or false"),
+        (lambda t: t.replace("seed = 1", "seed = 1\nrobot = 'nosuch'"), r"robot = 'nosuch'"),
+        (
+            lambda t: t.replace("[optimize]", "[optimize]\nrange_set = 'moon'"),
+            r"range_set = 'moon' is not a range set of",
+        ),
+        (
+            lambda t: t.replace("[optimize]", "[train]\n[optimize]").replace(
+                'families = ["par"]', "families = []"
+            ),
+            "not valid TOML",
+        ),
+        (
+            lambda t: t.replace('families = ["par"]', "families = []"),
+            r"fitness = 'surrogate' needs models of E",
+        ),
+        (
+            lambda t: t.replace("[data]", "[data]\ntrain_logs = ['nothere.csv']\ntest_logs = ['x.csv']"),
+            r"train_logs names 'nothere.csv', which does not exist",
+        ),
     ],
 )
 def test_load_experiment_errors(tmp_path, edit, pattern):
@@ -61,39 +91,85 @@ def test_bundled_demo_experiment_is_valid():
     assert exp.name == "demo" and exp.train.families == ("mlp", "svr", "par", "xgb")
 
 
-def test_run_experiment_caches_unchanged_stages(tmp_path):
-    exp = load_experiment(_write(tmp_path, TINY))
+def test_bundled_thesis_experiment_is_the_full_plan():
+    from importlib import resources
+
+    exp = load_experiment(str(resources.files("joulepath.experiment") / "presets" / "thesis.toml"))
+    assert (exp.data.train_moves, exp.data.test_moves, exp.data.micro_moves, exp.data.sim_moves) == (
+        1000,
+        100,
+        100,
+        1000,
+    )
+    assert exp.synth.rows == 75_000 and set(exp.synth.methods) == {"copula", "ctgan", "copulagan", "tvae"}
+    assert exp.train.grid == "thesis" and exp.train.cv == 5 and len(exp.train.targets) == 7
+    assert (exp.bench.tasks, exp.bench.generations, exp.bench.population) == (500, 250, 100)
+    assert exp.bench.configurations == "thesis"
+
+
+def test_tiny_demo_run_writes_every_stage(tiny_run):
+    summary = json.loads((tiny_run / "summary.json").read_text())
+    assert list(summary["stages"]) == ["data", "synth", "train", "importance", "optimize", "bench"]
+    for folder in ("data", "synth", "models", "importance", "optimize", "bench"):
+        assert (tiny_run / folder / "stage.json").exists(), folder
+    assert set(summary["stages"]["data"]["datasets"]) == {"train", "test", "micro", "sim"}
+    assert (tiny_run / "synth" / "copula.parquet").exists()
+    scores = pd.read_csv(tiny_run / "synth" / "scores.csv")
+    assert scores["column_shapes"].between(0, 1).all()
+    results = pd.read_csv(tiny_run / "models" / "results.csv")
+    assert set(results["family"]) == {"par", "mlp"} and set(results["target"]) == {"E", "E1"}
+    joints = json.loads((tiny_run / "importance" / "joints.json").read_text())["joints_by_influence"]
+    assert sorted(joints) == [1, 2, 3, 4, 5, 6]
+    tasks = pd.read_csv(tiny_run / "optimize" / "tasks.csv")
+    assert len(tasks) == 2 and np.isfinite(tasks["saved_pct"]).all()
+    for row in tasks.itertuples():
+        assert (tiny_run / "optimize" / f"task-{row.task:03d}" / "path.mod").exists() == bool(row.limits_ok)
+    bench = pd.read_csv(tiny_run / "bench" / "table.csv")
+    assert len(bench) == 6 and bench["configuration"].str.startswith("MA").sum() == 2
+    assert (tiny_run / "report.html").stat().st_size > 50_000
+    assert not list(tiny_run.rglob("*.tmp*")), "a temporary file was left behind"
+
+
+def test_run_experiment_skips_unchanged_stages_and_reruns_interrupted_ones(
+    tiny_run, tiny_demo_toml, tmp_path
+):
+    run = tmp_path / "run"
+    shutil.copytree(tiny_run, run)
+    toml = tiny_demo_toml(tmp_path, **{"train.targets": '["E", "E1"]'})
     said: list[str] = []
-    first = run_experiment(exp, tmp_path / "run", say=said.append)
-    assert (tmp_path / "run" / "optimize" / "task-000" / "result.json").exists()
-    assert first["mean_saved_pct"] is not None
+    run_experiment(load_experiment(toml), run, say=said.append)
+    skipped = [s for s in said if s.endswith("unchanged, skipped")]
+    assert [s.split(":")[0] for s in skipped] == ["data", "synth", "train", "importance", "optimize", "bench"]
+    # a change in [optimize] reruns optimize only
+    changed = tiny_demo_toml(tmp_path, **{"train.targets": '["E", "E1"]', "optimize.generations": "6"})
     said.clear()
-    run_experiment(exp, tmp_path / "run", say=said.append)
-    assert said[:3] == [
-        "data: unchanged, skipped",
-        "train: unchanged, skipped",
-        "optimize: unchanged, skipped",
-    ]
-    changed = load_experiment(_write(tmp_path, TINY.replace("generations = 6", "generations = 7")))
+    run_experiment(load_experiment(changed), run, say=said.append)
+    ran = [s.split(":")[0] for s in said if s.split(":")[0] in STAGES and "done in" in s]
+    assert ran == ["optimize"]
+    # an interrupted stage (no stage.json) runs again; the stages after it that read it too
+    (run / "importance" / "stage.json").unlink()
     said.clear()
-    run_experiment(changed, tmp_path / "run", say=said.append)
-    assert said[:2] == ["data: unchanged, skipped", "train: unchanged, skipped"]
-    assert said[2].startswith("optimize: task 0")
-    (tmp_path / "run" / "models" / "stage.json").unlink()  # an interrupted training stage runs again
-    said.clear()
-    run_experiment(changed, tmp_path / "run", say=said.append)
-    assert said[1].startswith("train: par E")
-    assert "mean_saved_pct" in json.loads((tmp_path / "run" / "summary.json").read_text())
-    assert (tmp_path / "run" / "run.log").read_text().count("data: ") >= 4
+    run_experiment(load_experiment(changed), run, say=said.append)
+    ran = [s.split(":")[0] for s in said if s.split(":")[0] in STAGES and "done in" in s]
+    assert ran == ["importance"]  # same settings: same key, so optimize and bench stay cached
+    assert (run / "run.log").read_text().count("data: ") >= 3
 
 
 def test_cli_run_errors_and_quiet(tmp_path, capsys):
     assert main(["run", str(tmp_path / "missing.toml")]) == 2
-    assert "cannot be read" in capsys.readouterr().err
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no such experiment file" in err[0]
     bad = _write(tmp_path, TINY.replace("cv = 3", "folds = 3"), "bad.toml")
     assert main(["run", str(bad)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "unknown key 'folds'" in err[0]
-    assert main(["run", str(_write(tmp_path, TINY)), "--out", str(tmp_path / "r"), "--quiet"]) == 0
+    assert not (tmp_path / "runs").exists()
+
+
+def test_cli_quiet_run_prints_one_line(tiny_run, tiny_demo_toml, tmp_path, capsys):
+    run = tmp_path / "run"
+    shutil.copytree(tiny_run, run)
+    toml = tiny_demo_toml(tmp_path, **{"train.targets": '["E", "E1"]'})
+    assert main(["run", str(toml), "--out", str(run), "--quiet"]) == 0
     out = capsys.readouterr().out.strip().splitlines()
-    assert len(out) == 1 and out[0].startswith("tiny: mean saving")
+    assert len(out) == 1 and out[0].startswith("demo: ") and out[0].endswith("report.html")

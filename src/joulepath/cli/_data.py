@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from joulepath.cli._common import console
+from joulepath.cli._common import check_out_file, check_out_folder, console
 
 rapid_app = typer.Typer(help="Write RAPID programs for the ABB controller.", no_args_is_help=True)
 
@@ -18,13 +18,16 @@ def rapid_collect(
     moves: int = typer.Option(1000, min=1, help="Number of random moves."),
     range_set: str = typer.Option("collection", help="Joint bounds: collection (App. D.1), lab, nominal."),
     mode: str = typer.Option("rand", help="rand: draw on the controller; table: embed the moves of --seed."),
-    seed: int = typer.Option(0, help="Seed of the moves (table) or of the controller's generator (rand)."),
+    seed: int = typer.Option(
+        0, min=0, max=2**32 - 1, help="Seed of the moves (table) or of the controller's generator (rand)."
+    ),
 ) -> int:
     """Write the data-collection programs of thesis Appendix D (collection + measurement)."""
     from joulepath import load_robot
     from joulepath._io import atomic_write_text
     from joulepath.export import collection_programs
 
+    check_out_folder(out)
     programs = collection_programs(
         load_robot(robot), n_moves=moves, range_set=range_set, mode=mode, seed=seed
     )
@@ -39,7 +42,9 @@ def simulate(
     out: Path = typer.Option(..., "--out", help="Log file (.csv) for one run, or a folder for --plan."),
     plant: str = typer.Option("lab", help="sim (nominal twin) or lab (emulated real robot)."),
     moves: int = typer.Option(1000, min=1, help="Number of random moves."),
-    seed: int = typer.Option(0, help="Seed of the random moves and of the plant's noise."),
+    seed: int = typer.Option(
+        0, min=0, max=2**32 - 1, help="Seed of the random moves and of the plant's noise."
+    ),
     plan: str = typer.Option("", help="'thesis': real, sim, micro and test datasets in one go."),
     robot: str = typer.Option("irb120", help="Robot name or .irml path."),
     workers: int = typer.Option(2, min=1, help="Processes for --plan."),
@@ -48,6 +53,10 @@ def simulate(
     from joulepath.sim import simulate as run
     from joulepath.sim import simulate_plan
 
+    if out.suffix == ".csv" and not plan:
+        check_out_file(out, example="lab.csv")
+    else:
+        check_out_folder(out)
     if plan:
         if plan != "thesis":
             raise typer.BadParameter(f"unknown plan {plan!r}; the only plan is 'thesis'", param_hint="--plan")
@@ -86,8 +95,10 @@ def ingest(
     from joulepath.data import ingest as run
     from joulepath.data import save_table
 
+    check_out_file(out, example="table.parquet")
     r = load_robot(robot) if robot else None
     table = run([str(p) for p in logs], robot=r, progress=lambda p: console.print(f"read {p}"))
+    out.parent.mkdir(parents=True, exist_ok=True)
     save_table(table, out)
     console.print(
         f"wrote {out}: {len(table.frame):,} rows, {table.n_moves} moves, "

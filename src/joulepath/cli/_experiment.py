@@ -1,32 +1,91 @@
-"""``joulepath run EXPERIMENT.toml``."""
+"""``joulepath run EXPERIMENT.toml`` and ``joulepath demo``."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import typer
 
 from joulepath.cli._common import console
 
+BUNDLED = ("demo", "thesis")
 
-def run(
-    experiment: str = typer.Argument(..., help="Experiment TOML file, or a bundled one: demo."),
-    out: Path = typer.Option(None, "--out", help="Run folder (default: runs/<name>)."),
-    quiet: bool = typer.Option(False, "--quiet", help="Print only the last line."),
-) -> int:
-    """Run a whole study (data, models, optimized moves); unchanged stages are skipped."""
+
+def _experiment_path(name: str) -> Path:
     from importlib import resources
 
+    if name in BUNDLED:
+        return Path(str(resources.files("joulepath.experiment") / "presets" / f"{name}.toml"))
+    return Path(name)
+
+
+@contextmanager
+def _bars(enabled: bool) -> Iterator[object]:
+    """Rich progress bars keyed by label; a no-op callback when disabled."""
+    if not enabled:
+        yield lambda _label, _done, _total: None
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(
+        TextColumn("{task.description:<22}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=False,
+    ) as bars:
+        tasks: dict[str, object] = {}
+
+        def update(label: str, done: int, total: int) -> None:
+            if label not in tasks:
+                tasks[label] = bars.add_task(label, total=total)
+            bars.update(tasks[label], completed=done, total=total)  # type: ignore[arg-type]
+
+        yield update
+
+
+def _run(experiment: str, out: Path | None, quiet: bool, scheduler: str | None) -> int:
     from joulepath.experiment import load_experiment, run_experiment
 
-    path = Path(experiment)
-    if experiment == "demo":
-        path = Path(str(resources.files("joulepath.experiment") / "presets" / "demo.toml"))
-    exp = load_experiment(path)
+    exp = load_experiment(_experiment_path(experiment))
     folder = out or Path("runs") / exp.name
-    summary = run_experiment(
-        exp, folder, say=(lambda _t: None) if quiet else (lambda t: console.print(t, markup=False))
-    )
+    say = (lambda _t: None) if quiet else (lambda t: console.print(t, markup=False))
+    with _bars(not quiet and console.is_terminal) as progress:
+        summary = run_experiment(exp, folder, say=say, progress=progress, scheduler=scheduler)  # type: ignore[arg-type]
+    saved = summary["mean_saved_pct"]
     if quiet:
-        console.print(f"{exp.name}: mean saving {summary['mean_saved_pct']:.1f} %; outputs in {folder}")
+        console.print(
+            f"{exp.name}: "
+            + (f"mean saving {saved:.1f} % at equal cycle time; " if saved is not None else "")
+            + f"report: {summary['report']}",
+            markup=False,
+        )
+    else:
+        console.print(f"\nreport: {summary['report']}", markup=False)
     return 0
+
+
+def run(
+    experiment: str = typer.Argument(
+        ..., help="Experiment TOML file, or a bundled one: demo (minutes), thesis (the full plan)."
+    ),
+    out: Path = typer.Option(None, "--out", help="Run folder (default: runs/<name>)."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress; print only the last line."),
+    scheduler: str = typer.Option(
+        None, "--scheduler", help="Dask scheduler address (tcp://host:8786) for grid search and benchmark."
+    ),
+) -> int:
+    """Run a whole study from one file: data, synthetic data, models, importance, optimized
+    moves, benchmark, then report.html. Unchanged stages are skipped."""
+    return _run(experiment, out, quiet, scheduler)
+
+
+def demo(
+    out: Path = typer.Option(Path("demo-out"), "--out", help="Run folder."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress; print only the last line."),
+) -> int:
+    """The bundled demo study on the IRB 120 (the same as ``joulepath run demo``)."""
+    return _run("demo", out, quiet, None)

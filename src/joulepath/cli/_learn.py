@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from joulepath.cli._common import console
+from joulepath.cli._common import check_out_folder, console
 
 
 def _split(
@@ -34,16 +34,18 @@ def train(
     cv: int = typer.Option(5, min=2, help="Folds."),
     inputs: str = typer.Option("physics", help="physics (raw + nominal model terms) or thesis (raw)."),
     out: Path = typer.Option(..., "--out", help="Folder for models and reports."),
-    seed: int = typer.Option(0),
+    seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     jobs: int = typer.Option(1, min=1, help="Local processes for the grid search."),
     scheduler: str = typer.Option("", help="Dask scheduler address (tcp://HOST:PORT) for the grid search."),
     robot: str = typer.Option("irb120", help="Robot of the data."),
 ) -> int:
     """Tune (grid search + CV), refit and test energy models; save them with cards and reports."""
     from joulepath.data import TARGETS, load_table
+    from joulepath.errors import InvalidInput
     from joulepath.learn import FAMILIES, TrainConfig
     from joulepath.learn import train as run
 
+    check_out_folder(out)
     config = TrainConfig(
         families=_split(family, "--family", FAMILIES, FAMILIES),
         targets=_split(target, "--target", TARGETS, TARGETS),
@@ -56,6 +58,11 @@ def train(
         robot=robot,
     )
     train_table, test_table = load_table(data), load_table(test)
+    if train_table.feature_set != test_table.feature_set:
+        raise InvalidInput(
+            f"{test}: feature set {test_table.feature_set!r}, but {data} has {train_table.feature_set!r}; "
+            "ingest both tables the same way (both with --robot, or both without)"
+        )
     with console.status("training...") as status:
         report = run(train_table, test_table, config, out, progress=lambda m: status.update(m))
     cols = [
@@ -87,13 +94,14 @@ def importance(
     data: Path = typer.Option(..., "--data", help="Energy table (.parquet)."),
     target: str = typer.Option("E", help="Target: E or E1..E6."),
     out: Path = typer.Option(..., "--out", help="Folder for importance.csv and the plot."),
-    seed: int = typer.Option(0),
+    seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
 ) -> int:
     """Rank the inputs (and joints) by their influence on the energy (thesis Figs 4.1-4.2)."""
     from joulepath._io import atomic_write_text
     from joulepath.data import load_table
     from joulepath.learn import feature_importance, plot_importance, rank_joints
 
+    check_out_folder(out)
     table = load_table(data)
     imp = feature_importance(table, target, seed=seed)
     out.mkdir(parents=True, exist_ok=True)

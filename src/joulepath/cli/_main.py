@@ -8,8 +8,7 @@ from collections.abc import Sequence
 import typer
 
 from joulepath.cli._data import ingest, rapid_app, simulate
-from joulepath.cli._demo import demo
-from joulepath.cli._experiment import run
+from joulepath.cli._experiment import demo, run
 from joulepath.cli._learn import importance, train
 from joulepath.cli._optimize import bench_optimizers, optimize
 from joulepath.cli._robot import robot_app

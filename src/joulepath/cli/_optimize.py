@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from joulepath.cli._common import console, parse_joints
+from joulepath.cli._common import check_out_folder, console, parse_joints
 
 
 def _models(
@@ -58,7 +58,7 @@ def optimize(
     parametrization: str = typer.Option("rest_to_rest", help="rest_to_rest (default) or thesis."),
     generations: int = typer.Option(200, min=1, help="Generation cap."),
     population: int = typer.Option(100, min=4),
-    seed: int = typer.Option(0),
+    seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     robot: str = typer.Option("irb120", help="Robot name or .irml/.urdf path."),
     out: Path = typer.Option(..., "--out", help="Run folder."),
 ) -> int:
@@ -66,6 +66,7 @@ def optimize(
     from joulepath import load_robot
     from joulepath.optimize import OptimizeConfig, optimize_move, write_run
 
+    check_out_folder(out)
     r = load_robot(robot)
     q0 = parse_joints(start, option="--start", degrees=degrees, n=r.n_joints)
     qf = parse_joints(end, option="--end", degrees=degrees, n=r.n_joints)
@@ -104,7 +105,7 @@ def bench_optimizers(
     population: int = typer.Option(100, min=4),
     quick: bool = typer.Option(False, help="10 tasks, 30 generations, population 30."),
     model: Path = typer.Option(None, "--model", help="Trained models: surrogate fitness (single and multi)."),
-    seed: int = typer.Option(0),
+    seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     jobs: int = typer.Option(2, min=1, help="Local processes."),
     scheduler: str = typer.Option("", help="Dask scheduler address."),
     robot: str = typer.Option("irb120"),
@@ -114,6 +115,7 @@ def bench_optimizers(
     from joulepath._io import atomic_write_text
     from joulepath.optimize import bench_optimizers as run
 
+    check_out_folder(out)
     if quick:
         tasks, generations, population = 10, 30, 30
     out.mkdir(parents=True, exist_ok=True)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from joulepath.cli._common import console
+from joulepath.cli._common import check_out_file, check_out_folder, console
 
 
 def synth(
@@ -16,7 +16,7 @@ def synth(
     ),
     rows: int = typer.Option(75000, "--rows", min=1, help="Synthetic rows to sample."),
     out: Path = typer.Option(..., "--out", help="Synthetic energy table to write (.parquet)."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the fit and the sample."),
+    seed: int = typer.Option(0, "--seed", min=0, max=2**32 - 1, help="Seed of the fit and the sample."),
     epochs: int = typer.Option(300, "--epochs", min=1, help="Training epochs (neural methods)."),
     batch_size: int = typer.Option(500, "--batch-size", min=2, help="Rows per training batch."),
     repair_kinematics: bool = typer.Option(
@@ -38,6 +38,9 @@ def synth(
     from joulepath.synth import SynthConfig, Synthesizer, synthesize
     from joulepath.synth import repair_kinematics as repair
 
+    check_out_file(out, example="synthetic.parquet")
+    if save_model is not None:
+        check_out_file(save_model, example="synthesizer.pkl", option="--save-model")
     both = "give exactly one of --from TABLE (fit a synthesizer) or --model FILE (sample a saved one)"
     if model is not None:
         if source is not None:
@@ -49,8 +52,14 @@ def synth(
             table = repair(table, load_robot(robot))
     elif source is not None:
         config = SynthConfig(method=method, epochs=epochs, batch_size=batch_size, seed=seed, verbose=progress)
+        real = load_table(source)
+        if repair_kinematics and real.feature_set != "full40":
+            raise InvalidInput(
+                f"{source}: feature set {real.feature_set!r} has no TCP columns for --repair-kinematics to "
+                "recompute; leave the option out, or use a full40 table (`joulepath ingest --robot`)"
+            )
         table = synthesize(
-            load_table(source),
+            real,
             n_rows=rows,
             config=config,
             repair=load_robot(robot) if repair_kinematics else None,
@@ -79,6 +88,7 @@ def compare(
     from joulepath.data import load_table
     from joulepath.synth import compare as run
 
+    check_out_folder(out)
     named = {}
     for path in tables:
         name = path.stem

@@ -1,32 +1,43 @@
 """Experiment files: one TOML file describes a whole study, validated before anything runs.
 
-Example (``joulepath/experiment/presets/demo.toml``)::
+Example (``joulepath/experiment/presets/demo.toml``, abridged)::
 
     name = "demo"
     robot = "irb120"
     seed = 0
+    scheduler = ""        # a Dask scheduler address ("tcp://host:8786") for grid search and benchmark
 
-    [data]            # simulate (plant, moves) or ingest logs
+    [data]                # simulate on a plant, or ingest logs (train_logs / test_logs)
     plant = "lab"
     train_moves = 40
     test_moves = 15
+    micro_moves = 10      # the thesis' small real sample that synthesis grows (0: none)
+    sim_moves = 40        # the thesis' simulated dataset, on the nominal "sim" plant (0: none)
+
+    [synth]               # optional: grow synthetic rows from a small real sample
+    methods = ["copula", "tvae"]
+    rows = 3000
 
     [train]
     families = ["mlp", "svr", "par", "xgb"]
     targets = ["E"]
     grid = "quick"
-    cv = 3
-    inputs = "physics"
+
+    [importance]
+    targets = ["E", "E1", "E2", "E3", "E4", "E5", "E6"]
 
     [optimize]
     tasks = 3
     algorithm = "ma-informed"
     fitness = "surrogate"
-    generations = 100
-    population = 100
 
-A wrong key or value stops the run at once with the key, the allowed keys or values,
-and the file.
+    [bench]               # optional: every GA/DE/MA configuration on the same random tasks
+    tasks = 3
+    generations = 30
+
+Sections left out take their defaults; ``[synth]`` and ``[bench]`` are skipped unless
+they are given (``methods`` non-empty, ``tasks`` ≥ 1). A wrong key or value stops the
+run at once with the file, the section and key, and the allowed keys or values.
 """
 
 from __future__ import annotations
@@ -39,16 +50,37 @@ from typing import Any
 
 from joulepath.errors import InvalidInput
 
+ALL_TARGETS = ("E", "E1", "E2", "E3", "E4", "E5", "E6")
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class DataStage:
-    """Where the data comes from: a simulated plant, or controller/generic logs."""
+    """Where the data comes from: a simulated plant, or controller/generic logs.
+
+    ``train`` plays the thesis' real 1000-move dataset, ``test`` its 100 other moves,
+    ``micro`` its small real sample (the synthesizers' source) and ``sim`` its
+    simulated dataset (nominal model, no plant error).
+    """
 
     plant: str = "lab"
     train_moves: int = 40
     test_moves: int = 15
+    micro_moves: int = 0
+    sim_moves: int = 0
     train_logs: tuple[str, ...] = ()
     test_logs: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SynthStage:
+    """Synthetic rows grown from ``source`` by each method, scored against real data."""
+
+    methods: tuple[str, ...] = ()
+    rows: int = 5000
+    epochs: int = 100
+    batch_size: int = 500
+    source: str = "micro"
+    repair: bool = False
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -58,8 +90,14 @@ class TrainStage:
     grid: str = "quick"
     cv: int = 3
     inputs: str = "physics"
-    jobs: int = 1
-    scheduler: str = ""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ImportanceStage:
+    """Feature importance by five methods for each target (thesis Figs 4.1–4.2)."""
+
+    targets: tuple[str, ...] = ALL_TARGETS
+    max_rows: int = 3000
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -73,29 +111,62 @@ class OptimizeStage:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class BenchStage:
+    """Optimizer benchmark (thesis Tables 4.5–4.6, Fig 4.19); off while ``tasks`` is 0."""
+
+    tasks: int = 0
+    generations: int = 250
+    population: int = 100
+    fitness: str = "physics"
+    configurations: str = "thesis"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Experiment:
-    """A whole study: data -> models -> optimized moves."""
+    """A whole study: data -> synthetic data -> models -> importance -> optimized moves -> benchmark."""
 
     name: str
     robot: str = "irb120"
     seed: int = 0
+    jobs: int = 1
+    scheduler: str = ""
     data: DataStage = field(default_factory=DataStage)
+    synth: SynthStage = field(default_factory=SynthStage)
     train: TrainStage = field(default_factory=TrainStage)
+    importance: ImportanceStage = field(default_factory=ImportanceStage)
     optimize: OptimizeStage = field(default_factory=OptimizeStage)
+    bench: BenchStage = field(default_factory=BenchStage)
     source: str = ""
 
 
-_ALLOWED = {
+SECTIONS: dict[str, type] = {
+    "data": DataStage,
+    "synth": SynthStage,
+    "train": TrainStage,
+    "importance": ImportanceStage,
+    "optimize": OptimizeStage,
+    "bench": BenchStage,
+}
+
+_ALLOWED: dict[str, tuple[str, ...]] = {
     "plant": ("sim", "lab"),
     "grid": ("quick", "thesis"),
     "inputs": ("physics", "thesis"),
     "algorithm": ("ga", "de", "ma-random", "ma-informed"),
     "fitness": ("surrogate", "surrogate-joints", "physics"),
+    "source": ("micro", "train"),
+    "configurations": ("thesis", "compact"),
+    "methods": ("copula", "copulagan", "ctgan", "tvae"),
+    "families": ("mlp", "svr", "par", "xgb"),
+    "targets": ALL_TARGETS,
 }
+_MAY_BE_ZERO = {"seed", "micro_moves", "sim_moves", "tasks"}
+_TYPE_NAMES = {int: "an integer", str: "a string", bool: "true or false", float: "a number"}
 
 
 def _section(cls: Any, raw: dict[str, Any], where: str, source: str) -> Any:
-    names = {f.name: f for f in fields(cls) if f.name not in ("data", "train", "optimize", "source")}
+    hidden = {*SECTIONS, "source"} if cls is Experiment else set()
+    names = {f.name: f for f in fields(cls) if f.name not in hidden}
     kwargs: dict[str, Any] = {}
     for key, value in raw.items():
         if key not in names:
@@ -103,20 +174,64 @@ def _section(cls: Any, raw: dict[str, Any], where: str, source: str) -> Any:
         default = names[key].default
         if key == "name":
             default = ""
+        allowed = _ALLOWED.get(key)
         if isinstance(default, tuple):
             if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-                raise InvalidInput(f"{source}: {where}{key} must be a list of strings, got {value!r}")
+                raise InvalidInput(
+                    f"{source}: {where}{key} must be a list of strings, got {value!r}; "
+                    f'write it as {key} = ["…", "…"]'
+                )
+            bad = [v for v in value if allowed and v not in allowed]
+            if bad:
+                raise InvalidInput(
+                    f"{source}: {where}{key} has {bad[0]!r}, which is not allowed; "
+                    f"use some of {', '.join(allowed or ())}"
+                )
             value = tuple(value)
-        elif isinstance(default, bool) or not isinstance(value, type(default)):
-            raise InvalidInput(f"{source}: {where}{key} must be a {type(default).__name__}, got {value!r}")
-        if key in _ALLOWED and value not in _ALLOWED[key]:
+        elif type(value) is not type(default):
             raise InvalidInput(
-                f"{source}: {where}{key} = {value!r} is not allowed; use one of {', '.join(_ALLOWED[key])}"
+                f"{source}: {where}{key} must be {_TYPE_NAMES.get(type(default), type(default).__name__)}, "
+                f"got {value!r}"
             )
-        if isinstance(value, int) and value < (0 if key == "seed" else 1) and key not in ("seed",):
-            raise InvalidInput(f"{source}: {where}{key} must be ≥ 1, got {value}")
+        elif allowed and value not in allowed:
+            raise InvalidInput(
+                f"{source}: {where}{key} = {value!r} is not allowed; use one of {', '.join(allowed)}"
+            )
+        elif isinstance(value, int) and not isinstance(value, bool):
+            low = 0 if key in _MAY_BE_ZERO else 2 if key == "cv" else 1
+            if value < low:
+                raise InvalidInput(f"{source}: {where}{key} must be ≥ {low}, got {value}")
         kwargs[key] = value
     return cls(**kwargs)
+
+
+def _check_together(exp: Experiment, source: str) -> None:
+    """Settings that are valid alone but not together."""
+    d, s, t, o = exp.data, exp.synth, exp.train, exp.optimize
+    if bool(d.train_logs) != bool(d.test_logs):
+        raise InvalidInput(
+            f"{source}: [data] give both train_logs and test_logs (other moves), or neither to simulate"
+        )
+    if s.methods and s.source == "micro" and d.micro_moves == 0:
+        raise InvalidInput(
+            f"{source}: [synth] source = 'micro' needs [data] micro_moves ≥ 1; "
+            "set micro_moves, or source = 'train'"
+        )
+    if s.methods and s.source == "micro" and d.train_logs:
+        raise InvalidInput(f"{source}: [synth] source = 'micro' simulates its sample; with logs use 'train'")
+    if s.methods and s.rows < 20:
+        raise InvalidInput(f"{source}: [synth] rows must be ≥ 20 to score the rows, got {s.rows}")
+    needs = {"surrogate": ("E",), "surrogate-joints": ALL_TARGETS[1:]}
+    for where, fitness in (("[optimize]", o.fitness), ("[bench]", exp.bench.fitness)):
+        if where == "[bench]" and exp.bench.tasks == 0:
+            continue
+        missing = [x for x in needs.get(fitness, ()) if x not in t.targets]
+        if missing or (fitness in needs and not t.families):
+            raise InvalidInput(
+                f"{source}: {where} fitness = {fitness!r} needs models of "
+                f"{', '.join(needs[fitness])}; add them to [train] targets (and a family), "
+                "or use fitness = 'physics'"
+            )
 
 
 def load_experiment(path: str | os.PathLike[str]) -> Experiment:
@@ -126,30 +241,78 @@ def load_experiment(path: str | os.PathLike[str]) -> Experiment:
     ------
     InvalidInput
         Unreadable TOML, an unknown section or key, a value of the wrong type or
-        outside its allowed values.
+        outside its allowed values, or settings that contradict each other.
     """
     p = Path(path)
     source = str(p)
     try:
         raw = tomllib.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError as err:
+        raise InvalidInput(
+            f"{source}: no such experiment file; give a path to a TOML file, or 'demo'"
+        ) from err
     except OSError as err:
         raise InvalidInput(f"{source}: cannot be read ({err.strerror})") from err
+    except UnicodeDecodeError as err:
+        raise InvalidInput(f"{source}: not UTF-8 text ({err.reason}); save it as UTF-8") from err
     except tomllib.TOMLDecodeError as err:
-        raise InvalidInput(f"{source}: not valid TOML ({err})") from err
+        raise InvalidInput(f"{source}: not valid TOML ({err}); fix the syntax there") from err
     top = {k: v for k, v in raw.items() if not isinstance(v, dict)}
     sections = {k: v for k, v in raw.items() if isinstance(v, dict)}
-    unknown = sorted(set(sections) - {"data", "train", "optimize"})
+    unknown = sorted(set(sections) - set(SECTIONS))
     if unknown:
-        raise InvalidInput(f"{source}: unknown section [{unknown[0]}]; allowed: [data], [train], [optimize]")
+        raise InvalidInput(
+            f"{source}: unknown section [{unknown[0]}]; allowed: {', '.join(f'[{s}]' for s in SECTIONS)}"
+        )
     if "name" not in top:
-        raise InvalidInput(f"{source}: missing key 'name' at the top of the file")
+        raise InvalidInput(f"{source}: missing key 'name' at the top of the file; add name = \"my-study\"")
     exp = _section(Experiment, top, "", source)
-    return Experiment(
+    if not exp.name or any(c in exp.name for c in '/\\:*?"<>|'):
+        raise InvalidInput(f"{source}: name {exp.name!r} must be a non-empty folder name without / \\ : * ?")
+    parts = {
+        name: _section(cls, sections.get(name, {}), f"[{name}] ", source) for name, cls in SECTIONS.items()
+    }
+    exp = Experiment(
         name=exp.name,
         robot=exp.robot,
         seed=exp.seed,
+        jobs=exp.jobs,
+        scheduler=exp.scheduler,
         source=source,
-        data=_section(DataStage, sections.get("data", {}), "[data] ", source),
-        train=_section(TrainStage, sections.get("train", {}), "[train] ", source),
-        optimize=_section(OptimizeStage, sections.get("optimize", {}), "[optimize] ", source),
+        **parts,
     )
+    base = p.resolve().parent
+    data = exp.data
+    for key in ("train_logs", "test_logs"):
+        for log in getattr(data, key):
+            log_path = Path(log) if Path(log).is_absolute() else base / log
+            if not log_path.is_file():
+                raise InvalidInput(
+                    f"{source}: [data] {key} names {log!r}, which does not exist "
+                    f"(paths are relative to the experiment file's folder)"
+                )
+    _check_together(exp, source)
+    _check_robot(exp, source)
+    return exp
+
+
+def _check_robot(exp: Experiment, source: str) -> None:
+    from joulepath.dynamics import load_robot
+    from joulepath.errors import JoulepathError
+
+    try:
+        robot = load_robot(exp.robot)
+    except JoulepathError as err:
+        raise InvalidInput(f"{source}: robot = {exp.robot!r}: {err}") from err
+    names = robot.range_set_names
+    if exp.optimize.range_set not in names:
+        raise InvalidInput(
+            f"{source}: [optimize] range_set = {exp.optimize.range_set!r} is not a range set of "
+            f"{robot.name}; use one of {', '.join(names)}"
+        )
+
+
+def resolve_logs(exp: Experiment, logs: tuple[str, ...]) -> list[str]:
+    """Log paths of ``exp`` made absolute, relative to the experiment file's folder."""
+    base = Path(exp.source).resolve().parent if exp.source else Path.cwd()
+    return [str(Path(p) if Path(p).is_absolute() else base / p) for p in logs]

@@ -1,9 +1,15 @@
 """Run an experiment stage by stage, skipping stages whose inputs and settings have not changed.
 
-Each stage writes its outputs under the run folder, then a ``stage.json`` holding a
-hash of its settings and of the stages it reads. A stage whose ``stage.json`` holds
-the same hash is skipped; an interrupted stage has no ``stage.json`` (it is written
-last) and runs again. Every file is written atomically.
+Stages, each in its own folder of the run: ``data`` (simulate on a plant or ingest
+logs), ``synth`` (optional), ``models`` (train), ``importance``, ``optimize``,
+``bench`` (optional); then ``report.html`` is rendered from what they wrote.
+
+Each stage writes its outputs, then a ``stage.json`` holding a hash of its settings
+and of the stages it reads. A stage whose ``stage.json`` holds the same hash is
+skipped. ``stage.json`` is removed when a stage starts and written last, so an
+interrupted stage runs again. Every file is written atomically (temporary file, then
+rename); the grid search keeps a per-candidate cache, so an interrupted training
+resumes where it stopped.
 """
 
 from __future__ import annotations
@@ -11,9 +17,10 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import time
 from collections.abc import Callable
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +28,19 @@ import numpy as np
 import pandas as pd
 
 from joulepath._io import atomic_write_text
-from joulepath.experiment._config import Experiment
+from joulepath.experiment._config import Experiment, resolve_logs
+
+Progress = Callable[[str, int, int], None]
+"""``progress(label, done, total)``: called as a long stage advances."""
+
+COMPACT_CONFIGURATIONS = (
+    "GA random P(C)=0.95 P(M)=0.05",
+    "GA average P(C)=0.9 P(M)=0.05",
+    "GA differential P(C)=0.95 P(M)=0.05 F=0.05",
+    "DE rand/1/bin",
+    "MA random local search",
+    "MA informed local search",
+)
 
 
 def _hash(*parts: Any) -> str:
@@ -32,79 +51,331 @@ def _file_hash(path: str) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def _cached(folder: Path, key: str) -> bool:
-    marker = folder / "stage.json"
-    return marker.exists() and json.loads(marker.read_text()).get("key") == key
+@dataclass(frozen=True, slots=True)
+class _Context:
+    exp: Experiment
+    root: Path
+    tell: Callable[[str], None]
+    progress: Progress
 
 
-def _done(folder: Path, key: str, started: float, extra: dict[str, Any]) -> None:
-    atomic_write_text(
-        folder / "stage.json", json.dumps({"key": key, "wall_s": time.perf_counter() - started, **extra})
-    )
+def _stage(
+    ctx: _Context, name: str, folder: str, key: str, body: Callable[[Path], dict[str, Any]]
+) -> dict[str, Any]:
+    """Run ``body(folder)`` unless the folder's ``stage.json`` holds ``key``; return its record."""
+    path = ctx.root / folder
+    marker = path / "stage.json"
+    if marker.exists():
+        record: dict[str, Any] = json.loads(marker.read_text(encoding="utf-8"))
+        if record.get("key") == key:
+            ctx.tell(f"{name}: unchanged, skipped")
+            return record
+        marker.unlink()
+    path.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    extra = body(path)
+    record = {"key": key, "stage": name, "wall_s": round(time.perf_counter() - t0, 3), **extra}
+    atomic_write_text(marker, json.dumps(record, indent=2, default=str))
+    ctx.tell(f"{name}: done in {record['wall_s']:.1f} s")
+    return record
 
 
 def run_experiment(
-    exp: Experiment, out: str | os.PathLike[str], *, say: Callable[[str], None] = print
+    exp: Experiment,
+    out: str | os.PathLike[str],
+    *,
+    say: Callable[[str], None] = print,
+    progress: Progress | None = None,
+    scheduler: str | None = None,
 ) -> dict[str, Any]:
-    """Run data -> train -> optimize for ``exp`` into ``out``; returns a summary dict."""
-    from joulepath.data import ingest, load_table, save_table
-    from joulepath.dynamics import load_robot
-    from joulepath.learn import TrainConfig, best_model, train
-    from joulepath.optimize import OptimizeConfig, optimize_move, random_tasks, write_run
-    from joulepath.sim import simulate
+    """Run every stage of ``exp`` into the folder ``out``; returns the summary (``summary.json``).
+
+    Parameters
+    ----------
+    exp : Experiment
+        From :func:`joulepath.experiment.load_experiment`.
+    out : path
+        The run folder. Running again into the same folder skips unchanged stages.
+    say : callable
+        Receives one line per event (also appended to ``<out>/run.log``).
+    progress : callable, optional
+        ``progress(label, done, total)`` as long stages advance (progress bars).
+    scheduler : str, optional
+        Dask scheduler address overriding the file's ``scheduler`` (grid search, benchmark).
+    """
+    from joulepath.report import render_report
 
     root = Path(out)
     root.mkdir(parents=True, exist_ok=True)
-    log_lines: list[str] = []
 
     def tell(text: str) -> None:
-        log_lines.append(text)
         with (root / "run.log").open("a", encoding="utf-8") as fh:
             fh.write(time.strftime("%Y-%m-%d %H:%M:%S ") + text + "\n")
         say(text)
 
-    robot = load_robot(exp.robot)
-    summary: dict[str, Any] = {"name": exp.name, "source": exp.source, "stages": {}}
-    # -- data
-    d = exp.data
-    logs = [_file_hash(p) for p in (*d.train_logs, *d.test_logs)]
-    data_key = _hash("data", exp.robot, exp.seed, asdict(d), logs)
-    data_dir = root / "data"
-    if _cached(data_dir, data_key):
-        tell("data: unchanged, skipped")
-    else:
-        t0 = time.perf_counter()
-        data_dir.mkdir(parents=True, exist_ok=True)
-        children = np.random.SeedSequence(exp.seed).spawn(2)
-        for name, n, given, seed in (
-            ("train", d.train_moves, d.train_logs, children[0]),
-            ("test", d.test_moves, d.test_logs, children[1]),
-        ):
-            paths = list(given) or [
-                str(
-                    simulate(
-                        data_dir / "logs" / f"{name}.csv",
-                        plant=d.plant,
-                        n_moves=n,
-                        seed=seed,
-                        robot=exp.robot,
-                    ).log
+    if scheduler:
+        from dataclasses import replace
+
+        exp = replace(exp, scheduler=scheduler)
+    ctx = _Context(exp, root, tell, progress or (lambda _l, _d, _t: None))
+    tell(f"run {exp.name} ({exp.source or 'in memory'}) into {root}")
+    t_start = time.perf_counter()
+    stages: dict[str, dict[str, Any]] = {}
+    stages["data"] = _data_stage(ctx)
+    keys = {"data": stages["data"]["key"]}
+    if exp.synth.methods:
+        stages["synth"] = _synth_stage(ctx, keys["data"])
+    if exp.train.families:
+        stages["train"] = _train_stage(ctx, keys["data"])
+    stages["importance"] = _importance_stage(ctx, keys["data"])
+    model_key = stages["train"]["key"] if "train" in stages else ""
+    stages["optimize"] = _optimize_stage(ctx, model_key, stages["importance"]["key"])
+    if exp.bench.tasks:
+        stages["bench"] = _bench_stage(ctx, model_key, stages["importance"]["key"])
+    tasks = pd.read_csv(root / "optimize" / "tasks.csv")
+    ok = tasks[tasks["limits_ok"].astype(bool)] if len(tasks) else tasks
+    summary: dict[str, Any] = {
+        "name": exp.name,
+        "source": exp.source,
+        "robot": exp.robot,
+        "seed": exp.seed,
+        "experiment": asdict(exp),
+        "stages": stages,
+        "mean_saved_pct": float(ok["saved_pct"].mean()) if len(ok) else None,
+        "mean_saved_lab_pct": float(ok["saved_lab_pct"].mean()) if len(ok) else None,
+        "tasks_within_limits": int(len(ok)),
+        "tasks": int(len(tasks)),
+        "wall_s": round(time.perf_counter() - t_start, 3),
+    }
+    atomic_write_text(root / "summary.json", json.dumps(summary, indent=2, default=str))
+    report = render_report(root)
+    summary["report"] = str(report)
+    saved = summary["mean_saved_pct"]
+    tell(
+        (
+            f"done: mean saving {saved:.1f} % on physics at equal cycle time "
+            if saved is not None
+            else "done: "
+        )
+        + f"({summary['tasks_within_limits']}/{summary['tasks']} tasks within the limits); "
+        f"report: {report}"
+    )
+    return summary
+
+
+# ----------------------------------------------------------------------------- data
+def _data_stage(ctx: _Context) -> dict[str, Any]:
+    from joulepath.data import ingest, save_table
+    from joulepath.dynamics import load_robot
+    from joulepath.sim import simulate
+
+    exp, d = ctx.exp, ctx.exp.data
+    logs = {
+        "train": resolve_logs(exp, d.train_logs),
+        "test": resolve_logs(exp, d.test_logs),
+    }
+    key = _hash(
+        "data", exp.robot, exp.seed, asdict(d), [_file_hash(p) for p in (*logs["train"], *logs["test"])]
+    )
+
+    def body(folder: Path) -> dict[str, Any]:
+        robot = load_robot(exp.robot)
+        children = np.random.SeedSequence(exp.seed).spawn(4)
+        plan = [
+            ("train", d.train_moves, d.plant, children[0]),
+            ("test", d.test_moves, d.plant, children[1]),
+            ("micro", d.micro_moves, d.plant, children[2]),
+            ("sim", d.sim_moves, "sim", children[3]),
+        ]
+        sets: dict[str, Any] = {}
+        for k, (name, n, plant, seed) in enumerate(plan):
+            ctx.progress("data", k, len(plan))
+            if name in logs and logs[name]:
+                paths, origin = logs[name], "logs"
+            elif n:
+                sim = simulate(
+                    folder / "logs" / f"{name}.csv", plant=plant, n_moves=n, seed=seed, robot=exp.robot
                 )
-            ]
+                paths, origin = [str(sim.log)], f"simulated on the {plant} plant"
+            else:
+                (folder / f"{name}.parquet").unlink(missing_ok=True)
+                continue
             table = ingest(paths, robot=robot)
-            save_table(table, data_dir / f"{name}.parquet")
-            tell(f"data: {name} {len(table.frame):,} rows, {table.n_moves} moves")
-        _done(data_dir, data_key, t0, {})
-    train_table, test_table = load_table(data_dir / "train.parquet"), load_table(data_dir / "test.parquet")
-    # -- train
-    t = exp.train
-    train_key = _hash("train", data_key, asdict(t), exp.seed)
-    model_dir = root / "models"
-    if t.families and not _cached(model_dir, train_key):
-        t0 = time.perf_counter()
+            save_table(table, folder / f"{name}.parquet")
+            sets[name] = {"rows": len(table.frame), "moves": table.n_moves, "origin": origin}
+            ctx.tell(f"data: {name} {len(table.frame):,} rows, {table.n_moves} moves ({origin})")
+        ctx.progress("data", len(plan), len(plan))
+        return {"datasets": sets}
+
+    return _stage(ctx, "data", "data", key, body)
+
+
+def _table(ctx: _Context, name: str) -> Any:
+    from joulepath.data import load_table
+
+    return load_table(ctx.root / "data" / f"{name}.parquet")
+
+
+# ----------------------------------------------------------------------------- synth
+def _synth_stage(ctx: _Context, data_key: str) -> dict[str, Any]:
+    exp, s = ctx.exp, ctx.exp.synth
+    key = _hash("synth", data_key, asdict(s), exp.seed)
+
+    def body(folder: Path) -> dict[str, Any]:
+        from joulepath.data import save_table
+        from joulepath.dynamics import load_robot
+        from joulepath.synth import (
+            SynthConfig,
+            Synthesizer,
+            compare,
+            kinematic_consistency,
+            quality_report,
+            repair_kinematics,
+            utility,
+        )
+
+        robot = load_robot(exp.robot)
+        source = _table(ctx, s.source)
+        train, test = _table(ctx, "train"), _table(ctx, "test")
+        rows: list[dict[str, Any]] = []
+        tables: dict[str, Any] = {}
+        for k, method in enumerate(s.methods):
+            ctx.progress("synth", k, len(s.methods))
+            t0 = time.perf_counter()
+            cfg = SynthConfig(method=method, epochs=s.epochs, batch_size=s.batch_size, seed=exp.seed)
+            table = Synthesizer(cfg).fit(source).sample(s.rows)
+            fit_s = time.perf_counter() - t0
+            consistent_raw = kinematic_consistency(table, robot) if table.feature_set == "full40" else None
+            if s.repair:
+                table = repair_kinematics(table, robot)
+            save_table(table, folder / f"{method}.parquet")
+            quality = quality_report(source, table)
+            use = utility(table, test, seed=exp.seed)
+            tables[method] = table
+            rows.append(
+                {
+                    "method": method,
+                    "rows": len(table.frame),
+                    "column_shapes": quality["column_shapes"],
+                    "column_pair_trends": quality["column_pair_trends"],
+                    "overall": quality["overall"],
+                    "utility_test_r2": use.r2,
+                    "utility_test_mae": use.mae,
+                    "tcp_consistent_share": consistent_raw,
+                    "repaired": s.repair,
+                    "wall_s": fit_s,
+                }
+            )
+            ctx.tell(
+                f"synth: {method}: column shapes {quality['column_shapes']:.3f}, pair trends "
+                f"{quality['column_pair_trends']:.3f}, train-on-synthetic test R² {use.r2:.3f}"
+            )
+        ctx.progress("synth", len(s.methods), len(s.methods))
+        baselines = []
+        for name in ("train", "micro", "sim"):
+            if (ctx.root / "data" / f"{name}.parquet").exists():
+                use = utility(_table(ctx, name), test, seed=exp.seed)
+                baselines.append({"train_on": name, "test_r2": use.r2, "test_mae": use.mae})
+        scores = pd.DataFrame(rows)
+        atomic_write_text(folder / "scores.csv", scores.to_csv(index=False))
+        atomic_write_text(folder / "utility_baselines.csv", pd.DataFrame(baselines).to_csv(index=False))
+        best = str(scores.sort_values("column_shapes", ascending=False)["method"].iloc[0])
+        shown: dict[str, Any] = {"real (train)": train}
+        if (ctx.root / "data" / "sim.parquet").exists():
+            shown["simulated"] = _table(ctx, "sim")
+        shown[f"synthetic ({best})"] = tables[best]
+        comparison = compare(shown, out_dir=folder / "plots")
+        atomic_write_text(folder / "statistics.csv", comparison.statistics.to_csv())
+        _plot_quality(scores, folder / "quality.png")
+        _plot_statistics(comparison.statistics, folder / "statistics.png")
+        return {"best_method": best}
+
+    return _stage(ctx, "synth", "synth", key, body)
+
+
+def _plot_quality(scores: pd.DataFrame, path: Path) -> None:
+    """Quality and utility per method (thesis Fig 4.3)."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8, 3.5))
+    ax1, ax2 = fig.subplots(1, 2)
+    x = np.arange(len(scores))
+    ax1.bar(x - 0.2, scores["column_shapes"], 0.4, label="column shapes")
+    ax1.bar(x + 0.2, scores["column_pair_trends"], 0.4, label="column pair trends")
+    ax1.set_xticks(x, scores["method"])
+    ax1.set_ylim(0, 1)
+    ax1.set_title("SDMetrics quality")
+    ax1.legend(fontsize="small", loc="lower right")
+    ax2.bar(x, scores["utility_test_r2"].clip(lower=-0.2), color="tab:green")
+    ax2.set_xticks(x, scores["method"])
+    ax2.set_ylim(-0.2, 1)
+    ax2.set_title("train on synthetic, test on real: R²(E)")
+    fig.tight_layout()
+    _save(fig, path)
+
+
+def _plot_statistics(stats: pd.DataFrame, path: Path) -> None:
+    """Each table's statistics relative to the real table's, per column (thesis Fig 4.10)."""
+    from matplotlib.figure import Figure
+
+    tables = list(dict.fromkeys(stats.index.get_level_values("table")))
+    columns = list(dict.fromkeys(stats.index.get_level_values("column")))
+    names = [c for c in ("mean", "std", "min", "max") if c in stats.columns]
+    fig = Figure(figsize=(11, 2.3 * len(names)))
+    axes = fig.subplots(len(names), 1, squeeze=False)[:, 0]
+    real = tables[0]
+    scale = stats.xs(real, level="table")["std"].replace(0, 1.0).abs()
+    markers = ["o", "+", "x", "s"]
+    for ax, stat in zip(axes, names, strict=True):
+        for m, name in enumerate(tables):
+            values = stats.xs(name, level="table")[stat].reindex(columns)
+            ref = stats.xs(real, level="table")[stat].reindex(columns)
+            ax.plot(
+                np.arange(len(columns)),
+                (values - ref) / scale.reindex(columns),
+                markers[m % 4],
+                label=name,
+                ms=4,
+            )
+        ax.axhline(0, color="k", lw=0.5)
+        ax.set_ylabel(f"Δ{stat} / σ(real)", fontsize=8)
+    axes[-1].set_xticks(np.arange(len(columns)), columns, rotation=90, fontsize=6)
+    for ax in axes[:-1]:
+        ax.set_xticks([])
+    axes[0].legend(fontsize="small", ncol=len(tables))
+    fig.tight_layout()
+    _save(fig, path)
+
+
+def _save(fig: Any, path: Path) -> None:
+    import io
+
+    from joulepath._io import atomic_write_bytes
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100)
+    atomic_write_bytes(path, buf.getvalue())
+
+
+# ----------------------------------------------------------------------------- train
+_CANDIDATES = re.compile(r"^(\S+) (\S+): (\d+)/(\d+) candidates$")
+
+
+def _train_stage(ctx: _Context, data_key: str) -> dict[str, Any]:
+    exp, t = ctx.exp, ctx.exp.train
+    key = _hash("train", data_key, asdict(t), exp.seed)
+
+    def body(folder: Path) -> dict[str, Any]:
+        from joulepath.learn import TrainConfig, train
+
+        def progress(message: str) -> None:
+            m = _CANDIDATES.match(message)
+            if m:
+                ctx.progress(f"train {m[1]} {m[2]}", int(m[3]), int(m[4]))
+
         report = train(
-            train_table,
-            test_table,
+            _table(ctx, "train"),
+            _table(ctx, "test"),
             TrainConfig(
                 families=t.families,
                 targets=t.targets,
@@ -112,39 +383,164 @@ def run_experiment(
                 cv=t.cv,
                 inputs=t.inputs,
                 seed=exp.seed,
-                n_jobs=t.jobs,
-                scheduler=t.scheduler or None,
+                n_jobs=exp.jobs,
+                scheduler=exp.scheduler or None,
                 robot=exp.robot,
             ),
-            model_dir,
-            progress=lambda m: None,
+            folder,
+            progress=progress,
         )
         for r in report.results.itertuples():
-            tell(
+            ctx.tell(
                 f"train: {r.family} {r.target}: grouped CV R² {r.cv_grouped_r2:.4f}, test R² {r.test_r2:.4f}"
             )
-        _done(model_dir, train_key, t0, {})
-    else:
-        tell("train: unchanged, skipped")
-    # -- optimize
-    o = exp.optimize
-    opt_key = _hash("optimize", train_key, asdict(o), exp.seed)
-    opt_dir = root / "optimize"
-    if _cached(opt_dir, opt_key):
-        tell("optimize: unchanged, skipped")
-    else:
-        t0 = time.perf_counter()
-        models: tuple[Any, ...] = ()
-        if o.fitness == "surrogate":
-            models = (best_model(model_dir, "E"),)
-        elif o.fitness == "surrogate-joints":
-            models = tuple(best_model(model_dir, f"E{i}") for i in range(1, 7))
-        joints = None
-        jf = model_dir / "joints.json"
-        if jf.exists():
-            joints = tuple(json.loads(jf.read_text())["joints_by_influence"])
+        if "E" in t.targets:
+            _compare_with_physics(ctx, folder)
+        return {}
+
+    return _stage(ctx, "train", "models", key, body)
+
+
+def _compare_with_physics(ctx: _Context, folder: Path) -> None:
+    """The best model of E against the analytical model on a section of the test data (Fig 4.18),
+    and both models' prediction times (thesis §4.4)."""
+    from matplotlib.figure import Figure
+
+    from joulepath.data import EnergyTable
+    from joulepath.dynamics import NOMINAL_FRICTION, load_robot
+    from joulepath.learn import best_model, physics_predict
+
+    robot = load_robot(ctx.exp.robot)
+    test = _table(ctx, "test")
+    model = best_model(folder, "E")
+    frame = test.frame
+    section = EnergyTable(frame=frame.iloc[: min(len(frame), 480)], feature_set=test.feature_set)
+    measured = section.frame["E"].to_numpy()
+    learned = model.predict(section.frame)
+    physics = physics_predict(section, robot, friction=NOMINAL_FRICTION)["E"]
+    fig = Figure(figsize=(10, 3.4))
+    ax = fig.subplots()
+    ax.plot(measured, "k-", lw=1.2, label="measured")
+    ax.plot(learned, "-", lw=0.9, label=f"learned ({model.family})")
+    ax.plot(physics, "--", lw=0.9, label="dynamics model + nominal friction")
+    ax.set_xlabel("test row (25 ms each)")
+    ax.set_ylabel("E per row (J)")
+    ax.legend(fontsize="small")
+    fig.tight_layout()
+    _save(fig, folder / "comparison.png")
+
+    def timed(fn: Callable[[], Any], repeat: int) -> float:
+        best = float("inf")
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            fn()
+            best = min(best, time.perf_counter() - t0)
+        return best
+
+    one = EnergyTable(frame=frame.iloc[:1], feature_set=test.feature_set)
+    size = sum(p.stat().st_size for p in (folder / f"{model.family}-E").iterdir() if p.is_file())
+    latency = {
+        "model": f"{model.family}-E",
+        "rows": len(frame),
+        "learned_batch_per_row_s": timed(lambda: model.predict(frame), 3) / len(frame),
+        "learned_single_s": timed(lambda: model.predict(one.frame), 20),
+        "learned_size_bytes": size,
+        "physics_batch_per_row_s": timed(lambda: physics_predict(test, robot, friction=NOMINAL_FRICTION), 3)
+        / len(frame),
+        "physics_single_s": timed(lambda: physics_predict(one, robot, friction=NOMINAL_FRICTION), 20),
+    }
+    atomic_write_text(folder / "latency.json", json.dumps(latency, indent=2))
+
+
+# ----------------------------------------------------------------------------- importance
+def _importance_stage(ctx: _Context, data_key: str) -> dict[str, Any]:
+    exp, imp = ctx.exp, ctx.exp.importance
+    key = _hash("importance", data_key, asdict(imp), exp.seed)
+
+    def body(folder: Path) -> dict[str, Any]:
+        from joulepath.learn import feature_importance, plot_importance, rank_joints
+
+        table = _table(ctx, "train")
+        targets = [x for x in imp.targets if x in table.frame.columns]
+        means: dict[str, pd.Series] = {}
+        first: pd.DataFrame | None = None
+        for k, target in enumerate(targets):
+            ctx.progress("importance", k, len(targets))
+            result = feature_importance(table, target, max_rows=imp.max_rows, seed=exp.seed)
+            atomic_write_text(folder / f"importance_{target}.csv", result.to_csv())
+            means[target] = result["mean"]
+            if first is None or target == "E":
+                first = result
+        ctx.progress("importance", len(targets), len(targets))
+        assert first is not None
+        ranked_on = "E" if "E" in means else targets[0]
+        plot_importance(
+            first, folder / f"importance_{ranked_on}.png", title=f"Feature importance for {ranked_on}"
+        )
+        joints = rank_joints(first)
+        atomic_write_text(
+            folder / "joints.json", json.dumps({"target": ranked_on, "joints_by_influence": joints})
+        )
+        _plot_heatmap(pd.DataFrame(means), folder / "heatmap.png")
+        ctx.tell(f"importance: joints by influence on {ranked_on}: {joints}")
+        return {"joints_by_influence": joints}
+
+    return _stage(ctx, "importance", "importance", key, body)
+
+
+def _plot_heatmap(means: pd.DataFrame, path: Path) -> None:
+    """Mean importance of every input (rows) for every target (columns) (thesis Figs 4.1–4.2)."""
+    from matplotlib.figure import Figure
+
+    order = means.mean(axis=1).sort_values(ascending=False).index
+    data = means.loc[order]
+    fig = Figure(figsize=(1.2 + 0.7 * data.shape[1], max(4.0, 0.2 * len(data))))
+    ax = fig.subplots()
+    image = ax.imshow(data.to_numpy(), aspect="auto", cmap="viridis")
+    ax.set_xticks(np.arange(data.shape[1]), data.columns)
+    ax.set_yticks(np.arange(len(data)), data.index, fontsize=7)
+    ax.set_title("feature importance (mean of 5 methods)")
+    fig.colorbar(image, ax=ax, fraction=0.05)
+    fig.tight_layout()
+    _save(fig, path)
+
+
+# ----------------------------------------------------------------------------- optimize
+def _models_for(ctx: _Context, fitness: str) -> tuple[Any, ...]:
+    from joulepath.learn import best_model
+
+    if fitness == "surrogate":
+        return (best_model(ctx.root / "models", "E"),)
+    if fitness == "surrogate-joints":
+        return tuple(best_model(ctx.root / "models", f"E{i}") for i in range(1, 7))
+    return ()
+
+
+def _joints(ctx: _Context) -> tuple[int, ...]:
+    data = json.loads((ctx.root / "importance" / "joints.json").read_text(encoding="utf-8"))
+    return tuple(data["joints_by_influence"])
+
+
+def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str, Any]:
+    exp, o = ctx.exp, ctx.exp.optimize
+    uses_models = o.fitness != "physics"
+    key = _hash("optimize", model_key if uses_models else "", importance_key, exp.robot, asdict(o), exp.seed)
+
+    def body(folder: Path) -> dict[str, Any]:
+        import shutil
+
+        from joulepath.dynamics import load_robot
+        from joulepath.optimize import OptimizeConfig, optimize_move, random_tasks, write_run
+
+        for old in folder.glob("task-*"):
+            shutil.rmtree(old)
+        robot = load_robot(exp.robot)
+        models = _models_for(ctx, o.fitness)
+        joints = _joints(ctx)
         rows = []
-        for k, (q0, qf, T) in enumerate(random_tasks(robot, o.tasks, seed=exp.seed, range_set=o.range_set)):
+        tasks = random_tasks(robot, o.tasks, seed=exp.seed, range_set=o.range_set)
+        for k, (q0, qf, T) in enumerate(tasks):
+            ctx.progress("optimize", k, len(tasks))
             cfg = OptimizeConfig(
                 algorithm=o.algorithm,
                 fitness=o.fitness,
@@ -153,33 +549,120 @@ def run_experiment(
                 seed=exp.seed + k,
             )
             res = optimize_move(robot, q0, qf, T, cfg, models=models, joints_ranked=joints)
-            write_run(res, robot, opt_dir / f"task-{k:03d}")
+            write_run(res, robot, folder / f"task-{k:03d}")
             s = res.summary
             rows.append(
                 {
                     "task": k,
+                    "q_start_deg": " ".join(f"{v:.1f}" for v in np.degrees(q0)),
+                    "q_end_deg": " ".join(f"{v:.1f}" for v in np.degrees(qf)),
                     "duration_s": T,
                     "default_J": s["energy_default_physics_J"],
                     "optimized_J": s["energy_optimized_physics_J"],
                     "saved_pct": s["improvement_physics_pct"],
                     "saved_lab_pct": s["improvement_lab_pct"],
+                    "saved_vs_initial_pct": s["improvement_vs_initial_best_pct"],
                     "limits_ok": s["limits_ok"],
                     "generations": s["generations"],
                     "wall_s": s["wall_s"],
                 }
             )
-            tell(
+            ctx.tell(
                 f"optimize: task {k} ({T:g} s): {s['improvement_physics_pct']:.1f} % saved on physics, "
-                f"limits ok {s['limits_ok']}"
+                f"{s['improvement_lab_pct']:.1f} % on the lab robot, limits ok {s['limits_ok']}"
             )
-        atomic_write_text(opt_dir / "tasks.csv", pd.DataFrame(rows).to_csv(index=False))
-        _done(opt_dir, opt_key, t0, {})
-    tasks = pd.read_csv(opt_dir / "tasks.csv")
-    summary["stages"] = {"data": data_key, "train": train_key, "optimize": opt_key}
-    summary["mean_saved_pct"] = float(tasks["saved_pct"].mean()) if len(tasks) else None
-    atomic_write_text(root / "summary.json", json.dumps(summary, indent=2))
-    tell(
-        f"done: mean saving {summary['mean_saved_pct']:.1f} % on physics at equal cycle time; "
-        f"outputs in {root}"
+        ctx.progress("optimize", len(tasks), len(tasks))
+        frame = pd.DataFrame(rows)
+        atomic_write_text(folder / "tasks.csv", frame.to_csv(index=False))
+        if len(frame):
+            _plot_tasks(frame, folder / "tasks.png")
+        return {}
+
+    return _stage(ctx, "optimize", "optimize", key, body)
+
+
+def _plot_tasks(frame: pd.DataFrame, path: Path) -> None:
+    """Energy of the default and the optimized move per task (thesis Table 4.7)."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(max(5.0, 0.8 * len(frame) + 2), 3.2))
+    ax = fig.subplots()
+    x = np.arange(len(frame))
+    ax.bar(x - 0.2, frame["default_J"], 0.4, label="default (minimum jerk, same duration)")
+    ax.bar(x + 0.2, frame["optimized_J"], 0.4, label="optimized")
+    for xi, (e, pct) in enumerate(zip(frame["optimized_J"], frame["saved_pct"], strict=True)):
+        ax.annotate(f"{pct:.1f} %", (xi + 0.2, e), ha="center", va="bottom", fontsize=8)
+    ax.set_xticks(x, [f"task {k}" for k in frame["task"]])
+    ax.set_ylabel("energy on the physics model (J)")
+    ax.legend(fontsize="small")
+    fig.tight_layout()
+    _save(fig, path)
+
+
+# ----------------------------------------------------------------------------- bench
+def _bench_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str, Any]:
+    exp, b = ctx.exp, ctx.exp.bench
+    uses_models = b.fitness != "physics"
+    key = _hash("bench", model_key if uses_models else "", importance_key, exp.robot, asdict(b), exp.seed)
+
+    def body(folder: Path) -> dict[str, Any]:
+        from joulepath.optimize import bench_optimizers, thesis_configurations
+
+        configs = thesis_configurations(b.fitness)
+        if b.configurations == "compact":
+            configs = [c for c in configs if c[0] in COMPACT_CONFIGURATIONS]
+        table = bench_optimizers(
+            robot=exp.robot,
+            n_tasks=b.tasks,
+            generations=b.generations,
+            population=b.population,
+            fitness=b.fitness,
+            models=_models_for(ctx, b.fitness),
+            joints=_joints(ctx),
+            configurations=configs,
+            seed=exp.seed,
+            n_jobs=exp.jobs,
+            scheduler=exp.scheduler or None,
+            progress=lambda done, total: ctx.progress("bench", done, total),
+        )
+        atomic_write_text(folder / "table.csv", table.to_csv(index=False))
+        _plot_bench(table, folder / "improvement.png")
+        best = table.sort_values("vs_default_mean", ascending=False).iloc[0]
+        ctx.tell(
+            f"bench: best at equal cycle time: {best['configuration']} "
+            f"{best['vs_default_mean']:.1f} % vs the default move ({best['vs_initial_mean']:.1f} % by "
+            "the thesis' metric)"
+        )
+        return {}
+
+    return _stage(ctx, "bench", "bench", key, body)
+
+
+def _plot_bench(table: pd.DataFrame, path: Path) -> None:
+    """Both improvement metrics per configuration (thesis Tables 4.5–4.6, Fig 4.19)."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9, 0.32 * len(table) + 1.6))
+    ax = fig.subplots()
+    y = np.arange(len(table))
+    ax.barh(
+        y + 0.2,
+        table["vs_initial_mean"],
+        0.4,
+        xerr=table["vs_initial_std"].fillna(0),
+        label="vs best initial individual (thesis)",
     )
-    return summary
+    ax.barh(
+        y - 0.2,
+        table["vs_default_mean"],
+        0.4,
+        xerr=table["vs_default_std"].fillna(0),
+        label="vs default move (honest)",
+    )
+    ax.set_yticks(y, table["configuration"], fontsize=7)
+    ax.axvline(0, color="k", lw=0.5)
+    ax.invert_yaxis()
+    ax.set_xlabel("energy saved (%)")
+    ax.legend(fontsize="small")
+    fig.tight_layout()
+    _save(fig, path)
