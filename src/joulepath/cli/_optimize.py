@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import typer
@@ -37,6 +38,28 @@ def _models(
     if jf.exists():
         joints = tuple(int(j) for j in json.loads(jf.read_text())["joints_by_influence"])
     return models, joints
+
+
+def _check_reachable(robot: Any, q0: np.ndarray, qf: np.ndarray, duration: float) -> None:
+    """Refuse a duration in which no path can make the move within the joint speed limits."""
+    from joulepath.errors import LimitViolation
+    from joulepath.units import SAMPLE_PERIOD
+
+    lo, hi = robot.joint_ranges()
+    outside = any(np.any((q < lo) | (q > hi)) for q in (q0, qf))
+    if outside or not (np.isfinite(duration) and duration > 0):
+        return  # optimize_move reports these
+    vmax = robot.velocity_limit
+    need = np.abs(qf - q0) / np.where(np.isfinite(vmax) & (vmax > 0), vmax, np.inf)
+    j = int(np.argmax(need))
+    if need[j] > duration:
+        jerk = np.ceil(1.875 * need[j] / SAMPLE_PERIOD - 1e-9) * SAMPLE_PERIOD
+        raise LimitViolation(
+            f"--duration {duration:g} s is too short: joint {j + 1} must turn "
+            f"{np.degrees(abs(qf[j] - q0[j])):.1f} deg, and at its speed limit of "
+            f"{np.degrees(vmax[j]):.0f} deg/s no path does that in less than {need[j]:.3f} s; "
+            f"give a longer --duration (the minimum-jerk path needs {jerk:.3f} s)"
+        )
 
 
 def _status(status: object, label: str) -> Callable[[int, int], None]:
@@ -78,6 +101,7 @@ def optimize(
         pop_size=population,
         seed=seed,
     )
+    _check_reachable(r, np.array(q0), np.array(qf), duration)
     models, joints = _models(model, fitness, family, r.name)
     with console.status(f"optimizing with {algo} on the {fitness} fitness..."):
         result = optimize_move(

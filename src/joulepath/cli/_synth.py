@@ -58,6 +58,8 @@ def synth(
                 f"{source}: feature set {real.feature_set!r} has no TCP columns for --repair-kinematics to "
                 "recompute; leave the option out, or use a full40 table (`joulepath ingest --robot`)"
             )
+        if save_model is not None:
+            save_model.parent.mkdir(parents=True, exist_ok=True)
         table = synthesize(
             real,
             n_rows=rows,
@@ -68,6 +70,7 @@ def synth(
         )
     else:
         raise InvalidInput(both)
+    out.parent.mkdir(parents=True, exist_ok=True)
     save_table(table, out)
     console.print(
         f"wrote {out}: {len(table.frame):,} synthetic rows, feature set {table.feature_set}"

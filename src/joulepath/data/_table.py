@@ -90,6 +90,8 @@ def load_table(path: str | os.PathLike[str]) -> EnergyTable:
         the feature set (naming the missing and unexpected ones).
     """
     p = Path(path)
+    if not p.exists():
+        raise InvalidLog(f"{p}: no such file; give an energy table (.parquet) written by `joulepath ingest`")
     try:
         arrow = pq.read_table(p)
     except (OSError, pa.ArrowInvalid) as err:
@@ -122,7 +124,10 @@ def check_columns(frame: pd.DataFrame, feature_set: str, *, source: str) -> None
             parts.append(f"missing column(s) {', '.join(missing)}")
         if extra:
             parts.append(f"unexpected column(s) {', '.join(extra)}")
-        raise InvalidLog(f"{source}: {'; '.join(parts)} for feature set {feature_set!r}")
+        raise InvalidLog(
+            f"{source}: {'; '.join(parts)} for feature set {feature_set!r}; "
+            "write the table again with `joulepath ingest` (or `save_table`)"
+        )
 
 
 def _tcp_from_robot(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -33,7 +33,7 @@ from sklearn.pipeline import Pipeline
 
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
-from joulepath.errors import InvalidInput
+from joulepath.errors import InvalidInput, MissingDependency
 
 SPLITS = ("grouped", "shuffled")
 
@@ -235,9 +235,7 @@ def grid_search(
     if not todo:
         pass
     elif scheduler is not None:
-        from dask.distributed import Client
-
-        with Client(scheduler), parallel_config(backend="dask"):  # type: ignore[no-untyped-call]
+        with connect_scheduler(scheduler), parallel_config(backend="dask"):
             outputs = Parallel(return_as="generator")(tasks)
             for i, out in zip(todo, outputs, strict=True):
                 record(i, out)
@@ -249,3 +247,19 @@ def grid_search(
         for i, out in zip(todo, outputs, strict=True):
             record(i, out)
     return SearchResult(candidates=tuple(results[i] for i in range(total)), split=split, n_splits=n_splits)
+
+
+def connect_scheduler(address: str) -> Any:
+    """A ``dask.distributed.Client`` of the scheduler at ``address``; InvalidInput when unreachable."""
+    try:
+        from dask.distributed import Client
+    except ImportError as err:
+        raise MissingDependency("Dask is not installed: pip install 'joulepath[dask]'") from err
+    try:
+        return Client(address)  # type: ignore[no-untyped-call]
+    except (OSError, ValueError, TypeError) as err:
+        reason = " ".join(str(err).split())
+        raise InvalidInput(
+            f"cannot connect to the Dask scheduler {address!r} ({reason}); give the address of a running "
+            "scheduler as tcp://HOST:PORT, or leave the scheduler out to use local processes"
+        ) from err

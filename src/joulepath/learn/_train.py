@@ -282,6 +282,12 @@ def plot_test_scores(results: pd.DataFrame, baselines: Sequence[dict[str, Any]],
 def load_models(folder: str | os.PathLike[str]) -> dict[str, EnergyModel]:
     """All models of a training output folder, keyed ``<family>-<target>``."""
     root = Path(folder)
+    if not root.is_dir():
+        raise InvalidModel(f"{root}: no such folder; give the --out folder of `joulepath train`")
+    if (root / "card.json").is_file():
+        raise InvalidModel(
+            f"{root}: is the folder of one model; give the folder above it (the --out of `joulepath train`)"
+        )
     found = {p.parent.name: EnergyModel.load(p.parent) for p in sorted(root.glob("*/card.json"))}
     if not found:
         raise InvalidModel(f"{root}: no models (folders with card.json); run `joulepath train` first")
@@ -299,6 +305,9 @@ def best_model(
     ]
     if not models:
         raise InvalidModel(
-            f"{folder}: no model for target {target!r}" + (f" of family {family!r}" if family else "")
+            f"{folder}: no model for target {target!r}"
+            + (f" of family {family!r}" if family else "")
+            + f"; train one with `joulepath train --target {target}"
+            + (f" --family {family}`" if family else "`")
         )
     return max(models, key=lambda m: float(m.card["cv_grouped"]["r2_mean"]))

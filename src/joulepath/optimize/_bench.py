@@ -110,9 +110,9 @@ def bench_optimizers(
     calls = (delayed(_run_one)(robot, task, cfg, models, joints) for _, cfg, task in jobs)
     out = []
     if scheduler:
-        from dask.distributed import Client
+        from joulepath.learn._search import connect_scheduler
 
-        with Client(scheduler), parallel_config(backend="dask"):  # type: ignore[no-untyped-call]
+        with connect_scheduler(scheduler), parallel_config(backend="dask"):
             results = list(Parallel(return_as="generator")(calls))
     else:
         results = []

@@ -138,7 +138,8 @@ def optimize_move(
             j = int(bad[0])
             raise LimitViolation(
                 f"{name} joint {j + 1} = {np.degrees(q[j]):.2f} deg is outside its range "
-                f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg"
+                f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg; "
+                f"move the {name} configuration inside the range"
             )
     default = minimum_jerk(q0, qf, duration)
     joints = tuple(config.informed_joints) or joints_ranked or rank_joints_by_energy(robot, default)

@@ -508,7 +508,13 @@ def _train(run: _Run) -> str:
     for family, table_key in _FAMILY_TABLE.items():
         rows = results[results["family"] == family]
         if len(rows):
-            out += _pair(f"<h3>{_e(family.upper())}</h3>" + _table(rows[cols]), (table_key,))
+            ours = f"<h3>{_e(family.upper())}</h3>" + _table(rows[cols])
+        else:
+            ours = (
+                f'<p class="note">No {_e(family.upper())} model in this run; '
+                f'add "{family}" to [train] families.</p>'
+            )
+        out += _pair(ours, (table_key,))
     trained = set(results["target"])
     for target, fig_key in _TARGET_FIGURE.items():
         if target in trained:

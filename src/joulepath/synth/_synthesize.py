@@ -484,6 +484,10 @@ def synthesize(
     -------
     EnergyTable
     """
+    if repair is not None:  # refuse a table that cannot be repaired before the (long) fit
+        from joulepath.synth._kinematics import _check
+
+        _check(table, repair, where="synthesize")
     synth = Synthesizer(config).fit(table, progress=progress)
     if model_path is not None:
         synth.save(model_path)
