@@ -1,4 +1,4 @@
-# make demo : set up .venv (if missing), install joulepath with its extras, run the demo
+# make demo : set up .venv (if missing), install joulepath with its extras, run demo.toml -> demo-out/report.html
 # make test : set up .venv (if missing), install joulepath with its extras, run all tests
 PYTHON ?= python3
 VENV := .venv
@@ -16,7 +16,8 @@ $(STAMP): $(BIN)/python pyproject.toml constraints.txt
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/joulepath demo --out demo-out
+	$(BIN)/joulepath run demo --out demo-out
+	@echo "The report: $(CURDIR)/demo-out/report.html (open it in a browser)"
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks scripts
@@ -30,6 +31,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/learn.py
 	$(BIN)/python benchmarks/optimizers.py
 	$(BIN)/python benchmarks/synth.py
+	$(BIN)/python benchmarks/experiment.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks scripts

@@ -40,6 +40,7 @@ def train(
     robot: str = typer.Option("irb120", help="Robot of the data."),
 ) -> int:
     """Tune (grid search + CV), refit and test energy models; save them with cards and reports."""
+    from joulepath import load_robot
     from joulepath.data import TARGETS, load_table
     from joulepath.errors import InvalidInput
     from joulepath.learn import FAMILIES, TrainConfig
@@ -57,11 +58,17 @@ def train(
         scheduler=scheduler or None,
         robot=robot,
     )
+    load_robot(robot)  # an unknown robot fails now, not after the training
     train_table, test_table = load_table(data), load_table(test)
     if train_table.feature_set != test_table.feature_set:
         raise InvalidInput(
             f"{test}: feature set {test_table.feature_set!r}, but {data} has {train_table.feature_set!r}; "
             "ingest both tables the same way (both with --robot, or both without)"
+        )
+    if train_table.n_moves < cv:
+        raise InvalidInput(
+            f"{data}: {train_table.n_moves} moves are too few for --cv {cv} grouped folds; "
+            f"give --cv {train_table.n_moves} or less, or a table of more moves"
         )
     with console.status("training...") as status:
         report = run(train_table, test_table, config, out, progress=lambda m: status.update(m))

@@ -142,7 +142,6 @@ def bench_optimizers(
     check_out_folder(out)
     if quick:
         tasks, generations, population = 10, 30, 30
-    out.mkdir(parents=True, exist_ok=True)
     variants = (
         [("physics", "single")] if model is None else [("surrogate", "single"), ("surrogate-joints", "multi")]
     )
@@ -162,6 +161,7 @@ def bench_optimizers(
                 scheduler=scheduler or None,
                 progress=_status(status, f"{kind}-objective ({fitness})"),
             )
+        out.mkdir(parents=True, exist_ok=True)
         atomic_write_text(out / f"optimizers_{kind}.csv", frame.to_csv(index=False))
         console.print(f"{kind}-objective, fitness {fitness}:")
         console.print(frame.to_string(index=False, float_format=lambda v: f"{v:.2f}"), markup=False)

@@ -116,6 +116,11 @@ def detect_kind(header: list[str], source: str) -> str:
             if got != want
         ]
         if len(header) != len(LOG_COLUMNS):
+            missing = [c for c in LOG_COLUMNS if c not in header]
+            extra = [h for h in header if h not in LOG_COLUMNS]
+            if missing or extra:  # name them rather than the shifted fields after them
+                wrong = [f"lacks column(s) {', '.join(missing)}"] if missing else []
+                wrong += [f"unexpected column(s) {', '.join(extra)}"] if extra else []
             wrong.insert(0, f"{len(header)} columns instead of {len(LOG_COLUMNS)}")
         raise InvalidLog(
             f"{source}: line 1: not the controller log header ({'; '.join(wrong[:3])}); "

@@ -95,7 +95,10 @@ def load_table(path: str | os.PathLike[str]) -> EnergyTable:
     try:
         arrow = pq.read_table(p)
     except (OSError, pa.ArrowInvalid) as err:
-        raise InvalidLog(f"{p}: not a readable Parquet energy table ({err})") from err
+        raise InvalidLog(
+            f"{p}: not a readable Parquet energy table ({' '.join(str(err).split())}); "
+            "give a table written by `joulepath ingest`"
+        ) from err
     raw = (arrow.schema.metadata or {}).get(METADATA_KEY)
     if raw is None:
         raise InvalidLog(f"{p}: has no joulepath metadata; create tables with `joulepath ingest`")

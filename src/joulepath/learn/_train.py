@@ -22,7 +22,7 @@ from joulepath.learn._evaluate import physics_baseline, score
 from joulepath.learn._families import FAMILIES, GRIDS, SUBSTITUTIONS, grid_for, make_pipeline
 from joulepath.learn._features import INPUTS, PHYSICS_VERSION, input_columns
 from joulepath.learn._model import EnergyModel, library_versions
-from joulepath.learn._search import cross_validate_candidate, grid_search, make_splits
+from joulepath.learn._search import connect_scheduler, cross_validate_candidate, grid_search, make_splits
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -115,6 +115,8 @@ def train(
             f"train table has feature set {train_table.feature_set!r}, test table "
             f"{test_table.feature_set!r}; ingest both the same way"
         )
+    if config.scheduler is not None:  # an unreachable scheduler fails before anything is written
+        connect_scheduler(config.scheduler).close()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cols = input_columns(train_table.feature_set, config.inputs)

@@ -98,7 +98,7 @@ def histogram_mode(values: FloatArray, *, bins: int = MODE_BINS) -> float:
     if x.size == 0:
         return float("nan")
     lo, hi = np.percentile(x, [1.0, 99.0])
-    if not hi > lo:
+    if not hi - lo > bins * 4 * np.finfo(float).eps * max(abs(lo), abs(hi)):  # no room for the bins
         return float(np.median(x))
     counts, edges = np.histogram(x, bins=bins, range=(lo, hi))
     k = int(np.argmax(counts))
