@@ -8,7 +8,7 @@ from pathlib import Path
 
 import typer
 
-from joulepath.cli._common import console
+from joulepath.cli._common import check_out_folder, console
 
 BUNDLED = ("demo", "thesis")
 
@@ -52,6 +52,7 @@ def _run(experiment: str, out: Path | None, quiet: bool, scheduler: str | None) 
 
     exp = load_experiment(_experiment_path(experiment))
     folder = out or Path("runs") / exp.name
+    check_out_folder(folder)
     say = (lambda _t: None) if quiet else (lambda t: console.print(t, markup=False))
     with _bars(not quiet and console.is_terminal) as progress:
         summary = run_experiment(exp, folder, say=say, progress=progress, scheduler=scheduler)  # type: ignore[arg-type]

@@ -73,9 +73,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("aborted", file=sys.stderr)
         return 130
     except typer.TyperException as err:  # usage errors: bad option values, missing arguments
-        show = getattr(err, "show", None)
-        if show is None:
+        message = getattr(err, "format_message", None)
+        if message is None or debug:
             raise
-        show()
+        ctx = getattr(err, "ctx", None)
+        where = ctx.command_path if ctx is not None else "joulepath"
+        print(f"error: {message().rstrip('.')}; see '{where} --help'", file=sys.stderr)
         return 2
     return int(result) if isinstance(result, int) else 0

@@ -161,6 +161,7 @@ _ALLOWED: dict[str, tuple[str, ...]] = {
     "targets": ALL_TARGETS,
 }
 _MAY_BE_ZERO = {"seed", "micro_moves", "sim_moves", "tasks"}
+_MINIMUM = {"cv": 2, "population": 4, "batch_size": 2}
 _TYPE_NAMES = {int: "an integer", str: "a string", bool: "true or false", float: "a number"}
 
 
@@ -198,7 +199,7 @@ def _section(cls: Any, raw: dict[str, Any], where: str, source: str) -> Any:
                 f"{source}: {where}{key} = {value!r} is not allowed; use one of {', '.join(allowed)}"
             )
         elif isinstance(value, int) and not isinstance(value, bool):
-            low = 0 if key in _MAY_BE_ZERO else 2 if key == "cv" else 1
+            low = 0 if key in _MAY_BE_ZERO else _MINIMUM.get(key, 1)
             if value < low:
                 raise InvalidInput(f"{source}: {where}{key} must be ≥ {low}, got {value}")
         kwargs[key] = value

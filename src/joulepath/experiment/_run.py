@@ -4,8 +4,8 @@ Stages, each in its own folder of the run: ``data`` (simulate on a plant or inge
 logs), ``synth`` (optional), ``models`` (train), ``importance``, ``optimize``,
 ``bench`` (optional); then ``report.html`` is rendered from what they wrote.
 
-Each stage writes its outputs, then a ``stage.json`` holding a hash of its settings
-and of the stages it reads. A stage whose ``stage.json`` holds the same hash is
+Each stage writes its outputs, then a ``stage.json`` holding a hash of its settings,
+of the stages it reads and of joulepath's version. A stage whose ``stage.json`` holds the same hash is
 skipped. ``stage.json`` is removed when a stage starts and written last, so an
 interrupted stage runs again. Every file is written atomically (temporary file, then
 rename); the grid search keeps a per-candidate cache, so an interrupted training
@@ -44,7 +44,11 @@ COMPACT_CONFIGURATIONS = (
 
 
 def _hash(*parts: Any) -> str:
-    return hashlib.sha256(json.dumps(parts, sort_keys=True, default=str).encode()).hexdigest()[:24]
+    """Key of a stage: its settings, the keys of what it reads, and joulepath's version."""
+    from joulepath import __version__
+
+    text = json.dumps([__version__, *parts], sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
 def _file_hash(path: str) -> str:
