@@ -149,7 +149,9 @@ def test_run_experiment_skips_unchanged_stages_and_reruns_interrupted_ones(
     # an interrupted stage (no stage.json) runs again; the stages after it that read it too
     (run / "importance" / "stage.json").unlink()
     said.clear()
-    run_experiment(load_experiment(changed), run, say=said.append)
+    bars: list[tuple[str, int, int]] = []
+    run_experiment(load_experiment(changed), run, say=said.append, progress=lambda *a: bars.append(a))
+    assert bars[0] == ("importance", 0, 2) and bars[-1] == ("importance", 2, 2)  # targets E, E1
     ran = [s.split(":")[0] for s in said if s.split(":")[0] in STAGES and "done in" in s]
     assert ran == ["importance"]  # same settings: same key, so optimize and bench stay cached
     assert (run / "run.log").read_text().count("data: ") >= 3
