@@ -175,3 +175,33 @@ def test_cli_quiet_run_prints_one_line(tiny_run, tiny_demo_toml, tmp_path, capsy
     assert main(["run", str(toml), "--out", str(run), "--quiet"]) == 0
     out = capsys.readouterr().out.strip().splitlines()
     assert len(out) == 1 and out[0].startswith("demo: ") and out[0].endswith("report.html")
+
+
+def test_an_interrupted_run_leaves_no_partial_file_and_resumes(
+    tiny_run, tiny_demo_toml, tmp_path, monkeypatch
+):
+    import joulepath.optimize
+
+    run = tmp_path / "run"
+    shutil.copytree(tiny_run, run)
+    changed = tiny_demo_toml(tmp_path, **{"train.targets": '["E", "E1"]', "optimize.generations": "7"})
+    real_write_run = joulepath.optimize.write_run
+    calls = []
+
+    def interrupted(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt  # Ctrl-C while the second task is written
+        return real_write_run(*args, **kwargs)
+
+    monkeypatch.setattr(joulepath.optimize, "write_run", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_experiment(load_experiment(changed), run, say=lambda _t: None)
+    assert not (run / "optimize" / "stage.json").exists()
+    assert not list(run.rglob("*.tmp*"))
+    monkeypatch.setattr(joulepath.optimize, "write_run", real_write_run)
+    said: list[str] = []
+    run_experiment(load_experiment(changed), run, say=said.append)
+    ran = [s.split(":")[0] for s in said if s.split(":")[0] in STAGES and "done in" in s]
+    assert ran == ["optimize"]
+    assert len(pd.read_csv(run / "optimize" / "tasks.csv")) == 2
