@@ -52,7 +52,6 @@ def test_main_robot_fk_bad_joints(capsys):
     assert main(["robot", "fk", "irb120", "--q", "a,b,c,d,e,f"]) == 2
 
 
-
 def test_main_version_and_unknown_command(capsys):
     assert main(["--version"]) == 0
     assert "joulepath 0.1.0" in capsys.readouterr().out

@@ -126,6 +126,11 @@ def test_tiny_demo_run_writes_every_stage(tiny_run):
         assert (tiny_run / "optimize" / f"task-{row.task:03d}" / "path.mod").exists() == bool(row.limits_ok)
     bench = pd.read_csv(tiny_run / "bench" / "table.csv")
     assert len(bench) == 6 and bench["configuration"].str.startswith("MA").sum() == 2
+    runs = pd.read_csv(tiny_run / "bench" / "runs.csv")
+    assert len(runs) == 6 * 2 and set(runs["task"]) == {0, 1}
+    assert np.allclose(
+        runs.groupby("configuration", sort=False)["vs_default"].mean(), bench["vs_default_mean"]
+    )
     assert (tiny_run / "report.html").stat().st_size > 50_000
     assert not list(tiny_run.rglob("*.tmp*")), "a temporary file was left behind"
 

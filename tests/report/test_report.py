@@ -185,3 +185,16 @@ def test_report_renders_in_headless_chromium(tiny_run, tmp_path):
     for image in result["images"]:
         assert image["complete"] and image["natural"] > 100 and image["shown"] > 100, image
     assert result["width"] <= 1280, "the page scrolls sideways"
+
+
+def test_h3_verdict_pairs_the_configurations_task_by_task(tmp_path):
+    run = _bench_run(tmp_path, 6.0, 5.0, 4.0, 6)  # unpaired: 1 point ahead, standard error 2.3
+    noise = [3.0, -4.0, 8.0, 0.0, -2.0, 7.0]  # task difficulty, shared by both configurations
+    rows = [
+        {"configuration": name, "task": k, "vs_default": base + gain + 0.05 * (-1) ** k}
+        for k, base in enumerate(noise)
+        for name, gain in (("GA random", 5.0), ("MA informed local search", 6.0))
+    ]
+    pd.DataFrame(rows).to_csv(run / "bench" / "runs.csv", index=False)
+    h3 = verdicts(run)[2]
+    assert h3.verdict == "supported" and "MA better on 6 of 6 tasks" in h3.evidence

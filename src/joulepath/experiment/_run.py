@@ -659,12 +659,12 @@ def _bench_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str
     key = _hash("bench", model_key if uses_models else "", importance_key, exp.robot, asdict(b), exp.seed)
 
     def body(folder: Path) -> dict[str, Any]:
-        from joulepath.optimize import bench_optimizers, thesis_configurations
+        from joulepath.optimize import bench_optimizers, summarize_bench, thesis_configurations
 
         configs = thesis_configurations(b.fitness)
         if b.configurations == "compact":
             configs = [c for c in configs if c[0] in COMPACT_CONFIGURATIONS]
-        table = bench_optimizers(
+        runs = bench_optimizers(
             robot=exp.robot,
             n_tasks=b.tasks,
             generations=b.generations,
@@ -677,7 +677,10 @@ def _bench_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str
             n_jobs=exp.jobs,
             scheduler=exp.scheduler or None,
             progress=lambda done, total: ctx.progress("bench", done, total),
+            per_run=True,
         )
+        table = summarize_bench(runs)
+        atomic_write_text(folder / "runs.csv", runs.to_csv(index=False))
         atomic_write_text(folder / "table.csv", table.to_csv(index=False))
         _plot_bench(table, folder / "improvement.png")
         best = table.sort_values("vs_default_mean", ascending=False).iloc[0]

@@ -1,6 +1,6 @@
 """The energy-optimal trajectory optimizer: fitness problems, one-move optimization, benchmarks."""
 
-from joulepath.optimize._bench import bench_optimizers, random_tasks, thesis_configurations
+from joulepath.optimize._bench import bench_optimizers, random_tasks, summarize_bench, thesis_configurations
 from joulepath.optimize._features import path_features
 from joulepath.optimize._problem import (
     FITNESS,
@@ -38,6 +38,7 @@ __all__ = [
     "physics_energy",
     "random_tasks",
     "rank_joints_by_energy",
+    "summarize_bench",
     "thesis_configurations",
     "write_run",
 ]

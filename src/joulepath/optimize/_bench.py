@@ -88,8 +88,12 @@ def bench_optimizers(
     n_jobs: int = 1,
     scheduler: str | None = None,
     progress: Callable[[int, int], None] | None = None,
+    per_run: bool = False,
 ) -> pd.DataFrame:
     """Run every configuration on the same random tasks; improvement % (mean, σ) both ways.
+
+    With ``per_run`` the result has one row per (configuration, task) instead (see
+    :func:`summarize_bench`), for paired comparisons of configurations on the same tasks.
 
     ``vs_initial`` is the thesis' metric (relative to the best individual of the
     random initial population); ``vs_default`` is the honest one (relative to the
@@ -120,9 +124,14 @@ def bench_optimizers(
             results.append(res)
             if progress:
                 progress(i + 1, total)
-    for (label, _, _), res in zip(jobs, results, strict=True):
-        out.append({"configuration": label, **res})
+    for (label, cfg, _), res in zip(jobs, results, strict=True):
+        out.append({"configuration": label, "task": cfg.seed - seed, **res})
     frame = pd.DataFrame(out)
+    return frame if per_run else summarize_bench(frame)
+
+
+def summarize_bench(frame: pd.DataFrame) -> pd.DataFrame:
+    """Per configuration: mean and σ of both improvements, wall time, generations, share within limits."""
     summary = frame.groupby("configuration", sort=False).agg(
         vs_initial_mean=("vs_initial", "mean"),
         vs_initial_std=("vs_initial", "std"),
