@@ -261,6 +261,11 @@ CASES = [
         ("duration", "positive number of seconds", "got -1"),
     ),
     (
+        "optimize-duration-huge",
+        "optimize --start 0,0,0,0,0,0 --end 0.5,0,0,0,0,0 --duration 1e9 --fitness physics --out {out}",
+        ("duration 1e+09 s is longer than 60 s", "in seconds"),
+    ),
+    (
         "optimize-duration-not-whole-samples",
         "optimize --start 0,0,0,0,0,0 --end 0.5,0,0,0,0,0 --duration 1.01 --fitness physics --out {out}",
         ("1.01", "whole number of 0.025 s samples", "use e.g."),

@@ -109,6 +109,10 @@ def _plant_energy(plant: Any, traj: Trajectory) -> float:
     return float((np.abs(tau * traj.qd) * traj.dt).sum())
 
 
+MAX_DURATION = 60.0
+"""Longest move :func:`optimize_move` accepts, s (2,400 samples at 40 Hz)."""
+
+
 def optimize_move(
     robot: Robot,
     q_start: FloatArray,
@@ -141,6 +145,11 @@ def optimize_move(
                 f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg; "
                 f"move the {name} configuration inside the range"
             )
+    if duration > MAX_DURATION:
+        raise InvalidInput(
+            f"duration {duration:g} s is longer than {MAX_DURATION:g} s; give the move's duration in "
+            "seconds (a point-to-point move of an industrial arm takes well under a minute)"
+        )
     default = minimum_jerk(q0, qf, duration)
     joints = tuple(config.informed_joints) or joints_ranked or rank_joints_by_energy(robot, default)
     problem = TrajectoryProblem(
