@@ -93,3 +93,18 @@ def tiny_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     toml = _tiny_demo_toml(base, **{"train.targets": '["E", "E1"]'})
     assert main(["run", str(toml), "--out", str(base / "run"), "--quiet"]) == 0
     return base / "run"
+
+
+@pytest.fixture
+def dask_scheduler():
+    """Address of an in-process Dask LocalCluster (one worker thread) on tcp://127.0.0.1."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=1,
+        threads_per_worker=1,
+        processes=False,
+        host="127.0.0.1",
+        protocol="tcp://",
+        dashboard_address=None,
+    ) as cluster:
+        yield cluster.scheduler_address

@@ -212,23 +212,12 @@ def test_an_interrupted_run_leaves_no_partial_file_and_resumes(
     assert len(pd.read_csv(run / "optimize" / "tasks.csv")) == 2
 
 
-def test_run_on_a_dask_scheduler_gives_the_local_results(tmp_path):
-    distributed = pytest.importorskip("distributed")
+def test_run_on_a_dask_scheduler_gives_the_local_results(tmp_path, dask_scheduler):
     text = TINY.replace("[optimize]", '[optimize]\nfitness = "physics"').replace("tasks = 2", "tasks = 1")
     text += "[bench]\ntasks = 1\ngenerations = 3\npopulation = 8\nconfigurations = 'compact'\n"
     exp = load_experiment(_write(tmp_path, text))
     local = run_experiment(exp, tmp_path / "local", say=lambda _t: None)
-    with distributed.LocalCluster(
-        n_workers=1,
-        threads_per_worker=1,
-        processes=False,
-        host="127.0.0.1",
-        protocol="tcp://",
-        dashboard_address=None,
-    ) as cluster:
-        remote = run_experiment(
-            exp, tmp_path / "dask", say=lambda _t: None, scheduler=cluster.scheduler_address
-        )
+    remote = run_experiment(exp, tmp_path / "dask", say=lambda _t: None, scheduler=dask_scheduler)
     assert remote["experiment"]["scheduler"].startswith("tcp://127.0.0.1")
     for name in ("models/results.csv", "bench/table.csv"):
         a = pd.read_csv(tmp_path / "local" / name).drop(columns=["search_s", "wall_s_mean"], errors="ignore")

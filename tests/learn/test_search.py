@@ -47,21 +47,10 @@ def test_interrupted_search_resumes_without_refitting(xy, tmp_path):
     assert third.n_fitted == 0
 
 
-def test_grid_search_on_a_dask_local_cluster(xy):
-    distributed = pytest.importorskip("distributed")
+def test_grid_search_on_a_dask_local_cluster(xy, dask_scheduler):
     X, y, groups, cols = xy
     pipe = make_pipeline("par", seed=0, columns=cols)
-    with distributed.LocalCluster(
-        n_workers=1,
-        threads_per_worker=1,
-        processes=False,
-        host="127.0.0.1",
-        protocol="tcp://",
-        dashboard_address=None,
-    ) as cluster:
-        res = grid_search(
-            pipe, GRID, X, y, groups, family="par", n_splits=3, scheduler=cluster.scheduler_address
-        )
+    res = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3, scheduler=dask_scheduler)
     local = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3)
     assert res.n_fitted == 4
     np.testing.assert_allclose([c.r2_mean for c in res.candidates], [c.r2_mean for c in local.candidates])
