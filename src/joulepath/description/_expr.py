@@ -41,8 +41,11 @@ def _walk(node: ast.AST, variables: frozenset[str]) -> Affine:
         return _walk(node.body, variables)
     if isinstance(node, ast.Constant):
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
-            raise ExpressionError(f"{node.value!r} is not a number")
-        return Affine(0.0, float(node.value), None)
+            raise ExpressionError(f"{str(node.value)[:20]!r} is not a number")
+        try:
+            return Affine(0.0, float(node.value), None)
+        except OverflowError as err:  # an integer literal beyond the float range
+            raise ExpressionError("has a number too large for a float") from err
     if isinstance(node, ast.Name):
         if node.id in _CONSTANTS:
             return Affine(0.0, _CONSTANTS[node.id], None)
@@ -79,9 +82,12 @@ def _walk(node: ast.AST, variables: frozenset[str]) -> Affine:
             if abs(b.const) > _MAX_EXPONENT:
                 raise ExpressionError(f"exponent {b.const} is larger than {_MAX_EXPONENT:g}")
             try:
-                return Affine(0.0, float(a.const**b.const), None)
+                value = a.const**b.const
             except (OverflowError, ZeroDivisionError) as err:
                 raise ExpressionError(f"cannot be evaluated ({err})") from err
+            if not isinstance(value, float):  # a negative base to a fractional power
+                raise ExpressionError(f"is not a real number (({a.const:g}) ** {b.const:g} is complex)")
+            return Affine(0.0, value, None)
     raise ExpressionError(
         f"contains {type(node).__name__}; allowed are numbers, pi, + - * / ** and parentheses"
     )
@@ -107,9 +113,12 @@ def evaluate_affine(text: str, variables: frozenset[str] = frozenset()) -> Affin
         raise ExpressionError(f"is longer than {_MAX_LEN} characters")
     try:
         tree = ast.parse(text, mode="eval")
-    except SyntaxError as err:
+    except (SyntaxError, ValueError, MemoryError, RecursionError) as err:
         raise ExpressionError("is not a valid arithmetic expression") from err
-    result = _walk(tree, variables)
+    try:
+        result = _walk(tree, variables)
+    except RecursionError as err:  # unreachable within _MAX_LEN characters; kept as a guard
+        raise ExpressionError("is nested too deeply") from err
     if not (math.isfinite(result.const) and math.isfinite(result.coef)):
         raise ExpressionError("is not finite")
     return result

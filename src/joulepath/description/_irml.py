@@ -25,7 +25,9 @@ Frame conventions: see :mod:`joulepath.description._model`.
 
 from __future__ import annotations
 
+import math
 import os
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -52,6 +54,12 @@ from joulepath.errors import InvalidRobotDescription
 _STRUCTURAL = {"joint", "range-set", "payload", "base", "name", "manufacturer"}
 _INERTIA_TAGS = ("xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz")
 IRML_VERSION = "0.2"
+MAX_BYTES = 4 << 20
+"""Largest IRML file read (4 MiB); a robot description is a few kB."""
+MAX_DEPTH = 16
+"""Deepest nesting of general-information elements (``<loads><maximal-loads><fx>`` is 3)."""
+MAX_JOINTS = 64
+_ID = re.compile(r"[0-9]{1,6}")
 
 
 class _Ctx:
@@ -65,6 +73,17 @@ class _Ctx:
         if fix:
             msg += f"; {fix}"
         return InvalidRobotDescription(msg)
+
+
+def _short(text: str, n: int = 40) -> str:
+    """``repr`` of ``text`` cut to about ``n`` characters, for messages."""
+    return repr(text if len(text) <= n else text[:n] + "…")
+
+
+def _joint_id(raw: str | None) -> int | None:
+    """The integer of a joint id attribute (decimal digits only), else None."""
+    text = (raw or "").strip()
+    return int(text) if _ID.fullmatch(text) else None
 
 
 def _children(el: ET.Element, tag: str) -> list[ET.Element]:
@@ -95,7 +114,7 @@ def _number(el: ET.Element, tag: str, ctx: _Ctx, where: str) -> float:
     except ExpressionError as err:
         raise ctx.fail(
             f"{where} <{tag}>",
-            f"{text!r} {err}",
+            f"{_short(text)} {err}",
             "write a number or an expression such as 0.29 or -pi/2",
         ) from err
 
@@ -119,16 +138,17 @@ def _joint(el: ET.Element, ctx: _Ctx) -> JointDescription:
     raw_id = el.get("id")
     if raw_id is None:
         raise ctx.fail("<joint>", "has no id attribute", 'write <joint id="1">')
-    try:
-        jid = int(raw_id)
-    except ValueError as err:
-        raise ctx.fail(f"joint {raw_id!r}", "id is not an integer", 'write <joint id="1">') from err
+    jid = _joint_id(raw_id)
+    if jid is None:
+        raise ctx.fail(
+            f"joint {_short(raw_id)}", "id is not an integer (of at most 6 digits)", 'write <joint id="1">'
+        )
     where = f"joint {jid}"
     jtype = _text(_child(el, "type", ctx, where), ctx, where)
     if jtype not in JOINT_TYPES:
         raise ctx.fail(
             f"{where} <type>",
-            f"unknown joint type {jtype!r}",
+            f"unknown joint type {_short(jtype)}",
             "use T (torsion), R (rotational) or L (linear)",
         )
     if jtype == "L":
@@ -139,7 +159,7 @@ def _joint(el: ET.Element, ctx: _Ctx) -> JointDescription:
         )
     xi_text = _text(_child(el, "xi", ctx, where), ctx, where)
     if xi_text not in ("0", "1"):
-        raise ctx.fail(f"{where} <xi>", f"{xi_text!r} is not 0 or 1", "write 1 for T/R joints")
+        raise ctx.fail(f"{where} <xi>", f"{_short(xi_text)} is not 0 or 1", "write 1 for T/R joints")
     xi = int(xi_text)
     if xi != 1:
         raise ctx.fail(f"{where} <xi>", f"xi is 0 but the type is {jtype}", "write <xi>1</xi>")
@@ -152,13 +172,13 @@ def _joint(el: ET.Element, ctx: _Ctx) -> JointDescription:
     except ExpressionError as err:
         raise ctx.fail(
             f"{where} <kinematics> <q>",
-            f"{q_text!r} {err}",
+            f"{_short(q_text)} {err}",
             f"write the joint variable, e.g. {variable} or {variable} - pi/2",
         ) from err
     if aff.var != variable or aff.coef not in (1.0, -1.0):
         raise ctx.fail(
             f"{where} <kinematics> <q>",
-            f"{q_text!r} is not ±{variable} plus a constant offset",
+            f"{_short(q_text)} is not ±{variable} plus a constant offset",
             f"write e.g. {variable} or {variable} - pi/2",
         )
     kw = f"{where} <kinematics>"
@@ -188,17 +208,36 @@ def _joint(el: ET.Element, ctx: _Ctx) -> JointDescription:
     )
 
 
-def _flatten_info(el: ET.Element, prefix: str, out: list[tuple[str, str]]) -> None:
-    for child in el:
-        if not isinstance(child.tag, str):  # comments, processing instructions
-            continue
-        if prefix == "" and child.tag in _STRUCTURAL:
-            continue
-        path = f"{prefix}{child.tag}"
-        if len(child):
-            _flatten_info(child, path + "/", out)
-        else:
-            out.append((path, (child.text or "").strip()))
+def _flatten_info(root: ET.Element, ctx: _Ctx) -> list[tuple[str, str]]:
+    """General information as ``(path, text)`` in document order; refuses nesting past MAX_DEPTH."""
+    out: list[tuple[str, str]] = []
+    stack: list[tuple[ET.Element, str, int]] = [(root, "", 0)]
+    while stack:
+        el, prefix, depth = stack.pop()
+        items: list[tuple[ET.Element, str, int]] = []
+        for child in el:
+            if not isinstance(child.tag, str):  # comments, processing instructions
+                continue
+            if prefix == "" and child.tag in _STRUCTURAL:
+                continue
+            path = f"{prefix}{child.tag}"
+            if len(child):
+                if depth + 1 >= MAX_DEPTH:
+                    raise ctx.fail(
+                        f"<{path.split('/')[0]}>",
+                        f"general information is nested deeper than {MAX_DEPTH} levels",
+                        "flatten it",
+                    )
+                items.append((child, path + "/", depth + 1))
+            else:
+                items.append((child, path, -1))
+        # depth-first, in document order: leaves are emitted when popped
+        for item in reversed(items):
+            stack.append(item)
+        while stack and stack[-1][2] == -1:
+            leaf, path, _ = stack.pop()
+            out.append((path, (leaf.text or "").strip()))
+    return out
 
 
 def _range_set(el: ET.Element, joint_ids: list[int], ctx: _Ctx) -> RangeSet:
@@ -208,10 +247,9 @@ def _range_set(el: ET.Element, joint_ids: list[int], ctx: _Ctx) -> RangeSet:
     where = f"range-set {name!r}"
     by_id: dict[int, tuple[float, float]] = {}
     for j in _children(el, "joint"):
-        try:
-            jid = int(j.get("id", ""))
-        except ValueError as err:
-            raise ctx.fail(where, "a <joint> has no integer id", 'write <joint id="1">') from err
+        jid = _joint_id(j.get("id"))
+        if jid is None:
+            raise ctx.fail(where, "a <joint> has no integer id", 'write <joint id="1">')
         lo = _number(j, "lower", ctx, f"{where} joint {jid}")
         hi = _number(j, "upper", ctx, f"{where} joint {jid}")
         by_id[jid] = (lo, hi)
@@ -235,6 +273,8 @@ def parse_irml(data: str | bytes, *, source: str = "<string>") -> RobotDescripti
         message names the source, the joint id and the tag.
     """
     ctx = _Ctx(source)
+    if len(data) > MAX_BYTES:
+        raise ctx.fail("file", f"is larger than {MAX_BYTES >> 20} MiB", "an IRML file is a few kB")
     try:
         root = DET.fromstring(data, forbid_dtd=True)
     except defusedxml.DefusedXmlException as err:
@@ -246,29 +286,39 @@ def parse_irml(data: str | bytes, *, source: str = "<string>") -> RobotDescripti
     except ET.ParseError as err:
         line, col = err.position
         raise ctx.fail(f"line {line}, column {col}", f"not well-formed XML ({err})") from err
+    except (LookupError, ValueError) as err:  # unknown encoding declared, text that is not XML
+        raise ctx.fail("XML", f"cannot be decoded ({err})", "save the file as UTF-8") from err
     if root.tag != "robot":
-        raise ctx.fail("root", f"the root element is <{root.tag}>", "IRML files start with <robot>")
+        raise ctx.fail("root", f"the root element is <{str(root.tag)[:40]}>", "IRML files start with <robot>")
     name = _text(_child(root, "name", ctx, "robot"), ctx, "robot")
     manu = _children(root, "manufacturer")
     manufacturer = (manu[0].text or "").strip() if manu else ""
     seen: set[str] = set()
-    for el in _children(root, "joint"):
-        raw = (el.get("id") or "").strip()
+    joint_els = _children(root, "joint")
+    if len(joint_els) > MAX_JOINTS:
+        raise ctx.fail(
+            "robot", f"has {len(joint_els)} joints; at most {MAX_JOINTS} are supported", "describe an arm"
+        )
+    for el in joint_els:
+        jid = _joint_id(el.get("id"))
+        raw = str(jid) if jid is not None else (el.get("id") or "").strip()
         if raw and raw in seen:
-            raise ctx.fail(f"joint {raw}", "duplicate joint id", "give each joint its own id")
+            shown = raw if jid is not None else _short(raw)
+            raise ctx.fail(f"joint {shown}", "duplicate joint id", "give each joint its own id")
         seen.add(raw)
-    joints = [_joint(el, ctx) for el in _children(root, "joint")]
+    joints = [_joint(el, ctx) for el in joint_els]
     if not joints:
         raise ctx.fail("robot", "has no <joint>", "describe at least one joint")
-    info: list[tuple[str, str]] = []
-    _flatten_info(root, "", info)
+    info = _flatten_info(root, ctx)
     for key in ("manipulator-mass", "reach", "carrying-capacity"):
         for k, v in info:
             if k == key:
                 try:
-                    float(v)
-                except ValueError as err:
-                    raise ctx.fail(f"<{key}>", f"{v!r} is not a number", "write e.g. 25") from err
+                    ok = math.isfinite(float(v))
+                except ValueError:
+                    ok = False
+                if not ok:
+                    raise ctx.fail(f"<{key}>", f"{_short(v)} is not a finite number", "write e.g. 25")
     ids = [j.id for j in joints]
     base = _children(root, "base")
     payload = _children(root, "payload")
@@ -294,6 +344,13 @@ def read_irml(path: str | os.PathLike[str]) -> RobotDescription:
     """
     p = Path(path)
     try:
+        if p.exists() and not p.is_file():
+            what = "is a folder" if p.is_dir() else "is not a regular file"
+            raise InvalidRobotDescription(f"{p}: {what}; give the path of an .irml file")
+        if p.exists() and p.stat().st_size > MAX_BYTES:
+            raise InvalidRobotDescription(
+                f"{p}: is larger than {MAX_BYTES >> 20} MiB; an IRML file is a few kB"
+            )
         data = p.read_bytes()
     except OSError as err:
         raise InvalidRobotDescription(f"{p}: cannot be read ({err.strerror})") from err
