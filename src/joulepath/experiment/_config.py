@@ -37,7 +37,8 @@ Example (``joulepath/experiment/presets/demo.toml``, abridged)::
 
 Sections left out take their defaults; ``[synth]`` and ``[bench]`` are skipped unless
 they are given (``methods`` non-empty, ``tasks`` ≥ 1). A wrong key or value stops the
-run at once with the file, the section and key, and the allowed keys or values.
+run at once with the file, the section and key, and the allowed keys or values. Every
+count, ``jobs`` and ``seed`` has a range (:data:`BOUNDS`), checked before anything runs.
 """
 
 from __future__ import annotations
@@ -160,18 +161,52 @@ _ALLOWED: dict[str, tuple[str, ...]] = {
     "families": ("mlp", "svr", "par", "xgb"),
     "targets": ALL_TARGETS,
 }
-_MAY_BE_ZERO = {"seed", "micro_moves", "sim_moves", "tasks"}
-_MINIMUM = {"cv": 2, "population": 4, "batch_size": 2}
+BOUNDS: dict[str, dict[str, tuple[int, int]]] = {
+    "": {"seed": (0, 2**32 - 1), "jobs": (1, 256)},
+    "data": {
+        "train_moves": (1, 20_000),
+        "test_moves": (1, 20_000),
+        "micro_moves": (0, 20_000),
+        "sim_moves": (0, 20_000),
+    },
+    "synth": {"rows": (1, 1_000_000), "epochs": (1, 10_000), "batch_size": (2, 100_000)},
+    "train": {"cv": (2, 20)},
+    "importance": {"max_rows": (1, 1_000_000)},
+    "optimize": {"tasks": (0, 1_000), "generations": (1, 10_000), "population": (4, 10_000)},
+    "bench": {"tasks": (0, 10_000), "generations": (1, 10_000), "population": (4, 10_000)},
+}
+"""Allowed range (inclusive) of every integer setting, by section (``""``: top level).
+
+The upper bounds are about 10× (data, synthesis) to 500× (bench tasks) the thesis plan,
+so that a typo such as ``train_moves = 1_000_000_000_000`` is refused at once instead of
+running out of memory or running for years.
+"""
 _TYPE_NAMES = {int: "an integer", str: "a string", bool: "true or false", float: "a number"}
+_MAX_FILE_BYTES = 1 << 20
+_MAX_TEXT = 200
+_MAX_LIST = 64
+
+
+def _show(value: object) -> str:
+    """``repr`` of a value, cut short for a one-line message."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _has_control(text: str) -> bool:
+    return any(ord(c) < 32 or ord(c) == 127 for c in text)
 
 
 def _section(cls: Any, raw: dict[str, Any], where: str, source: str) -> Any:
     hidden = {*SECTIONS, "source"} if cls is Experiment else set()
     names = {f.name: f for f in fields(cls) if f.name not in hidden}
+    bounds = BOUNDS[where.strip().strip("[]")]
     kwargs: dict[str, Any] = {}
     for key, value in raw.items():
         if key not in names:
-            raise InvalidInput(f"{source}: {where}unknown key {key!r}; allowed: {', '.join(sorted(names))}")
+            raise InvalidInput(
+                f"{source}: {where}unknown key {_show(key)}; allowed: {', '.join(sorted(names))}"
+            )
         default = names[key].default
         if key == "name":
             default = ""
@@ -179,29 +214,50 @@ def _section(cls: Any, raw: dict[str, Any], where: str, source: str) -> Any:
         if isinstance(default, tuple):
             if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
                 raise InvalidInput(
-                    f"{source}: {where}{key} must be a list of strings, got {value!r}; "
+                    f"{source}: {where}{key} must be a list of strings, got {_show(value)}; "
                     f'write it as {key} = ["…", "…"]'
                 )
             bad = [v for v in value if allowed and v not in allowed]
             if bad:
                 raise InvalidInput(
-                    f"{source}: {where}{key} has {bad[0]!r}, which is not allowed; "
+                    f"{source}: {where}{key} has {_show(bad[0])}, which is not allowed; "
                     f"use some of {', '.join(allowed or ())}"
+                )
+            if len(value) > _MAX_LIST:
+                raise InvalidInput(f"{source}: {where}{key} has {len(value)} items; at most {_MAX_LIST}")
+            twice = sorted({v for v in value if value.count(v) > 1})
+            if twice:
+                raise InvalidInput(
+                    f"{source}: {where}{key} names {_show(twice[0])} more than once; list each once"
+                )
+            if any(not v or len(v) > 4096 or "\x00" in v for v in value):
+                raise InvalidInput(
+                    f"{source}: {where}{key} has an empty, over-long or NUL-containing item; "
+                    "give plain names or paths"
                 )
             value = tuple(value)
         elif type(value) is not type(default):
             raise InvalidInput(
                 f"{source}: {where}{key} must be {_TYPE_NAMES.get(type(default), type(default).__name__)}, "
-                f"got {value!r}"
+                f"got {_show(value)}"
             )
         elif allowed and value not in allowed:
             raise InvalidInput(
-                f"{source}: {where}{key} = {value!r} is not allowed; use one of {', '.join(allowed)}"
+                f"{source}: {where}{key} = {_show(value)} is not allowed; use one of {', '.join(allowed)}"
             )
         elif isinstance(value, int) and not isinstance(value, bool):
-            low = 0 if key in _MAY_BE_ZERO else _MINIMUM.get(key, 1)
-            if value < low:
-                raise InvalidInput(f"{source}: {where}{key} must be ≥ {low}, got {value}")
+            low, high = bounds[key]
+            if not low <= value <= high:
+                side = f"must be ≥ {low}" if value < low else f"must be ≤ {high:_}"
+                raise InvalidInput(
+                    f"{source}: {where or '[top level] '}{key} {side}, got {value:_}; "
+                    f"the allowed range is {low}..{high:_}"
+                )
+        elif isinstance(value, str) and key != "name" and (len(value) > _MAX_TEXT or _has_control(value)):
+            raise InvalidInput(
+                f"{source}: {where}{key} = {_show(value)} is over {_MAX_TEXT} characters "
+                "or holds control characters; give a plain value"
+            )
         kwargs[key] = value
     return cls(**kwargs)
 
@@ -247,7 +303,16 @@ def load_experiment(path: str | os.PathLike[str]) -> Experiment:
     p = Path(path)
     source = str(p)
     try:
+        if p.exists() and not p.is_file():
+            what = "is a folder" if p.is_dir() else "is not a regular file"
+            raise InvalidInput(f"{source}: {what}; give a path to a TOML file, or 'demo'")
+        if p.exists() and p.stat().st_size > _MAX_FILE_BYTES:
+            raise InvalidInput(
+                f"{source}: is larger than {_MAX_FILE_BYTES >> 20} MiB; an experiment file is a few kB"
+            )
         raw = tomllib.loads(p.read_text(encoding="utf-8"))
+    except InvalidInput:
+        raise
     except FileNotFoundError as err:
         raise InvalidInput(
             f"{source}: no such experiment file; give a path to a TOML file, or 'demo'"
@@ -258,18 +323,31 @@ def load_experiment(path: str | os.PathLike[str]) -> Experiment:
         raise InvalidInput(f"{source}: not UTF-8 text ({err.reason}); save it as UTF-8") from err
     except tomllib.TOMLDecodeError as err:
         raise InvalidInput(f"{source}: not valid TOML ({err}); fix the syntax there") from err
+    except (ValueError, RecursionError, MemoryError) as err:  # e.g. arrays nested thousands deep
+        raise InvalidInput(f"{source}: not valid TOML ({type(err).__name__}); fix the syntax there") from err
     top = {k: v for k, v in raw.items() if not isinstance(v, dict)}
     sections = {k: v for k, v in raw.items() if isinstance(v, dict)}
     unknown = sorted(set(sections) - set(SECTIONS))
     if unknown:
         raise InvalidInput(
-            f"{source}: unknown section [{unknown[0]}]; allowed: {', '.join(f'[{s}]' for s in SECTIONS)}"
+            f"{source}: unknown section [{_show(unknown[0])[1:-1]}]; "
+            f"allowed: {', '.join(f'[{s}]' for s in SECTIONS)}"
         )
     if "name" not in top:
         raise InvalidInput(f"{source}: missing key 'name' at the top of the file; add name = \"my-study\"")
     exp = _section(Experiment, top, "", source)
-    if not exp.name or any(c in exp.name for c in '/\\:*?"<>|'):
-        raise InvalidInput(f"{source}: name {exp.name!r} must be a non-empty folder name without / \\ : * ?")
+    name = exp.name
+    if (
+        not name.strip()
+        or name in (".", "..")
+        or len(name) > 100
+        or _has_control(name)
+        or any(c in name for c in '/\\:*?"<>|')
+    ):
+        raise InvalidInput(
+            f"{source}: name {_show(name)} must be a folder name of 1 to 100 characters, not . or .., "
+            "without / \\ : * ? or control characters"
+        )
     parts = {
         name: _section(cls, sections.get(name, {}), f"[{name}] ", source) for name, cls in SECTIONS.items()
     }
