@@ -11,7 +11,9 @@ Provenance of every number:
   (R, t) the constant transform from URDF link frame i to DH frame i, computed here
   at q = 0 and checked at random q by tests/description/test_presets.py); ranges and
   max speeds of the ABB data sheet ROB0149EN_D; range sets "lab" (thesis Table 3.1)
-  and "collection" (thesis Appendix D.1).
+  and "collection" (thesis Appendix D.1). No <effort> (torque) limits: no public source
+  gives them for the IRB 120 (the ROS-I URDF has effort="0", i.e. unspecified; ABB's
+  product specification gives wrist inertia limits only); see presets/NOTICE.txt.
 
 Run from the repository root:  python scripts/make_irb120_preset.py
 """

@@ -7,7 +7,8 @@ def test_main_robot_show_bundled(capsys):
     assert main(["robot", "show", "irb120"]) == 0
     out = capsys.readouterr().out
     assert "ABB IRB 120" in out and "(374.0, 0.0, 630.0) mm" in out
-    assert "physical check: 0 error(s), 1 warning(s)" in out
+    assert "physical check: 0 error(s), 2 warning(s)" in out
+    assert "torque N·m" in out and "no torque (effort) limit" in out
 
 
 def test_main_robot_show_appendix_c_lists_problems(capsys, appendix_c_path):
@@ -56,3 +57,46 @@ def test_main_version_and_unknown_command(capsys):
     assert main(["--version"]) == 0
     assert "joulepath 0.1.0" in capsys.readouterr().out
     assert main(["frobnicate"]) == 2
+
+
+def _zero_axis_urdf(tmp_path):
+    from joulepath.description import preset_path
+
+    text = preset_path("irb120", fmt="urdf").read_text()
+    path = tmp_path / "zero_axis.urdf"
+    path.write_text(text.replace('<axis xyz="0 1 0"/>', '<axis xyz="0 0 0"/>', 1))
+    return path
+
+
+def test_main_robot_show_reports_what_other_commands_refuse(capsys, tmp_path):
+    bad = _zero_axis_urdf(tmp_path)
+    assert main(["robot", "show", str(bad)]) == 0
+    out = capsys.readouterr().out
+    assert "physical check: 1 error(s)" in out and "<axis>: rotation axis [0, 0, 0] is zero" in out
+    assert "experts can use it with --unchecked" in out
+
+
+def test_main_robot_fk_refuses_an_unphysical_robot_unless_unchecked(capsys, tmp_path):
+    bad = _zero_axis_urdf(tmp_path)
+    assert main(["robot", "fk", str(bad), "--q", "0,0,0,0,0,0"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "fails the physical check" in err[0] and "is zero" in err[0]
+    assert main(["robot", "fk", str(bad), "--q", "0,0,0,0,0,0", "--unchecked"]) == 0
+    captured = capsys.readouterr()
+    assert "374.000 0.000 630.000" in captured.out
+    assert captured.err.startswith("warning: --unchecked:") and "is zero" in captured.err
+
+
+def test_main_optimize_refuses_an_unphysical_robot_and_writes_nothing(capsys, tmp_path):
+    from joulepath.description import preset_path
+
+    text = preset_path("irb120", fmt="urdf").read_text()
+    bad = tmp_path / "negative_mass.urdf"
+    bad.write_text(text.replace('<mass value="3.909"/>', '<mass value="-3.909"/>', 1))
+    out = tmp_path / "out"
+    argv = ["optimize", "--start", "0,0,0,0,0,0", "--end", "0.5,0,0,0,0,0", "--duration", "1"]
+    argv += ["--fitness", "physics", "--robot", str(bad), "--out", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "mass -3.909 kg is not positive" in err[0]
+    assert not out.exists()

@@ -1,12 +1,50 @@
-"""``joulepath robot ...``: look at a robot description."""
+"""``joulepath robot ...``: look at a robot description; the CLI's one way to load a robot."""
 
 from __future__ import annotations
+
+import sys
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from joulepath.cli._common import console, parse_joints
 
+if TYPE_CHECKING:
+    from joulepath.dynamics import Robot
+
 robot_app = typer.Typer(help="Inspect robot descriptions (IRML, URDF, bundled).", no_args_is_help=True)
+
+UNCHECKED_HELP = (
+    "For experts: use a robot description that fails the physical check "
+    "(negative mass, non-positive-definite inertia, zero axis, missing limits); results may be meaningless."
+)
+
+
+def unchecked_option() -> Any:
+    """The ``--unchecked`` option, for any command that takes a robot."""
+    return typer.Option(False, "--unchecked", help=UNCHECKED_HELP)
+
+
+def load_robot_for_cli(name_or_path: str, *, unchecked: bool = False) -> Robot:
+    """Load a robot for a command: refused with the finding when it fails the physical check.
+
+    With ``unchecked`` (the ``--unchecked`` option) the robot is used anyway and one
+    warning line on stderr names the first error, so that the output of an expert's
+    run is never taken for a checked one.
+    """
+    from joulepath import load_robot
+
+    robot = load_robot(name_or_path, checked=not unchecked)
+    if unchecked:
+        errors = [f for f in robot.check_physical() if f.severity == "error"]
+        if errors:
+            more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+            print(
+                f"warning: --unchecked: using {robot.source}, which fails the physical check: "
+                f"{errors[0].where}: {errors[0].message}{more}",
+                file=sys.stderr,
+            )
+    return robot
 
 
 @robot_app.command("show")
@@ -14,11 +52,11 @@ def show(
     robot: str = typer.Argument(..., help="Bundled robot name (irb120) or an .irml/.urdf path."),
     strict: bool = typer.Option(False, help="Exit with code 1 when the physical check finds errors."),
 ) -> int:
-    """Print a robot's description and its physical-validity check."""
+    """Print a robot's description and its physical-validity check (also for a robot that fails it)."""
     from joulepath import load_robot
 
-    r = load_robot(robot)
-    console.print(r.summary())
+    r = load_robot(robot, checked=False)  # showing what is wrong is this command's job
+    console.print(r.summary(), markup=False)
     home = r.fk(r.home)
     x, y, z = home.position_mm
     w, qx, qy, qz = home.quaternion
@@ -33,6 +71,10 @@ def show(
         console.print(f"physical check: {len(errors)} error(s), {len(findings) - len(errors)} warning(s)")
         for f in findings:
             console.print(f"  {f}", markup=False)
+        if errors:
+            console.print(
+                "  other commands refuse this robot; experts can use it with --unchecked", markup=False
+            )
     return 1 if strict and errors else 0
 
 
@@ -41,11 +83,10 @@ def fk(
     robot: str = typer.Argument(..., help="Bundled robot name or an .irml/.urdf path."),
     q: str = typer.Option(..., "--q", help="Joint positions, comma separated."),
     degrees: bool = typer.Option(False, "--degrees", help="--q is in degrees (default rad)."),
+    unchecked: bool = unchecked_option(),
 ) -> int:
     """Print the tool0 pose for one configuration, in the controller's units."""
-    from joulepath import load_robot
-
-    r = load_robot(robot)
+    r = load_robot_for_cli(robot, unchecked=unchecked)
     values = parse_joints(q, option="--q", degrees=degrees, n=r.n_joints)
     pose = r.fk(values)
     x, y, z = pose.position_mm

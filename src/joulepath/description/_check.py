@@ -6,6 +6,14 @@ triangle inequality, a rotation matrix where a tensor belongs, a centre of mass
 farther from its link than the robot reaches) and a *warning* when they are
 possible but suspicious (link masses far below the data sheet's robot mass, two
 links with identical mass properties).
+
+Limits: a joint without a range (lower and upper) or a speed limit is an *error*,
+because every command that plans or checks motion needs them (random tasks, the
+optimizer's bounds, the limit check before a RAPID program is written); a robot
+without torque (effort) limits only draws a *warning*, since the torque check is
+then skipped. A joint whose rotation axis is zero (or not finite) is an *error*.
+:func:`joulepath.load_robot` refuses a robot with any error unless
+``checked=False``.
 """
 
 from __future__ import annotations
@@ -14,7 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from joulepath.description._model import Inertial, RobotDescription
+from joulepath._typing import FloatArray
+from joulepath.description._model import Chain, Inertial, RobotDescription
 
 
 @dataclass(frozen=True, slots=True)
@@ -119,6 +128,121 @@ def check_inertial(where: str, inertial: Inertial, *, reach: float | None = None
     return out
 
 
+def _joint_list(labels: list[str]) -> str:
+    return labels[0] if len(labels) == 1 else ", ".join(labels[:-1]) + " and " + labels[-1]
+
+
+def check_limits(
+    labels: list[str],
+    lower: FloatArray,
+    upper: FloatArray,
+    velocity: FloatArray,
+    effort: FloatArray,
+    *,
+    tag: str = "<limits>",
+) -> list[Finding]:
+    """Check joint limits: a range and a speed limit for every joint, in order and positive.
+
+    Parameters
+    ----------
+    labels : list of str
+        One label per joint, e.g. ``"joint 3"`` or ``"joint 'joint_3'"``.
+    lower, upper, velocity, effort : ndarray of shape (n,)
+        rad, rad/s, N·m; NaN where the description gives none.
+    tag : str
+        How the file calls its limits element (``"<limits>"`` in IRML, ``"<limit>"`` in URDF).
+
+    Returns
+    -------
+    list of Finding
+        Errors for a missing or empty range and a missing or non-positive speed or
+        torque limit; one warning naming every joint without a torque limit.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> nan = float("nan")
+    >>> findings = check_limits(["joint 1"], np.array([-1.0]), np.array([1.0]),
+    ...                         np.array([nan]), np.array([10.0]))
+    >>> [(f.severity, f.where) for f in findings]
+    [('error', 'joint 1 <limits>')]
+    """
+    out: list[Finding] = []
+    no_effort: list[str] = []
+    for label, lo, hi, v, e in zip(labels, lower, upper, velocity, effort, strict=True):
+        where = f"{label} {tag}"
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            missing = " and ".join(n for n, x in (("lower", lo), ("upper", hi)) if not np.isfinite(x))
+            out.append(
+                Finding(
+                    "error",
+                    where,
+                    f"no {missing} range limit; the optimizer, the random tasks and the limit check "
+                    "before a RAPID program need the joint range: give it in rad",
+                )
+            )
+        elif not lo < hi:
+            out.append(Finding("error", where, f"lower {lo:.6g} ≥ upper {hi:.6g} rad: the range is empty"))
+        if np.isnan(v):
+            out.append(
+                Finding(
+                    "error",
+                    where,
+                    "no speed limit (velocity); the optimizer and the limit check need the joint's "
+                    "maximum speed: give it in rad/s (the data sheet's axis speed)",
+                )
+            )
+        elif not v > 0:
+            out.append(Finding("error", where, f"velocity {v:.6g} rad/s must be positive"))
+        if np.isnan(e):
+            no_effort.append(label)
+        elif not e > 0:
+            out.append(Finding("error", where, f"effort {e:.6g} N·m must be positive"))
+    if no_effort:
+        out.append(
+            Finding(
+                "warning",
+                f"{'every joint' if no_effort == list(labels) else _joint_list(no_effort)} {tag}",
+                "no torque (effort) limit, so the torque check is skipped; give it in N·m to enable it",
+            )
+        )
+    return out
+
+
+def check_axes(labels: list[str], axes: FloatArray) -> list[Finding]:
+    """An error for every joint whose rotation axis is zero or not finite (shape ``(n, 3)``)."""
+    out: list[Finding] = []
+    for label, axis in zip(labels, axes, strict=True):
+        norm = float(np.linalg.norm(axis)) if np.all(np.isfinite(axis)) else float("nan")
+        if not norm > 1e-9:
+            out.append(
+                Finding(
+                    "error",
+                    f"{label} <axis>",
+                    f"rotation axis {_fmt(axis)} is {'zero' if norm == 0 else 'not a direction'}; "
+                    'give the unit axis the joint turns about, e.g. xyz="0 0 1"',
+                )
+            )
+    return out
+
+
+def check_chain(chain: Chain) -> list[Finding]:
+    """List everything not physical about a :class:`Chain` (e.g. one read from a URDF).
+
+    Checks every link's mass properties (:func:`check_inertial`), the joint axes
+    (:func:`check_axes`) and the limits (:func:`check_limits`). Errors first.
+    """
+    labels = [f"joint {name!r}" for name in chain.joint_names]
+    out: list[Finding] = []
+    for i, label in enumerate(labels):
+        body = Inertial.from_arrays(chain.masses[i], chain.coms[i], chain.inertias[i])
+        out += check_inertial(f"link of {label}", body)
+    out += check_axes(labels, chain.axes)
+    out += check_limits(labels, chain.lower, chain.upper, chain.velocity, chain.effort, tag="<limit>")
+    out.sort(key=lambda f: f.severity != "error")
+    return out
+
+
 def check_physical(desc: RobotDescription) -> list[Finding]:
     """List everything not physical about a robot description.
 
@@ -130,8 +254,8 @@ def check_physical(desc: RobotDescription) -> list[Finding]:
     Examples
     --------
     >>> from joulepath.description import preset_description
-    >>> [f.severity for f in check_physical(preset_description("irb120"))]
-    ['warning']
+    >>> [f.where for f in check_physical(preset_description("irb120"))]
+    ['every joint <limits>', '<manipulator-mass>']
     """
     out: list[Finding] = []
     reach = desc.reach_m
@@ -150,12 +274,19 @@ def check_physical(desc: RobotDescription) -> list[Finding]:
                     )
                 )
                 break
-        if j.lower is not None and j.upper is not None and not j.lower < j.upper:
-            out.append(Finding("error", f"joint {j.id} <limits>", f"lower {j.lower} ≥ upper {j.upper}"))
-        if j.velocity is not None and not j.velocity > 0:
-            out.append(Finding("error", f"joint {j.id} <limits> <velocity>", "must be positive"))
-        if j.effort is not None and not j.effort > 0:
-            out.append(Finding("error", f"joint {j.id} <limits> <effort>", "must be positive"))
+    nan = float("nan")
+
+    def arr(values: list[float | None]) -> FloatArray:
+        return np.array([nan if v is None else v for v in values], dtype=float)
+
+    js = desc.joints
+    out += check_limits(
+        [f"joint {j.id}" for j in js],
+        arr([j.lower for j in js]),
+        arr([j.upper for j in js]),
+        arr([j.velocity for j in js]),
+        arr([j.effort for j in js]),
+    )
     for rs in desc.range_sets:
         for j, lo, hi in zip(desc.joints, rs.lower, rs.upper, strict=True):
             if not lo < hi:

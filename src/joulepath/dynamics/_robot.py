@@ -26,6 +26,7 @@ from joulepath.description import (
     preset_path,
     read_irml,
 )
+from joulepath.description._check import check_chain
 from joulepath.dynamics._friction import Friction
 from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le
 from joulepath.dynamics._rnea import PinocchioRnea
@@ -263,28 +264,26 @@ class Robot:
 
     # ----------------------------------------------------------------- checks
     def check_physical(self) -> list[Finding]:
-        """Everything not physical about this robot's description (errors first)."""
+        """Everything not physical about this robot's description (errors first).
+
+        IRML robots are checked on their description (:func:`~joulepath.description.check_physical`),
+        other robots on their chain (mass properties, joint axes, limits).
+        """
         if self.description is not None:
             return check_physical(self.description)
-        out: list[Finding] = []
-        for i, name in enumerate(self.joint_names):
-            body = Inertial.from_arrays(self.chain.masses[i], self.chain.coms[i], self.chain.inertias[i])
-            out += check_inertial(f"link of {name}", body)
-            lo, hi = self.chain.lower[i], self.chain.upper[i]
-            if np.isfinite(lo) and np.isfinite(hi) and not lo < hi:
-                out.append(Finding("error", f"{name} limits", f"lower {lo} ≥ upper {hi}"))
-        out.sort(key=lambda f: f.severity != "error")
-        return out
+        return check_chain(self.chain)
 
     def summary(self) -> str:
         """A few lines describing the robot (used by ``joulepath robot show``)."""
         lines = [f"{self.name}  ({self.n_joints} revolute joints, source: {self.source})"]
         if self.description is not None and self.description.manufacturer:
             lines[0] = f"{self.description.manufacturer} " + lines[0]
-        lines.append("joint        lower°    upper°   speed°/s   mass kg")
+        lines.append("joint        lower°    upper°   speed°/s  torque N·m   mass kg")
         for i, name in enumerate(self.joint_names):
             lo, hi, v = np.degrees([self.chain.lower[i], self.chain.upper[i], self.chain.velocity[i]])
-            lines.append(f"{name:<10} {lo:8.1f}  {hi:8.1f}  {v:8.1f}  {self.chain.masses[i]:8.3f}")
+            e = self.chain.effort[i]
+            torque = f"{e:10.1f}" if np.isfinite(e) else f"{'not given':>10}"
+            lines.append(f"{name:<10} {lo:8.1f}  {hi:8.1f}  {v:8.1f}  {torque}  {self.chain.masses[i]:8.3f}")
         lines.append(f"moving mass {self.chain.masses.sum():.3f} kg")
         if self.payload is not None:
             lines.append(f"payload {self.payload.mass:.3f} kg at {self.payload.com} m (tool0)")
@@ -296,13 +295,38 @@ class Robot:
         return f"Robot(name={self.name!r}, n_joints={self.n_joints}, source={self.source!r})"
 
 
-def load_robot(name_or_path: str | os.PathLike[str], *, tool_frame: str | None = None) -> Robot:
+def load_robot(
+    name_or_path: str | os.PathLike[str], *, tool_frame: str | None = None, checked: bool = True
+) -> Robot:
     """Load a bundled robot by name (``"irb120"``) or a robot file (``.irml`` or ``.urdf``).
+
+    The robot is checked on load (:meth:`Robot.check_physical`): a description with
+    an error (a non-positive mass, an inertia that is not positive definite or breaks
+    the triangle inequality, a zero joint axis, a joint without a range or a speed
+    limit, ...) is refused. Warnings (e.g. no torque limits) are not.
+
+    Parameters
+    ----------
+    name_or_path : str or path
+        A bundled robot's name or a robot file.
+    tool_frame : str, optional
+        URDF only: the frame used as tool0.
+    checked : bool, default True
+        For experts: ``False`` loads a robot that fails the physical check (to
+        inspect it, as ``joulepath robot show`` does); its dynamics may be
+        meaningless or fail inside Pinocchio.
 
     Raises
     ------
     InvalidRobotDescription
-        Unknown name, unreadable or invalid file, unsupported extension.
+        Unknown name, unreadable or invalid file, unsupported extension, or (when
+        ``checked``) a description that fails the physical check; the message
+        names the first error found.
+
+    Examples
+    --------
+    >>> load_robot("irb120").n_joints
+    6
     """
     text = os.fspath(name_or_path)
     if text in PRESETS:
@@ -316,10 +340,27 @@ def load_robot(name_or_path: str | os.PathLike[str], *, tool_frame: str | None =
     suffix = path.suffix.lower()
     if suffix in (".irml", ".xml"):
         desc = read_irml(path)
-        return Robot(chain_from_description(desc), description=desc, source=str(path))
-    if suffix == ".urdf":
-        return Robot(chain_from_urdf(path, tool_frame=tool_frame), source=str(path))
-    raise InvalidRobotDescription(f"{path}: unknown robot file type {suffix!r}; use .irml or .urdf")
+        robot = Robot(chain_from_description(desc), description=desc, source=str(path))
+    elif suffix == ".urdf":
+        robot = Robot(chain_from_urdf(path, tool_frame=tool_frame), source=str(path))
+    else:
+        raise InvalidRobotDescription(f"{path}: unknown robot file type {suffix!r}; use .irml or .urdf")
+    if checked:
+        _refuse_unphysical(robot, text)
+    return robot
+
+
+def _refuse_unphysical(robot: Robot, given: str) -> None:
+    """Raise InvalidRobotDescription naming the first error of the physical check, if any."""
+    errors = [f for f in robot.check_physical() if f.severity == "error"]
+    if not errors:
+        return
+    more = f" (and {len(errors) - 1} more error(s))" if len(errors) > 1 else ""
+    raise InvalidRobotDescription(
+        f"{robot.source}: fails the physical check: {errors[0].where}: {errors[0].message}{more}; "
+        f"fix the description (`joulepath robot show {given}` lists every finding) or, for experts "
+        "only, use it unchecked (load_robot(..., checked=False), --unchecked on the command line)"
+    )
 
 
 __all__ = ["HOME", "METHODS", "Robot", "load_robot"]
