@@ -1,15 +1,31 @@
-"""Small helpers shared by the CLI commands (parsing only; no numerics)."""
+"""Small helpers shared by the CLI commands (parsing and output checks only; no numerics).
+
+Output checks run before any work, so a refused ``--out`` writes nothing:
+
+* an output file must be a regular file or not exist yet (never a folder, a device
+  such as ``/dev/null``, a FIFO or a socket), must not lie under a file, and must not
+  be one of the command's inputs (compared with :func:`os.path.samefile` when both
+  exist, by resolved path otherwise);
+* an output folder must be a folder or not exist yet; the files a command writes in
+  it are checked like output files;
+* the nearest existing folder above the output must be writable.
+"""
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterable
 from pathlib import Path
 
 import typer
 from rich.console import Console
 
+from joulepath._io import check_replaceable
 from joulepath.errors import InvalidInput
 
 console = Console(highlight=False, soft_wrap=True)
+
+PathLike = str | os.PathLike[str]
 
 
 def parse_joints(text: str, *, option: str, degrees: bool, n: int = 6) -> list[float]:
@@ -35,18 +51,83 @@ def _no_file_above(path: Path, option: str) -> None:
         if parent.exists():
             if not parent.is_dir():
                 raise InvalidInput(f"{path}: {parent} is a file, not a folder; choose another {option}")
+            if not os.access(parent, os.W_OK | os.X_OK):
+                raise InvalidInput(
+                    f"{path}: the folder {parent} is not writable (permission denied); "
+                    f"choose another {option}"
+                )
             return
 
 
-def check_out_file(path: Path, *, example: str, option: str = "--out") -> None:
-    """Refuse, before any work, an output file path that is a folder or lies under a file."""
+def same_file(a: PathLike, b: PathLike) -> bool:
+    """Whether two paths name the same file (samefile when both exist, resolved paths otherwise)."""
+    pa, pb = Path(a), Path(b)
+    try:
+        if pa.exists() and pb.exists():
+            return os.path.samefile(pa, pb)
+        return pa.resolve() == pb.resolve()
+    except OSError:
+        return False
+
+
+def _not_an_input(path: Path, inputs: Iterable[PathLike], option: str) -> None:
+    for given in inputs:
+        if str(given) and same_file(path, given):
+            raise InvalidInput(
+                f"{path}: is also an input of this command ({given}); writing there would destroy it: "
+                f"choose another {option}"
+            )
+
+
+def check_out_file(
+    path: Path, *, example: str, option: str = "--out", inputs: Iterable[PathLike] = ()
+) -> None:
+    """Refuse, before any work, an output file path that cannot or must not be written.
+
+    Refused: a folder, anything else that is not a regular file (``/dev/null``, a
+    FIFO, a socket), a path under a file or in an unwritable folder, and any of
+    ``inputs`` (the files the command reads).
+    """
     if path.is_dir():
         raise InvalidInput(f"{path}: is a folder, but {option} needs a file name; give e.g. {path / example}")
+    try:
+        check_replaceable(path)
+    except InvalidInput as err:
+        raise InvalidInput(f"{err} ({option})") from err
     _no_file_above(path, option)
+    _not_an_input(path, inputs, option)
 
 
-def check_out_folder(path: Path, *, option: str = "--out") -> None:
-    """Refuse, before any work, an output folder path that is a file or lies under a file."""
+def check_out_folder(
+    path: Path,
+    *,
+    option: str = "--out",
+    files: Iterable[str] = (),
+    inputs: Iterable[PathLike] = (),
+) -> None:
+    """Refuse, before any work, an output folder path that is not a folder or lies under a file.
+
+    ``files`` are the names the command will write inside the folder: each is
+    checked like :func:`check_out_file` against ``inputs``.
+    """
     if path.exists() and not path.is_dir():
         raise InvalidInput(f"{path}: is a file, but {option} needs a folder; give a new or existing folder")
-    _no_file_above(path, option)
+    _no_file_above(path / "x", option)
+    inputs = list(inputs)
+    _not_an_input(path, inputs, option)
+    for name in files:
+        target = path / name
+        if target.is_dir():
+            raise InvalidInput(
+                f"{target}: is a folder where a file must be written; move it or choose another {option}"
+            )
+        try:
+            check_replaceable(target)
+        except InvalidInput as err:
+            raise InvalidInput(f"{err} ({option})") from err
+        _not_an_input(target, inputs, option)
+
+
+def robot_inputs(robot: str) -> list[str]:
+    """The robot argument as an input path when it names an existing file (else nothing)."""
+    return [robot] if robot and Path(robot).is_file() else []

@@ -6,7 +6,9 @@ from pathlib import Path
 
 import typer
 
-from joulepath.cli._common import check_out_file, check_out_folder, console
+from joulepath.cli._common import check_out_file, check_out_folder, console, robot_inputs
+
+COLLECT_FILES = ("JPCollect.mod", "JPMeasure.mod")
 
 rapid_app = typer.Typer(help="Write RAPID programs for the ABB controller.", no_args_is_help=True)
 
@@ -21,17 +23,31 @@ def rapid_collect(
     seed: int = typer.Option(
         0, min=0, max=2**32 - 1, help="Seed of the moves (table) or of the controller's generator (rand)."
     ),
+    force: bool = typer.Option(
+        False, "--force", help="Replace JPCollect.mod and JPMeasure.mod if --out already holds them."
+    ),
 ) -> int:
-    """Write the data-collection programs of thesis Appendix D (collection + measurement)."""
+    """Write the data-collection programs of thesis Appendix D (collection + measurement).
+
+    Programs already in --out are never replaced silently: the command refuses
+    (exit 2, nothing written) unless --force is given.
+    """
     from joulepath import load_robot
-    from joulepath._io import atomic_write_text
+    from joulepath._io import atomic_write_text, make_folder
+    from joulepath.errors import InvalidInput
     from joulepath.export import collection_programs
 
-    check_out_folder(out)
+    check_out_folder(out, files=COLLECT_FILES, inputs=robot_inputs(robot))
+    existing = [name for name in COLLECT_FILES if (out / name).exists()]
+    if existing and not force:
+        raise InvalidInput(
+            f"{out}: already holds {' and '.join(existing)}; pass --force to replace "
+            f"{'them' if len(existing) > 1 else 'it'}, or choose another --out"
+        )
     programs = collection_programs(
         load_robot(robot), n_moves=moves, range_set=range_set, mode=mode, seed=seed
     )
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     for name, text in programs.items():
         atomic_write_text(out / name, text)
         console.print(f"wrote {out / name}")
@@ -50,13 +66,19 @@ def simulate(
     workers: int = typer.Option(2, min=1, help="Processes for --plan."),
 ) -> int:
     """Simulate data collection: random moves on the sim or lab plant, logged like the controller."""
+    from joulepath.data import moves_sidecar_path as sidecar_path
     from joulepath.sim import simulate as run
     from joulepath.sim import simulate_plan
 
+    inputs = robot_inputs(robot)
     if out.suffix == ".csv" and not plan:
-        check_out_file(out, example="lab.csv")
+        check_out_file(out, example="lab.csv", inputs=inputs)
+        check_out_file(sidecar_path(out), example="lab.moves.csv", inputs=inputs)
+    elif plan:
+        check_out_folder(out, inputs=inputs)
     else:
-        check_out_folder(out)
+        name = f"{plant}-{seed}.csv"
+        check_out_folder(out, files=(name, sidecar_path(Path(name)).name), inputs=inputs)
     if plan:
         if plan != "thesis":
             raise typer.BadParameter(f"unknown plan {plan!r}; the only plan is 'thesis'", param_hint="--plan")
@@ -77,7 +99,8 @@ def simulate(
     with console.status(f"simulating {moves} moves on the {plant} plant..."):
         res = run(target, plant=plant, n_moves=moves, seed=seed, robot=robot)
     console.print(
-        f"wrote {res.log} ({res.n_rows:,} rows, {res.n_moves} moves, {res.duration_s:.1f} s) and {res.moves}"
+        f"wrote {res.log} ({res.n_rows:,} rows, {res.n_moves} moves: simulated {res.duration_s:.1f} s "
+        f"of robot motion) and {res.moves}"
     )
     return 0
 
@@ -90,15 +113,20 @@ def ingest(
         help="Robot of the logs: checks controller logs' TCP, gives generic logs all 40 features.",
     ),
 ) -> int:
-    """Turn joint logs into the 40-feature energy table (or the joint-only one)."""
+    """Turn joint logs into the 40-feature energy table (or the joint-only one).
+
+    The `.moves.csv` files that `joulepath simulate` writes beside its logs are
+    skipped with a note, so `ingest logs/*.csv` works on its folder.
+    """
     from joulepath import load_robot
+    from joulepath._io import make_folder
     from joulepath.data import ingest as run
     from joulepath.data import save_table
 
-    check_out_file(out, example="table.parquet")
+    check_out_file(out, example="table.parquet", inputs=[*logs, *robot_inputs(robot)])
     r = load_robot(robot) if robot else None
-    table = run([str(p) for p in logs], robot=r, progress=lambda p: console.print(f"read {p}"))
-    out.parent.mkdir(parents=True, exist_ok=True)
+    table = run([str(p) for p in logs], robot=r, progress=console.print)
+    make_folder(out.parent)
     save_table(table, out)
     console.print(
         f"wrote {out}: {len(table.frame):,} rows, {table.n_moves} moves, "

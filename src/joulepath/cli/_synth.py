@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from joulepath.cli._common import check_out_file, check_out_folder, console
+from joulepath.cli._common import check_out_file, check_out_folder, console, robot_inputs
 
 
 def synth(
@@ -33,14 +33,17 @@ def synth(
 ) -> int:
     """Grow a small real energy table into a synthetic one (SDV; thesis §3.4)."""
     from joulepath import load_robot
+    from joulepath._io import make_folder
     from joulepath.data import load_table, save_table
     from joulepath.errors import InvalidInput
-    from joulepath.synth import SynthConfig, Synthesizer, synthesize
+    from joulepath.synth import SynthConfig, Synthesizer, sidecar_path, synthesize
     from joulepath.synth import repair_kinematics as repair
 
-    check_out_file(out, example="synthetic.parquet")
+    inputs = [p for p in (source, model) if p is not None] + robot_inputs(robot)
+    check_out_file(out, example="synthetic.parquet", inputs=inputs)
     if save_model is not None:
-        check_out_file(save_model, example="synthesizer.pkl", option="--save-model")
+        check_out_file(save_model, example="synthesizer.pkl", option="--save-model", inputs=[*inputs, out])
+        check_out_file(sidecar_path(save_model), example="synthesizer.pkl.json", option="--save-model")
     both = "give exactly one of --from TABLE (fit a synthesizer) or --model FILE (sample a saved one)"
     if model is not None:
         if source is not None:
@@ -59,7 +62,7 @@ def synth(
                 "recompute; leave the option out, or use a full40 table (`joulepath ingest --robot`)"
             )
         if save_model is not None:
-            save_model.parent.mkdir(parents=True, exist_ok=True)
+            make_folder(save_model.parent)
         table = synthesize(
             real,
             n_rows=rows,
@@ -70,10 +73,11 @@ def synth(
         )
     else:
         raise InvalidInput(both)
-    out.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(out.parent)
     save_table(table, out)
+    seeded = f" (seed {seed})" if model is None else f" (sampled from {model})"
     console.print(
-        f"wrote {out}: {len(table.frame):,} synthetic rows, feature set {table.feature_set}"
+        f"wrote {out}: {len(table.frame):,} synthetic rows, feature set {table.feature_set}{seeded}"
         + (", TCP columns recomputed from q" if repair_kinematics else "")
     )
     return 0
@@ -81,17 +85,28 @@ def synth(
 
 def compare(
     tables: list[Path] = typer.Argument(..., help="Energy tables (.parquet); the first is the reference."),
-    out: Path = typer.Option(Path("compare"), "--out", help="Folder for the distribution plots (PNG)."),
+    out: Path = typer.Option(
+        Path("compare"),
+        "--out",
+        help="Folder for the distribution plots (PNG) and the statistics (statistics.csv).",
+    ),
     quality: bool = typer.Option(False, "--quality", help="Score each table against the first (SDMetrics)."),
     robot: str = typer.Option(
         "", "--robot", help="Also report the share of rows within 5 mm of this robot's FK(q)."
     ),
 ) -> int:
-    """Print per-column statistics of energy tables and write distribution overlays."""
+    """Print and write per-column statistics of energy tables, and write distribution overlays.
+
+    --out receives statistics.csv (one row per table column and table, one column
+    per statistic), scores.csv with --quality or --robot (one row per table), and
+    one PNG per feature group.
+    """
     from joulepath.data import load_table
+    from joulepath.synth import FEATURE_GROUPS, SCORES_FILE, STATISTICS_FILE
     from joulepath.synth import compare as run
 
-    check_out_folder(out)
+    files = (STATISTICS_FILE, SCORES_FILE, *(f"{g}.png" for g in FEATURE_GROUPS))
+    check_out_folder(out, files=files, inputs=[*tables, *robot_inputs(robot)])
     named = {}
     for path in tables:
         name = path.stem
@@ -100,5 +115,7 @@ def compare(
             name, k = f"{path.stem}-{k}", k + 1
         named[name] = load_table(path)
     result = run(named, out_dir=out, quality=quality, robot=robot or None)
+    written = result.write(out)
     console.print(result.to_text(), markup=False)
+    console.print("\nwrote " + " and ".join(str(p) for p in written), markup=False)
     return 0

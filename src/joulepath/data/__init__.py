@@ -1,7 +1,14 @@
 """Data: joint logs (controller and generic), the energy-table schema, ingestion."""
 
-from joulepath.data._features import segment_moves, tcp_columns
-from joulepath.data._logs import JointLog, controller_log_text, read_log, write_controller_log
+from joulepath.data._features import find_gaps, segment_moves, tcp_columns
+from joulepath.data._logs import (
+    JointLog,
+    controller_log_text,
+    is_moves_sidecar,
+    moves_sidecar_path,
+    read_log,
+    write_controller_log,
+)
 from joulepath.data._schema import (
     FEATURE_SETS,
     FEATURES_FULL,
@@ -24,8 +31,11 @@ __all__ = [
     "TARGETS",
     "check_columns",
     "controller_log_text",
+    "find_gaps",
     "ingest",
+    "is_moves_sidecar",
     "load_table",
+    "moves_sidecar_path",
     "read_log",
     "save_table",
     "segment_moves",

@@ -21,6 +21,29 @@ CORNER_DIP = 0.6
 CORNER_TURN_DEG = 30.0
 """... or a dip where the direction of joint motion turns by more than this angle."""
 
+GAP_FACTOR = 2.0
+"""A step in ``t`` longer than this many median sample periods is a gap: the log stops there."""
+
+
+def find_gaps(t: FloatArray) -> np.ndarray:
+    """Indices ``k`` where ``t[k] - t[k-1]`` exceeds :data:`GAP_FACTOR` median sample periods.
+
+    A gap means the logger stopped (a pause, a lost connection, two recordings in
+    one file). Ingestion ends the move before a gap and starts a new one after it,
+    and gives the sample before the gap the median period as its length, so a gap
+    never becomes one row whose ``dt`` spans the pause.
+
+    Examples
+    --------
+    >>> find_gaps(np.array([0.0, 0.025, 0.05, 3600.0, 3600.025, 3600.05])).tolist()
+    [3]
+    """
+    if t.size < 3:
+        return np.zeros(0, dtype=np.int64)
+    step = np.diff(t)
+    period = float(np.median(step))
+    return (np.nonzero(step > GAP_FACTOR * period)[0] + 1).astype(np.int64)
+
 
 def segment_moves(t: FloatArray, qd: FloatArray, *, speed_scale: FloatArray | None = None) -> np.ndarray:
     """Label each sample with the move it belongs to; -1 for idle samples before the first move.
@@ -150,6 +173,9 @@ def log_to_frame(
 ) -> pd.DataFrame:
     """Energy-table rows of one log.
 
+    Moves end at every gap in ``t`` (:func:`find_gaps`); the sample before a gap
+    lasts the median sample period.
+
     Parameters
     ----------
     log : JointLog
@@ -162,14 +188,27 @@ def log_to_frame(
         Added to the move labels (to keep ``move_id`` unique across files).
     """
     t = log.t
+    gaps = find_gaps(t)
+    chunk = np.zeros(t.size, dtype=np.int64)
+    chunk[gaps] = 1
+    chunk = np.cumsum(chunk)
     if log.move is not None:
-        _, labels = np.unique(log.move, return_inverse=True)
-        labels = labels.astype(np.int64)
+        # a gap splits a move: one label per (stretch between gaps, move) pair, in order
+        _, labels = np.unique(np.column_stack([chunk, log.move]), axis=0, return_inverse=True)
+        labels = labels.reshape(-1).astype(np.int64)
         keep = np.ones(t.size, dtype=bool)
     else:
-        labels = segment_moves(t, log.qd, speed_scale=speed_scale)
+        labels = np.full(t.size, -1, dtype=np.int64)
+        bounds = np.r_[0, gaps, t.size]
+        n_seen = 0
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+            part = segment_moves(t[a:b], log.qd[a:b], speed_scale=speed_scale)
+            labels[a:b] = np.where(part >= 0, part + n_seen, -1)
+            n_seen += int(part.max()) + 1 if part.size else 0
         keep = labels >= 0
     dt = sample_lengths(t)
+    if gaps.size:
+        dt[gaps - 1] = float(np.median(np.diff(t)))
     idx = np.nonzero(keep)[0]
     t, labels, dt = t[idx], labels[idx], dt[idx]
     q, qd, tau = log.q[idx], log.qd[idx], log.tau[idx]
@@ -199,4 +238,4 @@ def log_to_frame(
     return frame[list(table_columns(feature_set))]
 
 
-__all__ = ["FEATURE_SETS", "TARGETS", "log_to_frame", "sample_lengths", "segment_moves"]
+__all__ = ["FEATURE_SETS", "TARGETS", "find_gaps", "log_to_frame", "sample_lengths", "segment_moves"]

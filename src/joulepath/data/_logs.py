@@ -11,8 +11,17 @@ joint, ``q{i}`` (rad), ``dq{i}`` (rad/s), ``tau{i}`` (N·m); optional ``ddq{i}``
 
 Files are parsed block by block with pyarrow's streaming CSV reader. When that
 fails, a line-by-line pass finds the exact line and field to report. Every check
-(header, field count, numbers, NaN, strictly increasing time, duplicated rows,
-plausible units) reports file and line; nothing is written for a log that fails.
+(UTF-8 text, header, field count, numbers, NaN, strictly increasing time, duplicated
+rows, at least :data:`MIN_ROWS` samples, plausible units) reports file and line;
+nothing is written for a log that fails.
+
+Units are checked, not assumed: ``t`` must be in seconds (a median sample period
+over :data:`MAX_SAMPLE_PERIOD_S`, or logged speeds about 1000 times the rate of the
+logged positions, mean milliseconds); a speed column that is about 57 times (or 1/57
+of) the rate of its position column means degrees mixed with radians. A generic
+log's header must name exactly joints 1..6: ``q7`` or ``tau0`` is refused, never
+dropped. Gaps in ``t`` are not refused here: ingestion splits the moves there
+(:func:`joulepath.data.find_gaps`).
 """
 
 from __future__ import annotations
@@ -20,6 +29,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,12 +39,26 @@ import pyarrow.csv as pacsv
 
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
-from joulepath.data._schema import GENERIC_REQUIRED, LOG_COLUMNS, N_JOINTS
+from joulepath.data._schema import (
+    GENERIC_REQUIRED,
+    LOG_COLUMNS,
+    MOVES_SIDECAR_COLUMNS,
+    MOVES_SIDECAR_SUFFIX,
+    N_JOINTS,
+)
 from joulepath.errors import InvalidLog
 from joulepath.units import DEG, MM
 
 _MAX_REPORTED = 5
 _BLOCK = 1 << 22  # 4 MiB blocks
+
+MIN_ROWS = 3
+"""Fewest data lines a log may hold (central differences need three samples)."""
+
+MAX_SAMPLE_PERIOD_S = 1.0
+"""Largest median sample period, s; above it ``t`` is taken for milliseconds and refused."""
+
+_JOINT_COLUMN = re.compile(r"^(q|dq|ddq|tau)(\d+)$")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -85,14 +109,28 @@ def _fail(source: str, problems: list[str], fix: str = "") -> InvalidLog:
     return InvalidLog(f"{source}: {text}" + (f" ({fix})" if fix else ""))
 
 
+def _not_utf8(source: str, data: bytes, err: UnicodeDecodeError, base: int = 0) -> InvalidLog:
+    """InvalidLog naming the line and byte offset of the first byte that is not UTF-8."""
+    pos = base + err.start
+    line = data.count(b"\n", 0, err.start) + 1
+    bad = data[err.start : err.start + 1].hex()
+    return InvalidLog(
+        f"{source}: line {line} (byte offset {pos}): byte 0x{bad} is not UTF-8 text; "
+        "is this a CSV log? save it as UTF-8 (or plain ASCII) CSV"
+    )
+
+
 def _read_header(path: Path, source: str) -> list[str]:
     try:
-        with path.open("r", encoding="utf-8", newline="") as fh:
-            first = fh.readline()
+        with path.open("rb") as fh:
+            raw = fh.readline()
     except OSError as err:
         raise InvalidLog(f"{source}: cannot be read ({err.strerror})") from err
+    try:
+        first = raw.decode("utf-8")
     except UnicodeDecodeError as err:
-        raise InvalidLog(f"{source}: line 1: not UTF-8 text; is this a CSV log?") from err
+        raise _not_utf8(source, raw, err) from err
+    first = first.removeprefix("\ufeff")  # a byte-order mark some spreadsheet programs write
     if not first.strip():
         raise InvalidLog(
             f"{source}: is empty; a log starts with a header line such as '{','.join(LOG_COLUMNS[:4])},...'"
@@ -100,14 +138,67 @@ def _read_header(path: Path, source: str) -> list[str]:
     return [h.strip() for h in first.strip().split(",")]
 
 
+def is_moves_sidecar(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` is the ``.moves.csv`` sidecar ``joulepath simulate`` writes beside a log.
+
+    Recognised by its header (``move,t_start,t_end,speed,zone,j1_deg,...``), not
+    by its name alone; a file that cannot be read is not a sidecar.
+    """
+    try:
+        with Path(path).open("rb") as fh:
+            first = fh.readline(4096).decode("utf-8", errors="replace")
+    except OSError:
+        return False
+    header = [h.strip() for h in first.strip().split(",")]
+    k = len(MOVES_SIDECAR_COLUMNS)
+    joints = header[k:]
+    return (
+        tuple(header[:k]) == MOVES_SIDECAR_COLUMNS
+        and len(joints) > 0
+        and joints == [f"j{i + 1}_deg" for i in range(len(joints))]
+    )
+
+
+def moves_sidecar_path(log: str | os.PathLike[str]) -> Path:
+    """The sidecar path beside a log: ``logs/lab.csv`` -> ``logs/lab.moves.csv``."""
+    p = Path(log)
+    return p.with_name(p.name.removesuffix(".csv") + MOVES_SIDECAR_SUFFIX)
+
+
+def _check_joint_columns(header: list[str], source: str) -> None:
+    """Refuse generic-log columns of joints other than 1..6 (never drop them)."""
+    other = sorted(
+        {
+            int(m.group(2))
+            for h in header
+            if (m := _JOINT_COLUMN.match(h)) and not 1 <= int(m.group(2)) <= N_JOINTS
+        }
+    )
+    if other:
+        cols = [h for h in header if (m := _JOINT_COLUMN.match(h)) and int(m.group(2)) in other]
+        n = max([N_JOINTS, *other])
+        raise InvalidLog(
+            f"{source}: line 1: column(s) {', '.join(cols)} name joint(s) {', '.join(map(str, other))}, "
+            f"but joulepath reads logs of 6-joint arms (q1..q6, dq1..dq6, tau1..tau6)"
+            + (f"; this looks like a {n}-joint log" if n > N_JOINTS else "")
+            + ": log a 6-joint arm, or remove those columns if they are not joints of the arm"
+        )
+
+
 def detect_kind(header: list[str], source: str) -> str:
     """``"controller"`` or ``"generic"`` from a header; InvalidLog for anything else."""
     if tuple(header) == LOG_COLUMNS:
         return "controller"
+    if tuple(header[: len(MOVES_SIDECAR_COLUMNS)]) == MOVES_SIDECAR_COLUMNS:
+        raise InvalidLog(
+            f"{source}: line 1: this is the list of programmed moves that `joulepath simulate` writes "
+            f"beside its log (*{MOVES_SIDECAR_SUFFIX}), not a joint log; give the log itself"
+        )
     if "x" not in header and all(c in header for c in GENERIC_REQUIRED):
         dup = sorted({h for h in header if header.count(h) > 1})
         if dup:
             raise InvalidLog(f"{source}: line 1: duplicated column(s) {', '.join(dup)}")
+        _check_joint_columns(header, source)
         return "generic"
     if len(header) == len(LOG_COLUMNS) or "x" in header:
         wrong = [
@@ -137,8 +228,12 @@ def _diagnose(path: Path, source: str, header: list[str]) -> InvalidLog:
     """Line-by-line pass that names the lines and fields pyarrow could not parse."""
     problems: list[str] = []
     n = len(header)
-    with path.open("r", encoding="utf-8", newline="") as fh:
-        lines = fh.read().split("\n")
+    data = path.read_bytes()
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        return _not_utf8(source, data, err)
+    lines = text.split("\n")
     last = len(lines)
     while last > 1 and not lines[last - 1].strip():
         last -= 1
@@ -188,6 +283,11 @@ def _parse(path: Path, source: str, header: list[str]) -> dict[str, np.ndarray]:
     out = {h: (np.concatenate(v) if v else np.empty(0)) for h, v in chunks.items()}
     if out["t"].size == 0:
         raise InvalidLog(f"{source}: has a header but no data lines")
+    if out["t"].size < MIN_ROWS:
+        raise InvalidLog(
+            f"{source}: has only {out['t'].size} data line(s); a log needs at least {MIN_ROWS} samples "
+            "of a moving arm: log a whole move"
+        )
     return out
 
 
@@ -219,6 +319,24 @@ def _check_rows(cols: dict[str, np.ndarray], header: list[str], source: str) -> 
                 for k in back
             ],
             "time must strictly increase; are two logs concatenated?",
+        )
+
+
+def _check_time_unit(t: FloatArray, q: FloatArray, qd: FloatArray, source: str) -> None:
+    """Refuse ``t`` that is not in seconds (milliseconds, most likely)."""
+    period = float(np.median(np.diff(t)))
+    if period > MAX_SAMPLE_PERIOD_S:
+        raise InvalidLog(
+            f"{source}: column t advances {period:g} per sample (median); in seconds that is slower "
+            f"than one sample per {MAX_SAMPLE_PERIOD_S:g} s: is t in milliseconds? t must be in seconds "
+            "(divide it by 1000)"
+        )
+    ratios = _unit_ratio(q, qd, t)
+    finite = ratios[np.isfinite(ratios)]
+    if finite.size and abs(np.log(np.median(finite) / 1000.0)) < 0.4:
+        raise InvalidLog(
+            f"{source}: the logged speeds dq are about {np.median(finite):.0f} times the rate of change "
+            "of q over t: is t in milliseconds? t must be in seconds (divide it by 1000)"
         )
 
 
@@ -291,6 +409,7 @@ def read_log(path: str | os.PathLike[str]) -> JointLog:
     q = np.column_stack([cols[f"q{i}"] for i in joints])
     qd = np.column_stack([cols[f"dq{i}"] for i in joints])
     tau = np.column_stack([cols[f"tau{i}"] for i in joints])
+    _check_time_unit(t, q, qd, source)
     _check_units(q, qd, t, source, kind)
     if kind == "controller":
         quat = np.column_stack([cols[c] for c in ("e1", "e2", "e3", "e4")])

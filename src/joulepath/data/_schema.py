@@ -49,6 +49,13 @@ GENERIC_REQUIRED: tuple[str, ...] = (
 )
 """Required columns of the generic joint log (s, rad, rad/s, N·m); optional ``ddq{i}`` and ``move``."""
 
+MOVES_SIDECAR_COLUMNS: tuple[str, ...] = ("move", "t_start", "t_end", "speed", "zone")
+"""First columns of the ``<log>.moves.csv`` sidecar with the programmed moves that
+``joulepath simulate`` writes beside each log (then ``j1_deg``, ``j2_deg``, ...): not a log."""
+
+MOVES_SIDECAR_SUFFIX = ".moves.csv"
+"""Name ending of that sidecar: ``lab.csv`` -> ``lab.moves.csv``."""
+
 JOINT_STATE = tuple(f"{p}{i}" for i in range(1, N_JOINTS + 1) for p in ("q", "dq"))
 JOINT_ACC = tuple(f"ddq{i}" for i in range(1, N_JOINTS + 1))
 

@@ -17,22 +17,30 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from joulepath._io import atomic_write_bytes
-from joulepath.data._features import log_to_frame
-from joulepath.data._logs import JointLog, read_log
+from joulepath.data._features import GAP_FACTOR, REST_SPEED, find_gaps, log_to_frame
+from joulepath.data._logs import JointLog, is_moves_sidecar, read_log
 from joulepath.data._schema import (
     FEATURE_SETS,
     METADATA_KEY,
+    MOVES_SIDECAR_SUFFIX,
+    N_JOINTS,
     SCHEMA_VERSION,
     TARGETS,
     table_columns,
 )
-from joulepath.errors import InvalidLog
+from joulepath.errors import InvalidInput, InvalidLog
 
 if TYPE_CHECKING:
     from joulepath.dynamics import Robot
 
 TCP_TOLERANCE_M = 0.005
 """Largest median distance between a log's TCP columns and FK(q) before ingestion refuses it."""
+
+RANGE_TOLERANCE_RAD = 0.05
+"""How far (rad, about 3 deg) a logged joint may sit outside the robot's range before ingestion refuses it."""
+
+SPEED_TOLERANCE = 1.5
+"""How many times its speed limit a logged joint speed may reach before ingestion refuses it."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -157,6 +165,71 @@ def _check_tcp(log: JointLog, robot: Robot) -> None:
     )
 
 
+def _check_limits(log: JointLog, robot: Robot) -> None:
+    """Refuse logged positions outside ``robot``'s ranges and speeds far beyond its limits.
+
+    Degrees in a radian log (x57) land here even when q and dq are consistent
+    with each other; limits that are unknown (NaN) are not checked.
+    """
+    lower, upper, vmax = robot.lower, robot.upper, robot.velocity_limit
+    problems: list[str] = []
+    for j in range(N_JOINTS):
+        q, qd = log.q[:, j], log.qd[:, j]
+        lo = float(lower[j]) - RANGE_TOLERANCE_RAD if np.isfinite(lower[j]) else -np.inf
+        hi = float(upper[j]) + RANGE_TOLERANCE_RAD if np.isfinite(upper[j]) else np.inf
+        out = np.nonzero((q < lo) | (q > hi))[0]
+        if out.size:
+            k = int(out[np.argmax(np.abs(q[out]))])
+            problems.append(
+                f"line {k + 2}: q{j + 1} = {q[k]:.3f} rad is outside {robot.name}'s range "
+                f"[{lower[j]:.3f}, {upper[j]:.3f}] rad ({out.size} rows)"
+            )
+        if np.isfinite(vmax[j]) and vmax[j] > 0:
+            fast = np.nonzero(np.abs(qd) > SPEED_TOLERANCE * vmax[j])[0]
+            if fast.size:
+                k = int(fast[np.argmax(np.abs(qd[fast]))])
+                problems.append(
+                    f"line {k + 2}: dq{j + 1} = {qd[k]:.3f} rad/s is {abs(qd[k]) / vmax[j]:.1f} times "
+                    f"{robot.name}'s speed limit {vmax[j]:.3f} rad/s ({fast.size} rows)"
+                )
+    if problems:
+        unit = (
+            "controller logs are in deg and deg/s"
+            if log.kind == "controller"
+            else "generic logs are in rad and rad/s: degrees in q and dq?"
+        )
+        shown = problems[:5] + ([f"and {len(problems) - 5} more"] if len(problems) > 5 else [])
+        raise InvalidLog(
+            f"{log.source}: {'; '.join(shown)}; {unit} (is this log from {robot.name}? pass the right "
+            "robot, or none to skip the check)"
+        )
+
+
+def _check_motion(log: JointLog, frame: pd.DataFrame) -> None:
+    """Refuse a log that gives no rows: the arm never moved."""
+    if len(frame) and np.abs(log.qd).max() > REST_SPEED:
+        return
+    top = float(np.abs(log.qd).max())
+    raise InvalidLog(
+        f"{log.source}: no motion: the fastest joint speed is {np.degrees(top):.3g} deg/s, below the "
+        f"{np.degrees(REST_SPEED):.0f} deg/s at which a joint counts as moving, so the log gives no "
+        "energy-table rows; log the arm while it moves"
+    )
+
+
+def _gap_note(log: JointLog) -> str:
+    gaps = find_gaps(log.t)
+    if not gaps.size:
+        return ""
+    period = float(np.median(np.diff(log.t)))
+    k = int(gaps[0])
+    return (
+        f"note: {log.source}: {gaps.size} gap(s) in t longer than {GAP_FACTOR:g} x the median sample "
+        f"period {period:.4g} s (first: line {k + 2}, {log.t[k] - log.t[k - 1]:.4g} s after line {k + 1}); "
+        "the moves end there, and no energy is counted across a gap"
+    )
+
+
 def ingest(
     paths: Sequence[str | os.PathLike[str]],
     *,
@@ -171,21 +244,65 @@ def ingest(
     when no robot is given. Files that cannot all give ``full40`` make a ``joint``
     table. ``move_id`` is unique across files, in the order given.
 
+    Guards: the ``.moves.csv`` sidecars that :func:`joulepath.sim.simulate` writes
+    beside its logs are skipped (with a note to ``progress``); a gap in ``t`` over
+    ``GAP_FACTOR`` median sample periods ends the move there (with a note); with a
+    robot, logged positions outside its ranges (by more than
+    :data:`RANGE_TOLERANCE_RAD`) or speeds over :data:`SPEED_TOLERANCE` times its
+    limits are refused (degrees in a radian log, or another robot's log); a log
+    without motion, which would give no rows, is refused.
+
+    Parameters
+    ----------
+    paths : sequence of path
+        Controller or generic logs (see :func:`read_log`).
+    robot : Robot, optional
+        The robot that was logged; must have 6 joints.
+    progress : callable, optional
+        Called with one line per file read, skipped or noted.
+
     Raises
     ------
     InvalidLog
         For the first log that cannot be used; nothing is returned then.
+    InvalidInput
+        ``robot`` does not have 6 joints.
     """
     if not paths:
         raise InvalidLog("no log files given")
+    if robot is not None and robot.n_joints != N_JOINTS:
+        raise InvalidInput(
+            f"robot {robot.name!r} has {robot.n_joints} joints, but the energy table holds 6-joint arms; "
+            "give a 6-joint robot"
+        )
     logs = []
+    skipped = []
     for p in paths:
+        if is_moves_sidecar(p):
+            skipped.append(str(p))
+            if progress:
+                progress(
+                    f"skipped {p}: the programmed moves that `joulepath simulate` writes beside its log "
+                    f"(*{MOVES_SIDECAR_SUFFIX}), not a log"
+                )
+            continue
         log = read_log(p)
+        if robot is not None:
+            _check_limits(log, robot)
         if robot is not None and log.kind == "controller":
             _check_tcp(log, robot)
         logs.append(log)
         if progress:
-            progress(str(p))
+            progress(f"read {p}")
+            note = _gap_note(log)
+            if note:
+                progress(note)
+    if not logs:
+        raise InvalidLog(
+            f"no joint logs among the {len(skipped)} file(s) given: {', '.join(skipped[:3])}"
+            f"{' ...' if len(skipped) > 3 else ''} are `joulepath simulate`'s lists of programmed moves "
+            f"(*{MOVES_SIDECAR_SUFFIX}); give the logs beside them"
+        )
     full = all(log.kind == "controller" or robot is not None for log in logs)
     feature_set = "full40" if full else "joint"
     frames = []
@@ -198,6 +315,7 @@ def ingest(
             assert robot is not None
             tcp = _tcp_from_robot(robot, log.q)
         frame = log_to_frame(log, feature_set=feature_set, tcp=tcp, speed_scale=scale, move_offset=offset)
+        _check_motion(log, frame)
         n_moves = int(frame["move_id"].nunique())
         sources.append(
             {
@@ -206,6 +324,7 @@ def ingest(
                 "rows": len(frame),
                 "moves": n_moves,
                 "first_move_id": offset,
+                "gaps": int(find_gaps(log.t).size),
             }
         )
         offset += n_moves

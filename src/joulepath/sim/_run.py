@@ -10,8 +10,15 @@ from pathlib import Path
 
 import numpy as np
 
-from joulepath._io import atomic_write_text
-from joulepath.data import controller_log_text, ingest, save_table, write_controller_log
+from joulepath._io import atomic_write_text, check_replaceable, make_folder
+from joulepath.data import (
+    controller_log_text,
+    ingest,
+    moves_sidecar_path,
+    save_table,
+    write_controller_log,
+)
+from joulepath.data._schema import MOVES_SIDECAR_COLUMNS
 from joulepath.dynamics import Robot, load_robot
 from joulepath.export import Move, draw_moves
 from joulepath.sim._controller import ControllerConfig, MotionPlan, log_times, plan_moves
@@ -20,7 +27,7 @@ from joulepath.sim._plants import Measured, make_plant, run_plant
 
 @dataclass(frozen=True, slots=True)
 class SimulatedLog:
-    """What a simulated run wrote."""
+    """What a simulated run wrote; ``duration_s`` is the simulated robot time (s) the log covers."""
 
     log: Path
     moves: Path
@@ -60,7 +67,8 @@ def log_text(robot: Robot, m: Measured) -> str:
 
 def moves_text(plan: MotionPlan) -> str:
     """Sidecar CSV with the programmed moves (ground truth for tests and plots)."""
-    lines = ["move,t_start,t_end,speed,zone," + ",".join(f"j{i + 1}_deg" for i in range(plan.start.size))]
+    head = [*MOVES_SIDECAR_COLUMNS, *(f"j{i + 1}_deg" for i in range(plan.start.size))]
+    lines = [",".join(head)]
     for k, seg in enumerate(plan.segments):
         target = ",".join(f"{v:.5f}" for v in np.degrees(seg.move.target))
         lines.append(f"{k},{seg.t0:.5f},{seg.t_end:.5f},{seg.move.speed},{seg.move.zone},{target}")
@@ -79,16 +87,20 @@ def simulate(
 ) -> SimulatedLog:
     """Run ``n_moves`` random moves (thesis Appendix D.1) on a plant and write the log.
 
-    Writes ``out`` (the controller CSV) and ``out`` with suffix ``.moves.csv``.
+    Writes ``out`` (the controller CSV) and its sidecar ``<name>.moves.csv`` with the
+    programmed moves (:func:`joulepath.data.moves_sidecar_path`), which
+    :func:`joulepath.data.ingest` recognises and skips. ``duration_s`` of the result
+    is simulated robot time, not the time the simulation took.
     """
     r = load_robot(robot)
     rng = np.random.default_rng(seed)
     moves = draw_moves(r, n_moves, range_set=range_set, rng=rng)
     plan, measured = measure(r, plant, moves, rng=rng, config=config)
     path = Path(out)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(path.parent)
+    side = moves_sidecar_path(path)
+    check_replaceable(side)
     write_controller_log(path, log_text(r, measured))
-    side = path.with_suffix(".moves.csv")
     atomic_write_text(side, moves_text(plan))
     return SimulatedLog(path, side, int(measured.t.size), len(plan.segments), float(measured.t[-1]))
 
@@ -136,7 +148,7 @@ def simulate_plan(
     """
     children = np.random.SeedSequence(seed).spawn(len(plan))
     results: list[dict[str, object]] = []
-    Path(out).mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     if workers <= 1:
         for (name, plant, n), child in zip(plan, children, strict=True):
             results.append(_plan_job(name, plant, n, child, str(out), robot))

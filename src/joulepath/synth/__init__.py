@@ -16,7 +16,9 @@ SDV and SDMetrics are optional (``pip install 'joulepath[synth]'``); only
 
 from joulepath.synth._compare import (
     FEATURE_GROUPS,
+    SCORES_FILE,
     STATISTICS,
+    STATISTICS_FILE,
     Comparison,
     compare,
     describe,
@@ -48,7 +50,9 @@ __all__ = [
     "FEATURE_GROUPS",
     "METHODS",
     "NotFittedError",
+    "SCORES_FILE",
     "STATISTICS",
+    "STATISTICS_FILE",
     "SynthConfig",
     "Synthesizer",
     "TCP_TOLERANCE_M",

@@ -20,6 +20,12 @@ from joulepath.errors import InvalidInput
 if TYPE_CHECKING:
     from joulepath.dynamics import Robot
 
+STATISTICS_FILE = "statistics.csv"
+"""What :meth:`Comparison.write` names the descriptive statistics."""
+
+SCORES_FILE = "scores.csv"
+"""What :meth:`Comparison.write` names the quality and kinematic-consistency scores."""
+
 FEATURE_GROUPS: dict[str, tuple[str, ...]] = {
     "joint_positions": tuple(f"q{i}" for i in range(1, 7)),
     "joint_speeds": tuple(f"dq{i}" for i in range(1, 7)),
@@ -256,6 +262,26 @@ class Comparison:
     quality: dict[str, dict[str, float]] = field(default_factory=dict)
     consistency: dict[str, float] = field(default_factory=dict)
 
+    def scores(self) -> pd.DataFrame:
+        """Quality and consistency per table (columns as available); empty when neither was asked."""
+        rows: dict[str, dict[str, float]] = {}
+        for name, q in self.quality.items():
+            rows.setdefault(name, {}).update({k: float(v) for k, v in q.items()})
+        for name, share in self.consistency.items():
+            rows.setdefault(name, {})["tcp_within_5mm"] = float(share)
+        frame = pd.DataFrame.from_dict(rows, orient="index")
+        frame.index.name = "table"
+        return frame
+
+    def write(self, out_dir: str | os.PathLike[str]) -> tuple[Path, ...]:
+        """Write ``statistics.csv`` (index column, table) and, if any, ``scores.csv`` into ``out_dir``."""
+        out = Path(out_dir)
+        written = [atomic_write_bytes(out / STATISTICS_FILE, self.statistics.to_csv().encode())]
+        scores = self.scores()
+        if len(scores):
+            written.append(atomic_write_bytes(out / SCORES_FILE, scores.to_csv().encode()))
+        return tuple(written)
+
     def to_text(self) -> str:
         """The statistics table, scores and files as plain text for a terminal."""
         with pd.option_context("display.max_rows", None, "display.width", 200):
@@ -284,6 +310,9 @@ def compare(
     robot: Robot | str | None = None,
 ) -> Comparison:
     """Statistics, plots and optionally quality and kinematic consistency of several tables.
+
+    Only the plots are written here; :meth:`Comparison.write` writes the
+    statistics (and scores) as CSV, as ``joulepath compare`` does.
 
     Parameters
     ----------
@@ -328,7 +357,9 @@ def compare(
 
 __all__ = [
     "FEATURE_GROUPS",
+    "SCORES_FILE",
     "STATISTICS",
+    "STATISTICS_FILE",
     "Comparison",
     "compare",
     "describe",

@@ -193,6 +193,11 @@ def finish_frame(
     return out[list(table_columns(feature_set))]
 
 
+def _seed_text(seed: int | None) -> str:
+    """The user's seed as progress messages show it (the integers SDV gets are derived from it)."""
+    return "no seed: fresh entropy" if seed is None else f"seed {seed}"
+
+
 class Synthesizer:
     """An SDV synthesizer that learns an energy table and samples new ones.
 
@@ -268,7 +273,8 @@ class Synthesizer:
         )
         if progress:
             progress(
-                f"fitting {cfg.method} on {len(frame):,} rows x {len(columns)} columns (seed {fit_seed})"
+                f"fitting {cfg.method} on {len(frame):,} rows x {len(columns)} columns "
+                f"({_seed_text(cfg.seed)}; SDV fit seed {fit_seed} derived from it)"
             )
         _sdv.fit(model, frame, seed=fit_seed, n_threads=cfg.n_threads)
         n_moves = max(table.n_moves, 1)
@@ -329,7 +335,10 @@ class Synthesizer:
         cfg = self._config
         seed = integer_seed(rng)
         if progress:
-            progress(f"sampling {int(n_rows):,} rows from {cfg.method} (seed {seed})")
+            progress(
+                f"sampling {int(n_rows):,} rows from {cfg.method} "
+                f"({_seed_text(cfg.seed)}; SDV sampling seed {seed} derived from it)"
+            )
         raw = _sdv.sample(model, int(n_rows), seed=seed, n_threads=cfg.n_threads)
         info = self._info
         frame = finish_frame(raw, feature_set=info["feature_set"], rows_per_move=info["rows_per_move"])
