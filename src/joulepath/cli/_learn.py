@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import typer
@@ -23,6 +26,20 @@ def _split(
             param_hint=option,
         )
     return items
+
+
+@contextmanager
+def _progress_lines(label: str) -> Iterator[Callable[[str], None]]:
+    """A progress callback: a live status line on a terminal, plain lines on stderr otherwise."""
+    if console.is_terminal:
+        with console.status(label) as status:
+            yield lambda message: status.update(message)
+        return
+
+    def line(message: str) -> None:
+        print(message, file=sys.stderr, flush=True)
+
+    yield line
 
 
 def train(
@@ -60,6 +77,11 @@ def train(
     )
     load_robot(robot)  # an unknown robot fails now, not after the training
     train_table, test_table = load_table(data), load_table(test)
+    for path, table, what in ((data, train_table, "--data"), (test, test_table, "--test")):
+        if len(table.frame) == 0:
+            raise InvalidInput(
+                f"{path}: the table has no rows; give {what} a table ingested from logs with moves"
+            )
     if train_table.feature_set != test_table.feature_set:
         raise InvalidInput(
             f"{test}: feature set {test_table.feature_set!r}, but {data} has {train_table.feature_set!r}; "
@@ -70,8 +92,8 @@ def train(
             f"{data}: {train_table.n_moves} moves are too few for --cv {cv} grouped folds; "
             f"give --cv {train_table.n_moves} or less, or a table of more moves"
         )
-    with console.status("training...") as status:
-        report = run(train_table, test_table, config, out, progress=lambda m: status.update(m))
+    with _progress_lines("training...") as say:
+        report = run(train_table, test_table, config, out, progress=say)
     cols = [
         "family",
         "target",

@@ -14,7 +14,9 @@ from joulepath.learn._features import INPUTS, PhysicsFeatures, input_columns, ph
 from joulepath.learn._importance import feature_importance, plot_importance, rank_joints
 from joulepath.learn._model import TRUSTED_TYPES, EnergyModel
 from joulepath.learn._search import CandidateResult, SearchResult, grid_search, make_splits
+from joulepath.learn._svr import KERNEL_SVR_MAX_ROWS, ScalableSVR, SubsampleWarning
 from joulepath.learn._train import TrainConfig, TrainingReport, best_model, load_models, train
+from joulepath.learn._validate import check_finite_predictions, read_joints_json
 
 __all__ = [
     "CandidateResult",
@@ -22,16 +24,20 @@ __all__ = [
     "FAMILIES",
     "GRIDS",
     "INPUTS",
+    "KERNEL_SVR_MAX_ROWS",
     "PhysicsFeatures",
     "QUICK_GRIDS",
     "SUBSTITUTIONS",
+    "ScalableSVR",
     "Scores",
     "SearchResult",
+    "SubsampleWarning",
     "THESIS_GRIDS",
     "TRUSTED_TYPES",
     "TrainConfig",
     "TrainingReport",
     "best_model",
+    "check_finite_predictions",
     "feature_importance",
     "grid_for",
     "grid_search",
@@ -45,6 +51,7 @@ __all__ = [
     "physics_transform",
     "plot_importance",
     "rank_joints",
+    "read_joints_json",
     "score",
     "train",
 ]

@@ -1,5 +1,10 @@
 """The four model families of the thesis (§2.2), their pipelines and grids (Tables 2.2–2.5).
 
+SVR is :class:`~joulepath.learn.ScalableSVR`: the linear kernel is fitted with
+liblinear (``LinearSVR``) and the other kernels on at most
+:data:`~joulepath.learn.KERNEL_SVR_MAX_ROWS` sampled rows, so the thesis grid runs
+on the thesis' table sizes.
+
 Every family is a scikit-learn Pipeline: [PhysicsFeatures →] StandardScaler →
 estimator (XGBoost trees need no scaling and get none, so the fitted booster can be
 saved in XGBoost's own JSON format). Grid keys are written ``model__param``.
@@ -21,10 +26,10 @@ from sklearn.linear_model import SGDRegressor
 from sklearn.neural_network import MLPRegressor
 from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
-from sklearn.svm import SVR
 
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.learn._features import PhysicsFeatures
+from joulepath.learn._svr import ScalableSVR
 
 FAMILIES = ("mlp", "svr", "par", "xgb")
 GRIDS = ("thesis", "quick")
@@ -106,7 +111,7 @@ def _estimator(family: str, seed: int) -> Any:
     if family == "mlp":
         return MLPRegressor(max_iter=500, early_stopping=True, random_state=seed)
     if family == "svr":
-        return SVR(cache_size=500)
+        return ScalableSVR(random_state=seed)
     if family == "par":
         return SGDRegressor(
             loss="epsilon_insensitive",

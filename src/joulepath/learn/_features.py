@@ -26,6 +26,8 @@ INPUTS = ("thesis", "physics")
 PHYSICS_VERSION = 2
 """Version of the physics inputs; a model card records it and loading refuses another."""
 N_JOINTS = 6
+N_PHYSICS_TERMS = 4 * N_JOINTS + 1
+"""Columns :func:`physics_transform` appends: per-joint energy, its sum, signed energy, |qd| dt, qd² dt."""
 
 
 def input_columns(feature_set: str, inputs: str) -> tuple[str, ...]:

@@ -6,8 +6,12 @@ Files (one folder per model):
   file's types against an allowlist first and refuses anything else, so it never
   runs code from the file;
 * ``model.json`` — XGBoost boosters in XGBoost's own JSON format (no pickle);
-* ``card.json`` — feature names in order, feature set and inputs, units, target,
-  training-data hash, CV and test metrics, hyperparameters, library versions.
+* ``card.json`` — feature names in order (and their SHA-256), feature set and
+  inputs, units, target, training-data hash, CV and test metrics,
+  hyperparameters, library versions.
+
+Loading checks the card and the model file against each other before either
+reaches a library (:mod:`joulepath.learn._validate`).
 """
 
 from __future__ import annotations
@@ -23,21 +27,34 @@ from typing import Any
 import numpy as np
 import pandas as pd
 from sklearn.pipeline import Pipeline
+from sklearn.svm import LinearSVR
 
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
 from joulepath.errors import InvalidModel, MissingDependency
 from joulepath.learn._features import PHYSICS_VERSION, PhysicsFeatures, physics_transform
+from joulepath.learn._svr import ScalableSVR
+from joulepath.learn._validate import (
+    check_card,
+    check_pipeline,
+    check_xgboost_json,
+    input_columns_sha256,
+    model_file,
+    n_model_features,
+)
 
 CARD_VERSION = 1
 TRUSTED_TYPES = frozenset(
     {
         "joulepath.learn._features.PhysicsFeatures",
+        "joulepath.learn._svr.ScalableSVR",
         "sklearn.neural_network._stochastic_optimizers.AdamOptimizer",
         "sklearn.neural_network._stochastic_optimizers.SGDOptimizer",
     }
 )
 """Types outside scikit-learn/NumPy that a model file may contain."""
+_XGB_COLUMNS_ATTR = "joulepath_input_columns"
+"""Booster attribute holding the ordered input names (JSON), checked against the card on load."""
 
 _ACTIVATIONS: dict[str, Callable[[FloatArray], FloatArray]] = {
     "identity": lambda z: z,
@@ -87,11 +104,14 @@ class EnergyModel:
     card : dict
         ``family``, ``target``, ``feature_set``, ``inputs``, ``input_columns``,
         ``robot``, metrics and versions (see the module docstring).
+    source : Path or None
+        The folder the model was loaded from (for messages).
     """
 
-    def __init__(self, pipeline: Pipeline, card: dict[str, Any]) -> None:
+    def __init__(self, pipeline: Pipeline, card: dict[str, Any], *, source: Path | None = None) -> None:
         self.pipeline = pipeline
         self.card = card
+        self.source = source
         self._forward = self._mlp_forward()
 
     @property
@@ -129,15 +149,18 @@ class EnergyModel:
                 biases=tuple(np.asarray(b, float) for b in model.intercepts_),
                 activation=model.activation,
             )
-        linear = family == "par" or (family == "svr" and getattr(model, "kernel", None) == "linear")
-        if linear and hasattr(model, "coef_"):  # a linear model is a one-layer identity network
-            coef = np.asarray(model.coef_, float).reshape(-1, 1)
+        fitted: Any = getattr(model, "estimator_", None) if isinstance(model, ScalableSVR) else model
+        linear = family == "par" or (
+            family == "svr" and (isinstance(fitted, LinearSVR) or getattr(fitted, "kernel", None) == "linear")
+        )
+        if linear and hasattr(fitted, "coef_"):  # a linear model is a one-layer identity network
+            coef = np.asarray(fitted.coef_, float).reshape(-1, 1)
             return _Forward(
                 physics=physics,
                 mean=mean,
                 scale=scale,
                 weights=(coef,),
-                biases=(np.asarray(model.intercept_, float).reshape(1),),
+                biases=(np.asarray(fitted.intercept_, float).reshape(1),),
                 activation="identity",
             )
         return None
@@ -196,9 +219,11 @@ class EnergyModel:
         out.mkdir(parents=True, exist_ok=True)
         card = dict(self.card)
         card["card_version"] = CARD_VERSION
+        card["input_columns_sha256"] = input_columns_sha256(self.input_columns)
         if self.family == "xgb":
             steps = dict(self.pipeline.steps)
             tmp = out / ".tmp.model.json"
+            steps["model"].get_booster().set_attr(**{_XGB_COLUMNS_ATTR: json.dumps(list(self.input_columns))})
             steps["model"].save_model(tmp)
             os.replace(tmp, out / "model.json")
             card["file"] = "model.json"
@@ -218,31 +243,45 @@ class EnergyModel:
     def load(cls, folder: str | os.PathLike[str]) -> EnergyModel:
         """Load a model folder written by :meth:`save`; never executes code from the files.
 
+        The card and the model file are checked against each other before the model
+        file reaches scikit-learn or XGBoost (see :mod:`joulepath.learn._validate`).
+
         Raises
         ------
         InvalidModel
-            No card, unknown card version or file, or types outside the allowlist.
+            No card; a card with missing or wrong keys, or input columns in another
+            order than the model was trained on; a model file outside the folder; an
+            XGBoost tree out of range or cyclic; shapes that do not fit the card; or
+            types outside the allowlist.
         """
         src = Path(folder)
         card_path = src / "card.json"
         if not card_path.is_file():
             raise InvalidModel(f"{src}: no card.json; is this a joulepath model folder?")
         try:
-            card = json.loads(card_path.read_text())
-        except json.JSONDecodeError as err:
+            raw = json.loads(card_path.read_bytes())
+        except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as err:
             raise InvalidModel(f"{card_path}: not valid JSON ({err})") from err
-        for key in ("family", "target", "input_columns", "feature_set", "inputs", "file"):
-            if key not in card:
-                raise InvalidModel(f"{card_path}: the card lacks {key!r}")
+        except OSError as err:
+            raise InvalidModel(f"{card_path}: cannot be read ({err.strerror})") from err
+        card = check_card(raw, card_path)
         if card["inputs"] == "physics" and card.get("physics_version") != PHYSICS_VERSION:
             raise InvalidModel(
                 f"{card_path}: trained with physics inputs version {card.get('physics_version')}, this "
                 f"joulepath computes version {PHYSICS_VERSION}; train the model again"
             )
-        file = src / str(card["file"])
+        cols = tuple(card["input_columns"])
         if card["family"] == "xgb":
-            if file.suffix != ".json":
-                raise InvalidModel(f"{file}: an XGBoost model must be a .json booster")
+            if not isinstance(card["file"], str) or not card["file"].endswith(".json"):
+                raise InvalidModel(f"{src / str(card['file'])}: an XGBoost model must be a .json booster")
+            file = model_file(src, card, card_path)
+            doc = check_xgboost_json(file, n_features=n_model_features(len(cols), card["inputs"]))
+            trained = doc["learner"].get("attributes", {}).get(_XGB_COLUMNS_ATTR)
+            if trained is not None and trained != json.dumps(list(cols)):
+                raise InvalidModel(
+                    f"{file}: was trained on other input columns (or another order) than {card_path} "
+                    "lists; restore the card or train the model again"
+                )
             from xgboost import XGBRegressor
 
             model = XGBRegressor()
@@ -252,14 +291,16 @@ class EnergyModel:
                 raise InvalidModel(f"{file}: not a readable XGBoost JSON model ({err})") from err
             steps: list[tuple[str, Any]] = []
             if card["inputs"] == "physics":
-                cols = tuple(card["input_columns"])
                 phys = PhysicsFeatures(robot=card.get("robot_source", "irb120"), columns=cols)
                 phys.fit(np.zeros((1, len(cols))))
                 steps.append(("physics", phys))
             steps.append(("model", model))
-            return cls(Pipeline(steps), card)
-        if file.suffix != ".skops":
-            raise InvalidModel(f"{file}: scikit-learn models are read from .skops files only")
+            return cls(Pipeline(steps), card, source=src)
+        if not isinstance(card["file"], str) or not card["file"].endswith(".skops"):
+            raise InvalidModel(
+                f"{src / str(card['file'])}: scikit-learn models are read from .skops files only"
+            )
+        file = model_file(src, card, card_path)
         import skops.io as sio
 
         try:
@@ -271,7 +312,11 @@ class EnergyModel:
             raise InvalidModel(
                 f"{file}: refused, it contains types outside the allowlist: {', '.join(unknown)}"
             )
-        pipeline = sio.load(file, trusted=sorted(set(untrusted)))
+        try:
+            pipeline = sio.load(file, trusted=sorted(set(untrusted)))
+        except Exception as err:
+            raise InvalidModel(f"{file}: not a readable skops file ({err})") from err
         if not isinstance(pipeline, Pipeline):
             raise InvalidModel(f"{file}: holds a {type(pipeline).__name__}, not a Pipeline")
-        return cls(pipeline, card)
+        check_pipeline(pipeline, card, file)
+        return cls(pipeline, card, source=src)

@@ -34,6 +34,7 @@ from sklearn.pipeline import Pipeline
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
 from joulepath.errors import InvalidInput, MissingDependency
+from joulepath.learn._svr import SubsampleWarning
 
 SPLITS = ("grouped", "shuffled")
 
@@ -140,6 +141,7 @@ def cross_validate_candidate(
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ConvergenceWarning)
             warnings.simplefilter("ignore", RuntimeWarning)
+            warnings.simplefilter("ignore", SubsampleWarning)  # train() states the sample size once
             try:
                 model.fit(X[train], y[train])
                 pred = model.predict(X[test])
@@ -152,6 +154,109 @@ def cross_validate_candidate(
             r2.append(float("-inf"))
             mae.append(float("inf"))
     return r2, mae, time.perf_counter() - t0
+
+
+def _read_cached(path: Path, params: dict[str, Any]) -> CandidateResult | None:
+    """A finished candidate from the cache; None when absent or unreadable (it is fitted again)."""
+    try:
+        rec = json.loads(path.read_text())
+        return CandidateResult(
+            params,
+            tuple(float(v) for v in rec["r2"]),
+            tuple(float(v) for v in rec["mae"]),
+            float(rec["fit_s"]),
+            cached=True,
+        )
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def _plan(
+    grid: dict[str, list[Any]],
+    X: FloatArray,
+    y: FloatArray,
+    groups: np.ndarray,
+    family: str,
+    split: str,
+    n_splits: int,
+    seed: int,
+    cache_dir: str | Path | None,
+) -> tuple[list[dict[str, Any]], list[str], dict[int, CandidateResult], list[int]]:
+    """Grid points, their cache keys, the finished ones (by index) and the indices still to fit."""
+    points = list(ParameterGrid(grid))
+    digest = data_hash(X, y, groups)
+    keys = [_key(family, p, split, n_splits, seed, digest) for p in points]
+    done: dict[int, CandidateResult] = {}
+    todo: list[int] = []
+    for i, (params, key) in enumerate(zip(points, keys, strict=True)):
+        found = _read_cached(Path(cache_dir) / f"{key}.json", params) if cache_dir is not None else None
+        if found is not None:
+            done[i] = found
+        else:
+            todo.append(i)
+    return points, keys, done, todo
+
+
+def pending_candidates(
+    grid: dict[str, list[Any]],
+    X: FloatArray,
+    y: FloatArray,
+    groups: np.ndarray,
+    *,
+    family: str,
+    split: str = "grouped",
+    n_splits: int = 5,
+    seed: int = 0,
+    cache_dir: str | Path | None = None,
+) -> int:
+    """How many points of ``grid`` :func:`grid_search` would fit (the others are in the cache)."""
+    return len(_plan(grid, X, y, groups, family, split, n_splits, seed, cache_dir)[3])
+
+
+def estimate_fit_seconds(
+    pipeline: Pipeline,
+    grid: dict[str, list[Any]],
+    X: FloatArray,
+    y: FloatArray,
+    *,
+    n_rows: int,
+    seed: int,
+    trial_rows: int = 2000,
+    n_trials: int = 3,
+) -> tuple[float, int]:
+    """Rough seconds one fit of a grid point takes on ``n_rows`` rows, and the trial size used.
+
+    Fits up to ``n_trials`` grid points (first, last and evenly between) on a seeded
+    sample of ``trial_rows`` rows and scales their mean time linearly with the rows
+    (quadratically, up to ``max_rows``, for kernel SVR). It is an estimate: iterative
+    models (MLP with early stopping, liblinear) need a different number of passes
+    on more data.
+    """
+    from joulepath.learn._svr import ScalableSVR
+
+    points = list(ParameterGrid(grid))
+    picks = sorted({round(k) for k in np.linspace(0, len(points) - 1, min(n_trials, len(points)))})
+    m = min(trial_rows, len(y))
+    rows = np.sort(np.random.default_rng(seed).choice(len(y), m, replace=False))
+    seconds = []
+    for k in picks:
+        model = clone(pipeline).set_params(**points[k])
+        t0 = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ConvergenceWarning)
+            warnings.simplefilter("ignore", RuntimeWarning)
+            try:
+                model.fit(X[rows], y[rows])
+            except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+                pass
+        spent = time.perf_counter() - t0
+        est = model.steps[-1][1]
+        if isinstance(est, ScalableSVR) and est.kernel != "linear":
+            spent *= (min(n_rows, est.max_rows) / m) ** 2
+        else:
+            spent *= n_rows / m
+        seconds.append(spent)
+    return float(np.mean(seconds)), m
 
 
 def grid_search(
@@ -192,23 +297,10 @@ def grid_search(
     from joblib import Parallel, delayed, parallel_config
 
     splits = make_splits(len(y), groups, split=split, n_splits=n_splits, seed=seed)
-    points = list(ParameterGrid(grid))
-    digest = data_hash(X, y, groups)
+    points, keys, results, todo = _plan(grid, X, y, groups, family, split, n_splits, seed, cache_dir)
     cache = Path(cache_dir) if cache_dir is not None else None
     if cache is not None:
         cache.mkdir(parents=True, exist_ok=True)
-    results: dict[int, CandidateResult] = {}
-    todo: list[int] = []
-    keys = [_key(family, p, split, n_splits, seed, digest) for p in points]
-    for i, (params, key) in enumerate(zip(points, keys, strict=True)):
-        path = cache / f"{key}.json" if cache is not None else None
-        if path is not None and path.exists():
-            rec = json.loads(path.read_text())
-            results[i] = CandidateResult(
-                params, tuple(rec["r2"]), tuple(rec["mae"]), rec["fit_s"], cached=True
-            )
-        else:
-            todo.append(i)
     total = len(points)
     if progress:
         progress(len(results), total)

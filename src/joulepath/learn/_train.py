@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 from sklearn.exceptions import ConvergenceWarning
+from sklearn.model_selection import ParameterGrid
 
 from joulepath._io import atomic_write_text
 from joulepath.data import TARGETS, EnergyTable
@@ -22,7 +23,15 @@ from joulepath.learn._evaluate import physics_baseline, score
 from joulepath.learn._families import FAMILIES, GRIDS, SUBSTITUTIONS, grid_for, make_pipeline
 from joulepath.learn._features import INPUTS, PHYSICS_VERSION, input_columns
 from joulepath.learn._model import EnergyModel, library_versions
-from joulepath.learn._search import connect_scheduler, cross_validate_candidate, grid_search, make_splits
+from joulepath.learn._search import (
+    connect_scheduler,
+    cross_validate_candidate,
+    estimate_fit_seconds,
+    grid_search,
+    make_splits,
+    pending_candidates,
+)
+from joulepath.learn._svr import KERNEL_SVR_MAX_ROWS, SubsampleWarning
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -83,11 +92,73 @@ class TrainingReport:
     models: dict[str, Path] = field(default_factory=dict)
 
 
+def _duration(seconds: float) -> str:
+    """``"45 s"``, ``"3 min"``, ``"2.5 h"``: a rough duration for progress lines."""
+    if seconds < 90:
+        return f"{max(seconds, 1):.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
 def _progress(say: Callable[[str], None], family: str, target: str) -> Callable[[int, int], None]:
+    """A grid-search progress callback that says done/total, time spent and time left."""
+    start = time.perf_counter()
+    first: list[int] = []
+
     def report(done: int, total: int) -> None:
-        say(f"{family} {target}: {done}/{total} candidates")
+        if not first:
+            first.append(done)
+            cached = f" ({done} from the cache)" if done else ""
+            say(f"{family} {target}: {done}/{total} candidates{cached}")
+            return
+        spent = time.perf_counter() - start
+        fitted = done - first[0]
+        left = spent / fitted * (total - done) if fitted else float("nan")
+        eta = f", about {_duration(left)} left" if done < total and np.isfinite(left) else ""
+        say(f"{family} {target}: {done}/{total} candidates, {_duration(spent)} spent{eta}")
 
     return report
+
+
+def _announce(
+    say: Callable[[str], None],
+    family: str,
+    target: str,
+    pipeline: Any,
+    grid: dict[str, list[Any]],
+    X: np.ndarray,
+    y: np.ndarray,
+    groups: np.ndarray,
+    config: TrainConfig,
+    cache_dir: Path,
+) -> None:
+    """Say how many fits the search, the shuffled CV and the refit need and roughly how long."""
+    n_points = len(ParameterGrid(grid))
+    pending = pending_candidates(
+        grid, X, y, groups, family=family, n_splits=config.cv, seed=config.seed, cache_dir=cache_dir
+    )
+    fold_rows = round(len(y) * (config.cv - 1) / config.cv)
+    n_fits = pending * config.cv + config.cv + 1
+    label = f"{family} {target}"
+    if (
+        family == "svr"
+        and fold_rows > KERNEL_SVR_MAX_ROWS
+        and any(k != "linear" for k in grid.get("model__kernel", ["rbf"]))
+    ):
+        say(
+            f"{label}: kernel SVR candidates fit on a random {KERNEL_SVR_MAX_ROWS:,} of the ~{fold_rows:,} "
+            "rows of each fold (KERNEL_SVR_MAX_ROWS); the linear kernel uses all rows"
+        )
+    per_fit, trial = estimate_fit_seconds(pipeline, grid, X, y, n_rows=fold_rows, seed=config.seed)
+    workers = max(1, min(config.n_jobs, pending)) if config.scheduler is None else max(1, pending)
+    total = per_fit * (np.ceil(pending / workers) * config.cv + config.cv + config.cv / (config.cv - 1))
+    par = f" on {workers} processes" if workers > 1 and config.scheduler is None else ""
+    say(
+        f"{label}: {n_fits} fits ({pending} of {n_points} candidates x {config.cv} folds{par}, "
+        f"{config.cv} shuffled folds, 1 refit) on ~{fold_rows:,} rows; roughly {_duration(total)} "
+        f"(scaled from trial fits on {trial:,} rows)"
+    )
 
 
 def _fmt_params(params: dict[str, Any]) -> str:
@@ -110,6 +181,11 @@ def train(
     """
     from joulepath.dynamics import NOMINAL_FRICTION, load_robot
 
+    for name, table in (("training", train_table), ("test", test_table)):
+        if len(table.frame) == 0:
+            raise InvalidInput(
+                f"the {name} table has no rows; ingest logs with at least one move for the {name} table"
+            )
     if train_table.feature_set != test_table.feature_set:
         raise InvalidInput(
             f"train table has feature set {train_table.feature_set!r}, test table "
@@ -132,6 +208,8 @@ def train(
                 family, seed=config.seed, inputs=config.inputs, columns=cols, robot=config.robot
             )
             grid = grid_for(family, config.grid)
+            cache_dir = out / ".gridcache" / f"{family}-{target}"
+            _announce(say, family, target, pipeline, grid, X, y, groups, config, cache_dir)
             t0 = time.perf_counter()
             search = grid_search(
                 pipeline,
@@ -143,18 +221,21 @@ def train(
                 split="grouped",
                 n_splits=config.cv,
                 seed=config.seed,
-                cache_dir=out / ".gridcache" / f"{family}-{target}",
+                cache_dir=cache_dir,
                 n_jobs=config.n_jobs,
                 scheduler=config.scheduler,
                 progress=_progress(say, family, target),
             )
             best = search.best
+            say(f"{family} {target}: shuffled-fold CV of the best candidate ({config.cv} fits)")
             shuffled = make_splits(len(y), groups, split="shuffled", n_splits=config.cv, seed=config.seed)
             r2_s, mae_s, _ = cross_validate_candidate(pipeline, best.params, X, y, shuffled)
             model_pipe = pipeline.set_params(**best.params)
 
+            say(f"{family} {target}: refitting the best candidate on all {len(y):,} rows")
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", ConvergenceWarning)
+                warnings.simplefilter("ignore", SubsampleWarning)  # said before the search
                 model_pipe.fit(X, y)
             card = {
                 "family": family,
@@ -189,6 +270,9 @@ def train(
             }
             if family in SUBSTITUTIONS:
                 card["substitution"] = SUBSTITUTIONS[family]
+            fit_rows = getattr(model_pipe.steps[-1][1], "n_fit_rows_", len(y))
+            if fit_rows != len(y):
+                card["fit_rows"] = int(fit_rows)
             model = EnergyModel(model_pipe, card)
             test_scores = score(test_table, target, model.predict(test_table.frame))
             card["test"] = test_scores.as_dict()
@@ -220,6 +304,7 @@ def train(
             say(f"{family} {target}: grouped CV R² {best.r2_mean:.4f}, test R² {test_scores.r2:.4f}")
     from joulepath.learn._importance import feature_importance, plot_importance, rank_joints
 
+    say("feature importance on 5,000 training rows")
     imp = feature_importance(train_table, "E", max_rows=5000, seed=config.seed)
     atomic_write_text(out / "importance_E.csv", imp.to_csv())
     plot_importance(imp, out / "importance_E.png", title="Feature importance for E (training data)")
