@@ -90,11 +90,11 @@ def check_out_file(
     """
     if path.is_dir():
         raise InvalidInput(f"{path}: is a folder, but {option} needs a file name; give e.g. {path / example}")
+    _no_file_above(path, option)
     try:
         check_replaceable(path)
     except InvalidInput as err:
         raise InvalidInput(f"{err} ({option})") from err
-    _no_file_above(path, option)
     _not_an_input(path, inputs, option)
 
 
