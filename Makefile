@@ -1,4 +1,5 @@
-# make demo : set up .venv (if missing), install joulepath with its extras, run demo.toml -> demo-out/report.html
+# make demo : set up .venv (if missing), install joulepath with its extras, run demo.toml -> runs/demo/report.html
+#             (the folder of `joulepath run demo` too, so either reuses what the other computed)
 # make test : set up .venv (if missing), install joulepath with its extras, run all tests
 PYTHON ?= python3
 VENV := .venv
@@ -16,8 +17,8 @@ $(STAMP): $(BIN)/python pyproject.toml constraints.txt
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/joulepath run demo --out demo-out
-	@echo "The report: $(CURDIR)/demo-out/report.html (open it in a browser)"
+	$(BIN)/joulepath run demo
+	@echo "The report: $(CURDIR)/runs/demo/report.html (open it in a browser)"
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks scripts

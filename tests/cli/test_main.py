@@ -100,3 +100,27 @@ def test_main_optimize_refuses_an_unphysical_robot_and_writes_nothing(capsys, tm
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "mass -3.909 kg is not positive" in err[0]
     assert not out.exists()
+
+
+def test_main_demo_and_run_demo_and_make_demo_share_one_folder(monkeypatch, tmp_path):
+    import re
+    from pathlib import Path
+
+    import joulepath.experiment
+
+    folders = []
+
+    def fake_run(exp, folder, **_kwargs):
+        folders.append(Path(folder))
+        return {"mean_saved_pct": None, "report": str(Path(folder) / "report.html")}
+
+    monkeypatch.setattr(joulepath.experiment, "run_experiment", fake_run)
+    monkeypatch.chdir(tmp_path)
+    assert main(["demo", "--quiet"]) == 0
+    assert main(["run", "demo", "--quiet"]) == 0
+    assert folders == [Path("runs/demo"), Path("runs/demo")]
+    makefile = (Path(__file__).parents[2] / "Makefile").read_text()
+    recipe = re.search(r"^demo:.*\n((?:\t.*\n)+)", makefile, re.M)
+    assert recipe is not None
+    assert "joulepath run demo\n" in recipe[1] and "--out" not in recipe[1]
+    assert "runs/demo/report.html" in recipe[1]

@@ -200,9 +200,14 @@ def test_an_interrupted_run_leaves_no_partial_file_and_resumes(
         return real_write_run(*args, **kwargs)
 
     monkeypatch.setattr(joulepath.optimize, "write_run", interrupted)
+    before = sorted(p.relative_to(run) for p in (run / "optimize").rglob("*"))
+    old_key = json.loads((run / "optimize" / "stage.json").read_text())["key"]
     with pytest.raises(KeyboardInterrupt):
         run_experiment(load_experiment(changed), run, say=lambda _t: None)
-    assert not (run / "optimize" / "stage.json").exists()
+    # the previous complete optimize folder is untouched; the interrupted one is aside
+    assert sorted(p.relative_to(run) for p in (run / "optimize").rglob("*")) == before
+    assert json.loads((run / "optimize" / "stage.json").read_text())["key"] == old_key
+    assert (run / ".optimize.partial").is_dir()
     assert not list(run.rglob("*.tmp*"))
     monkeypatch.setattr(joulepath.optimize, "write_run", real_write_run)
     said: list[str] = []
@@ -210,6 +215,8 @@ def test_an_interrupted_run_leaves_no_partial_file_and_resumes(
     ran = [s.split(":")[0] for s in said if s.split(":")[0] in STAGES and "done in" in s]
     assert ran == ["optimize"]
     assert len(pd.read_csv(run / "optimize" / "tasks.csv")) == 2
+    assert not (run / ".optimize.partial").exists() and not (run / ".optimize.old").exists()
+    assert json.loads((run / "optimize" / "stage.json").read_text())["key"] != old_key
 
 
 def test_run_on_a_dask_scheduler_gives_the_local_results(tmp_path, dask_scheduler):

@@ -11,6 +11,13 @@ import typer
 from joulepath.cli._common import check_out_folder, console
 
 BUNDLED = ("demo", "thesis")
+RUNS = Path("runs")
+"""Where runs go unless ``--out`` says otherwise: ``runs/<name>`` (``make demo`` too: ``runs/demo``)."""
+
+
+def default_folder(name: str) -> Path:
+    """The run folder of the experiment called ``name`` when no ``--out`` is given."""
+    return RUNS / name
 
 
 def _experiment_path(name: str) -> Path:
@@ -51,7 +58,7 @@ def _run(experiment: str, out: Path | None, quiet: bool, scheduler: str | None) 
     from joulepath.experiment import load_experiment, run_experiment
 
     exp = load_experiment(_experiment_path(experiment))
-    folder = out or Path("runs") / exp.name
+    folder = out or default_folder(exp.name)
     check_out_folder(folder)
     say = (lambda _t: None) if quiet else (lambda t: console.print(t, markup=False))
     with _bars(not quiet and console.is_terminal) as progress:
@@ -85,8 +92,9 @@ def run(
 
 
 def demo(
-    out: Path = typer.Option(Path("demo-out"), "--out", help="Run folder."),
+    out: Path = typer.Option(None, "--out", help="Run folder (default: runs/demo, as `joulepath run demo`)."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress; print only the last line."),
 ) -> int:
-    """The bundled demo study on the IRB 120 (the same as ``joulepath run demo``)."""
+    """The bundled demo study on the IRB 120: the same as ``joulepath run demo``, into the same
+    folder (runs/demo), so either reuses what the other computed."""
     return _run("demo", out, quiet, None)

@@ -5,11 +5,21 @@ logs), ``synth`` (optional), ``models`` (train), ``importance``, ``optimize``,
 ``bench`` (optional); then ``report.html`` is rendered from what they wrote.
 
 Each stage writes its outputs, then a ``stage.json`` holding a hash of its settings,
-of the stages it reads and of joulepath's version. A stage whose ``stage.json`` holds the same hash is
-skipped. ``stage.json`` is removed when a stage starts and written last, so an
-interrupted stage runs again. Every file is written atomically (temporary file, then
-rename); the grid search keeps a per-candidate cache, so an interrupted training
-resumes where it stopped.
+of the stages it reads (so a stage whose inputs changed runs again, and so do the
+stages after it), of the robot file's content and of joulepath's version. A stage
+whose ``stage.json`` holds the same hash is skipped.
+
+A stage's folder holds only what the current settings produce: a stage runs in a
+fresh hidden sibling (``.models.partial``), which replaces the stage's folder once
+its ``stage.json`` is written. So a model family dropped from ``[train] families``
+leaves no model behind, a refused ``path.mod`` leaves no older one, and an
+interrupted stage leaves the previous complete folder as it was (and runs again
+next time). The only things carried from one run of a stage to the next are
+content-keyed caches (the grid search's per-candidate results, ``.gridcache``), so an
+interrupted training resumes where it stopped. The folder of a stage that is no
+longer in the plan is removed, and so are ``summary.json`` and ``report.html`` as
+soon as any stage's folder is replaced (they are written again at the end). Every
+file is written atomically (temporary file, then rename).
 """
 
 from __future__ import annotations
@@ -18,6 +28,7 @@ import hashlib
 import json
 import os
 import re
+import shutil
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -63,10 +74,67 @@ class _Context:
     progress: Progress
 
 
+#: Folders inside a stage's folder that are caches keyed by their content, carried
+#: from one run of the stage to the next (the grid search's per-candidate results).
+CACHES = (".gridcache",)
+
+
+def _robot_key(robot: str) -> list[str]:
+    """The robot as a stage key sees it: its name or path, and the file's content if it is one."""
+    from joulepath.description import PRESETS
+
+    path = Path(robot)
+    if robot not in PRESETS and path.is_file():
+        return [robot, _file_hash(robot)]
+    return [robot]
+
+
+def _carry_caches(sources: list[Path], work: Path) -> None:
+    """Move the content-keyed cache files of ``sources`` (first one wins) into ``work``."""
+    for name in CACHES:
+        for source in sources:
+            src = source / name
+            if not src.is_dir():
+                continue
+            for f in sorted(src.rglob("*")):
+                target = work / name / f.relative_to(src)
+                if f.is_file() and not target.exists():
+                    target.parent.mkdir(parents=True, exist_ok=True)
+                    os.replace(f, target)
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    elif path.exists() or path.is_symlink():
+        path.unlink()
+
+
+def _drop_stage(ctx: _Context, name: str, folder: str) -> None:
+    """Remove the folder of a stage that is no longer in the plan (and its leftovers)."""
+    path = ctx.root / folder
+    for leftover in (ctx.root / f".{folder}.partial", ctx.root / f".{folder}.old"):
+        _remove(leftover)
+    if path.exists():
+        _remove(path)
+        _forget_results(ctx)
+        ctx.tell(f"{name}: no longer in the experiment; its folder {folder}/ was removed")
+
+
+def _forget_results(ctx: _Context) -> None:
+    """Remove the run's summary and report: they describe stage folders that are being replaced."""
+    for stale in ("summary.json", "report.html"):
+        (ctx.root / stale).unlink(missing_ok=True)
+
+
 def _stage(
     ctx: _Context, name: str, folder: str, key: str, body: Callable[[Path], dict[str, Any]]
 ) -> dict[str, Any]:
-    """Run ``body(folder)`` unless the folder's ``stage.json`` holds ``key``; return its record."""
+    """Run ``body(folder)`` unless the folder's ``stage.json`` holds ``key``; return its record.
+
+    ``body`` writes into a fresh sibling folder, which replaces ``folder`` when
+    ``body`` has finished and ``stage.json`` is written; only :data:`CACHES` are carried over.
+    """
     path = ctx.root / folder
     marker = path / "stage.json"
     if marker.exists():
@@ -74,12 +142,28 @@ def _stage(
         if record.get("key") == key:
             ctx.tell(f"{name}: unchanged, skipped")
             return record
-        marker.unlink()
-    path.mkdir(parents=True, exist_ok=True)
+    work = ctx.root / f".{folder}.partial"
+    old = ctx.root / f".{folder}.old"
+    if work.exists():  # an interrupted run of this stage: keep its caches only
+        stale = ctx.root / f".{folder}.stale"
+        _remove(stale)
+        work.rename(stale)
+        work.mkdir()
+        _carry_caches([stale, path, old], work)
+        _remove(stale)
+    else:
+        work.mkdir()
+        _carry_caches([path, old], work)
     t0 = time.perf_counter()
-    extra = body(path)
+    extra = body(work)
     record = {"key": key, "stage": name, "wall_s": round(time.perf_counter() - t0, 3), **extra}
-    atomic_write_text(marker, json.dumps(record, indent=2, default=str))
+    atomic_write_text(work / "stage.json", json.dumps(record, indent=2, default=str))
+    _forget_results(ctx)
+    _remove(old)
+    if path.exists():
+        path.rename(old)
+    work.rename(path)
+    _remove(old)
     ctx.tell(f"{name}: done in {record['wall_s']:.1f} s")
     return record
 
@@ -129,13 +213,19 @@ def run_experiment(
     keys = {"data": stages["data"]["key"]}
     if exp.synth.methods:
         stages["synth"] = _synth_stage(ctx, keys["data"])
+    else:
+        _drop_stage(ctx, "synth", "synth")
     if exp.train.families:
         stages["train"] = _train_stage(ctx, keys["data"])
+    else:
+        _drop_stage(ctx, "train", "models")
     stages["importance"] = _importance_stage(ctx, keys["data"])
     model_key = stages["train"]["key"] if "train" in stages else ""
     stages["optimize"] = _optimize_stage(ctx, model_key, stages["importance"]["key"])
     if exp.bench.tasks:
         stages["bench"] = _bench_stage(ctx, model_key, stages["importance"]["key"])
+    else:
+        _drop_stage(ctx, "bench", "bench")
     tasks = pd.read_csv(root / "optimize" / "tasks.csv")
     ok = tasks[tasks["limits_ok"].astype(bool)] if len(tasks) else tasks
     summary: dict[str, Any] = {
@@ -179,7 +269,11 @@ def _data_stage(ctx: _Context) -> dict[str, Any]:
         "test": resolve_logs(exp, d.test_logs),
     }
     key = _hash(
-        "data", exp.robot, exp.seed, asdict(d), [_file_hash(p) for p in (*logs["train"], *logs["test"])]
+        "data",
+        _robot_key(exp.robot),
+        exp.seed,
+        asdict(d),
+        [_file_hash(p) for p in (*logs["train"], *logs["test"])],
     )
 
     def body(folder: Path) -> dict[str, Any]:
@@ -577,7 +671,14 @@ def _joints(ctx: _Context) -> tuple[int, ...]:
 def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str, Any]:
     exp, o = ctx.exp, ctx.exp.optimize
     uses_models = o.fitness != "physics"
-    key = _hash("optimize", model_key if uses_models else "", importance_key, exp.robot, asdict(o), exp.seed)
+    key = _hash(
+        "optimize",
+        model_key if uses_models else "",
+        importance_key,
+        _robot_key(exp.robot),
+        asdict(o),
+        exp.seed,
+    )
 
     def body(folder: Path) -> dict[str, Any]:
         import shutil
@@ -656,7 +757,9 @@ def _plot_tasks(frame: pd.DataFrame, path: Path) -> None:
 def _bench_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str, Any]:
     exp, b = ctx.exp, ctx.exp.bench
     uses_models = b.fitness != "physics"
-    key = _hash("bench", model_key if uses_models else "", importance_key, exp.robot, asdict(b), exp.seed)
+    key = _hash(
+        "bench", model_key if uses_models else "", importance_key, _robot_key(exp.robot), asdict(b), exp.seed
+    )
 
     def body(folder: Path) -> dict[str, Any]:
         from joulepath.optimize import bench_optimizers, summarize_bench, thesis_configurations
