@@ -257,3 +257,21 @@ def test_cli_ingest_glob_after_simulate_skips_the_sidecar(tmp_path, capsys):
 def test_cli_ingest_only_sidecars_refused(tmp_path, lab, capsys):
     out = tmp_path / "t.parquet"
     _refused(capsys, ["ingest", str(lab.moves), "--out", str(out)], "no joint logs among the 1 file(s)", out)
+
+
+# --------------------------------------------------------------------------- inputs that are not files
+
+
+def test_read_log_refuses_a_fifo_without_blocking(tmp_path):
+    import os
+
+    fifo = tmp_path / "live.csv"
+    os.mkfifo(fifo)  # opening it for reading would wait for a writer forever
+    assert not is_moves_sidecar(fifo)
+    with pytest.raises(InvalidLog, match=r"live\.csv: is a FIFO \(named pipe\), not a regular file"):
+        read_log(fifo)
+
+
+def test_read_log_refuses_a_folder(tmp_path):
+    with pytest.raises(InvalidLog, match=r"is a folder, not a log; give the log files in it"):
+        read_log(tmp_path)

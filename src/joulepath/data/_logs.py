@@ -30,6 +30,7 @@ import csv
 import io
 import os
 import re
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,7 +38,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.csv as pacsv
 
-from joulepath._io import atomic_write_text
+from joulepath._io import atomic_write_text, file_kind
 from joulepath._typing import FloatArray
 from joulepath.data._schema import (
     GENERIC_REQUIRED,
@@ -122,6 +123,17 @@ def _not_utf8(source: str, data: bytes, err: UnicodeDecodeError, base: int = 0) 
 
 def _read_header(path: Path, source: str) -> list[str]:
     try:
+        mode = os.stat(path).st_mode
+    except OSError as err:
+        raise InvalidLog(f"{source}: cannot be read ({err.strerror})") from err
+    if stat.S_ISDIR(mode):
+        raise InvalidLog(f"{source}: is a folder, not a log; give the log files in it (e.g. {source}/*.csv)")
+    if not stat.S_ISREG(mode):
+        raise InvalidLog(
+            f"{source}: is a {file_kind(mode)}, not a regular file; a log is read several times, so save "
+            "it to a file first and give that file"
+        )
+    try:
         with path.open("rb") as fh:
             raw = fh.readline()
     except OSError as err:
@@ -144,8 +156,11 @@ def is_moves_sidecar(path: str | os.PathLike[str]) -> bool:
     Recognised by its header (``move,t_start,t_end,speed,zone,j1_deg,...``), not
     by its name alone; a file that cannot be read is not a sidecar.
     """
+    p = Path(path)
+    if not p.is_file() or p.is_fifo():
+        return False
     try:
-        with Path(path).open("rb") as fh:
+        with p.open("rb") as fh:
             first = fh.readline(4096).decode("utf-8", errors="replace")
     except OSError:
         return False
