@@ -275,3 +275,13 @@ def test_read_log_refuses_a_fifo_without_blocking(tmp_path):
 def test_read_log_refuses_a_folder(tmp_path):
     with pytest.raises(InvalidLog, match=r"is a folder, not a log; give the log files in it"):
         read_log(tmp_path)
+
+
+def test_read_log_stray_carriage_return_is_one_error(tmp_path, lab):
+    """Found by fuzzing: a lone \\r inside a line made the line-by-line pass raise csv.Error."""
+    data = lab.log.read_bytes().split(b"\n")
+    data[4] = data[4][:12] + b"\r" + data[4][12:]
+    p = tmp_path / "cr.csv"
+    p.write_bytes(b"\n".join(data))
+    with pytest.raises(InvalidLog, match=r"cr\.csv: line 5: not a CSV line"):
+        read_log(p)

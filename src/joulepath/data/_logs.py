@@ -257,7 +257,11 @@ def _diagnose(path: Path, source: str, header: list[str]) -> InvalidLog:
         if not raw.strip():
             problems.append(f"line {lineno}: empty line")
             continue
-        fields = next(csv.reader(io.StringIO(raw)))
+        try:
+            fields = next(csv.reader(io.StringIO(raw)))
+        except (csv.Error, StopIteration) as err:
+            problems.append(f"line {lineno}: not a CSV line ({err or 'a stray carriage return or quote'})")
+            continue
         if len(fields) != n:
             what = f"line {lineno}: {len(fields)} fields instead of {n}"
             if lineno == last and len(fields) < n:
