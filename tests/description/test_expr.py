@@ -71,3 +71,27 @@ def test_format_angle_round_trips_exactly(value):
 def test_format_number_round_trips_exactly():
     for v in (0.29, 1.0, -8.0784e-05, 3.06700626, 1e300):
         assert float(format_number(v)) == v
+
+
+@pytest.mark.parametrize(
+    ("text", "pattern"),
+    [
+        ("(-1)**0.5", r"is not a real number \(\(-1\) \*\* 0.5 is complex\)"),
+        ("(-8)**(1/3)", "is complex"),
+        ("1" + "0" * 190 + "**2", "not finite|larger|cannot be evaluated"),
+        ("1\x00", "not a valid arithmetic expression"),
+    ],
+)
+def test_evaluate_refuses_complex_and_hostile_values_with_expression_error(text, pattern):
+    with pytest.raises(ExpressionError, match=pattern):
+        evaluate(text)
+
+
+def test_evaluate_affine_complex_offset_is_expression_error():
+    with pytest.raises(ExpressionError, match="complex"):
+        evaluate_affine("q1 + (-2)**0.5", frozenset({"q1"}))
+
+
+def test_evaluate_deepest_nesting_within_the_length_limit():
+    assert evaluate("(" * 99 + "1" + ")" * 99) == 1.0
+    assert evaluate("-" * 199 + "1") == -1.0

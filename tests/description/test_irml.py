@@ -182,3 +182,41 @@ def test_irml_error_messages_name_file_joint_and_tag():
         parse_irml(good().replace("<x>0</x>", "<x>zero</x>", 2), source="cell/robot.irml")
     msg = str(info.value)
     assert re.match(r"cell/robot\.irml: joint 1 <dynamics> <center> <x>: 'zero'", msg)
+
+
+@pytest.mark.parametrize(
+    ("mutate", "pattern"),
+    [
+        (lambda t: _break(t, "<d>0.1</d>", "<d>(-1)**0.5</d>"), r"joint 1 <kinematics> <d>: .*is complex"),
+        (lambda t: _break(t, "<q>q1</q>", "<q>q1 + (-2)**0.5</q>"), r"joint 1 <kinematics> <q>: .*complex"),
+        (
+            lambda t: t.replace("<name>T</name>", "<name>T</name>" + "<a>" * 2000 + "</a>" * 2000),
+            r"<a>: general information is nested deeper than 16 levels",
+        ),
+        (lambda t: ("<?xml version='1.0' encoding='klingon'?>" + t).encode(), r"XML: cannot be decoded"),
+        (lambda t: _break(t, 'id="1"', f'id="{"9" * 5000}"'), r"id is not an integer"),
+        (lambda t: _break(t, 'id="1"', 'id="1_0"'), r"id is not an integer"),
+        (lambda t: t.replace("<name>T</name>", "<name>T</name><reach>nan</reach>"), r"<reach>: 'nan'"),
+        (lambda t: t.replace("<name>T</name>", "<name>T</name><reach>1e999</reach>"), r"not a finite"),
+    ],
+)
+def test_parse_irml_hostile_values_give_invalid_robot_description(mutate, pattern):
+    with pytest.raises(InvalidRobotDescription, match=pattern):
+        parse_irml(mutate(good()), source="bad.irml")
+
+
+def test_parse_irml_refuses_too_many_joints_and_oversized_text():
+    with pytest.raises(InvalidRobotDescription, match="has 65 joints; at most 64"):
+        parse_irml(good(65))
+    with pytest.raises(InvalidRobotDescription, match="larger than 4 MiB"):
+        parse_irml(good().replace("<name>", " " * (5 << 20) + "<name>"))
+
+
+def test_parse_irml_keeps_shallow_general_information_in_order():
+    text = good().replace("<name>T</name>", "<name>T</name><a><b>1</b><c><d>2</d></c></a><e>3</e>")
+    assert parse_irml(text).info == (("a/b", "1"), ("a/c/d", "2"), ("e", "3"))
+
+
+def test_read_irml_refuses_a_folder(tmp_path):
+    with pytest.raises(InvalidRobotDescription, match="is a folder"):
+        read_irml(tmp_path)
