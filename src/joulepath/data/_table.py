@@ -88,40 +88,74 @@ def save_table(table: EnergyTable, path: str | os.PathLike[str]) -> Path:
     return atomic_write_bytes(path, buf.getvalue())
 
 
+def _corrupt(p: Path, what: str) -> InvalidLog:
+    return InvalidLog(
+        f"{p}: {what}; the file is damaged or not a joulepath table: write it again with `joulepath ingest`"
+    )
+
+
 def load_table(path: str | os.PathLike[str]) -> EnergyTable:
-    """Read a table written by :func:`save_table` and check its columns against the schema.
+    """Read a table written by :func:`save_table` and check it against the schema.
 
     Raises
     ------
     InvalidLog
-        Not a Parquet file, no joulepath metadata, or columns that do not match
-        the feature set (naming the missing and unexpected ones).
+        Not a Parquet file, no (or damaged) joulepath metadata, columns that do not
+        match the feature set (naming the missing and unexpected ones), or columns
+        that are not numbers or hold NaN or infinite values.
     """
     p = Path(path)
     if not p.exists():
         raise InvalidLog(f"{p}: no such file; give an energy table (.parquet) written by `joulepath ingest`")
     try:
         arrow = pq.read_table(p)
-    except (OSError, pa.ArrowInvalid) as err:
+    except (OSError, ValueError, pa.ArrowException) as err:
         raise InvalidLog(
-            f"{p}: not a readable Parquet energy table ({' '.join(str(err).split())}); "
+            f"{p}: not a readable Parquet energy table ({' '.join(str(err).split())[:300]}); "
             "give a table written by `joulepath ingest`"
         ) from err
     raw = (arrow.schema.metadata or {}).get(METADATA_KEY)
     if raw is None:
         raise InvalidLog(f"{p}: has no joulepath metadata; create tables with `joulepath ingest`")
-    meta = json.loads(raw)
+    try:
+        meta = json.loads(raw)
+    except ValueError as err:  # not UTF-8, or not JSON
+        raise _corrupt(p, "its joulepath metadata is not valid JSON") from err
+    if not isinstance(meta, dict):
+        raise _corrupt(p, f"its joulepath metadata is a JSON {type(meta).__name__}, not an object")
     feature_set = meta.get("feature_set")
-    if feature_set not in FEATURE_SETS:
-        raise InvalidLog(f"{p}: unknown feature set {feature_set!r}")
-    frame = arrow.to_pandas()
+    if not isinstance(feature_set, str) or feature_set not in FEATURE_SETS:
+        raise InvalidLog(
+            f"{p}: unknown feature set {feature_set!r}; expected one of {', '.join(FEATURE_SETS)}"
+        )
+    robot, sources = meta.get("robot"), meta.get("sources", [])
+    if robot is not None and not isinstance(robot, str):
+        raise _corrupt(p, f"its metadata names the robot as {robot!r}, not a string")
+    if not isinstance(sources, list) or not all(isinstance(s, dict) for s in sources):
+        raise _corrupt(p, "its metadata's sources are not a list of objects")
+    try:
+        frame = arrow.to_pandas(ignore_metadata=True)  # pandas' own metadata is not needed
+    except (ValueError, TypeError, KeyError, pa.ArrowException) as err:
+        raise _corrupt(p, f"its columns cannot be read ({' '.join(str(err).split())[:200]})") from err
     check_columns(frame, feature_set, source=str(p))
-    return EnergyTable(
-        frame=frame[list(table_columns(feature_set))],
-        feature_set=feature_set,
-        robot=meta.get("robot"),
-        sources=tuple(meta.get("sources", ())),
-    )
+    frame = frame[list(table_columns(feature_set))]
+    _check_values(frame, p)
+    return EnergyTable(frame=frame, feature_set=feature_set, robot=robot, sources=tuple(sources))
+
+
+def _check_values(frame: pd.DataFrame, p: Path) -> None:
+    """Every column numeric and finite (one InvalidLog naming the columns)."""
+    text = [str(c) for c, dtype in frame.dtypes.items() if not pd.api.types.is_numeric_dtype(dtype)]
+    if text:
+        raise InvalidLog(f"{p}: column(s) {', '.join(text)} do not hold numbers; write the table again")
+    values = frame.to_numpy(dtype=float)
+    bad = ~np.isfinite(values)
+    if bad.any():
+        cols = [f"{frame.columns[j]} ({int(bad[:, j].sum())} rows)" for j in np.nonzero(bad.any(axis=0))[0]]
+        raise InvalidLog(
+            f"{p}: NaN or infinite values in column(s) {', '.join(cols[:5])}"
+            f"{' ...' if len(cols) > 5 else ''}; write the table again from its logs"
+        )
 
 
 def check_columns(frame: pd.DataFrame, feature_set: str, *, source: str) -> None:
