@@ -1,7 +1,7 @@
 """The four model families of the thesis (§2.2), their pipelines and grids (Tables 2.2–2.5).
 
 SVR is :class:`~joulepath.learn.ScalableSVR`: the linear kernel is fitted with
-liblinear (``LinearSVR``) and the other kernels on at most
+liblinear (``LinearSVR``, squared epsilon-insensitive loss) and the other kernels on at most
 :data:`~joulepath.learn.KERNEL_SVR_MAX_ROWS` sampled rows, so the thesis grid runs
 on the thesis' table sizes.
 
@@ -40,7 +40,13 @@ SUBSTITUTIONS = {
         "replaced by its documented equivalent SGDRegressor(loss='epsilon_insensitive', "
         "penalty=None, learning_rate='pa1'|'pa2', eta0=C): thesis loss epsilon_insensitive -> pa1, "
         "squared_epsilon_insensitive -> pa2, C -> eta0"
-    )
+    ),
+    "svr": (
+        "SVR is joulepath's ScalableSVR: the linear kernel is fitted with LinearSVR on the squared "
+        "epsilon-insensitive loss (primal liblinear; libsvm's linear SVR and liblinear's dual solver "
+        "take minutes to hours on tens of thousands of rows), the other kernels with SVR on at most "
+        "KERNEL_SVR_MAX_ROWS = 5,000 randomly sampled rows"
+    ),
 }
 
 _HIDDEN = [

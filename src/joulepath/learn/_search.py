@@ -221,42 +221,48 @@ def estimate_fit_seconds(
     *,
     n_rows: int,
     seed: int,
-    trial_rows: int = 2000,
-    n_trials: int = 3,
+    trial_rows: tuple[int, int] = (500, 2000),
+    n_trials: int = 2,
 ) -> tuple[float, int]:
-    """Rough seconds one fit of a grid point takes on ``n_rows`` rows, and the trial size used.
+    """Rough seconds one fit of a grid point takes on ``n_rows`` rows, and the largest trial size.
 
-    Fits up to ``n_trials`` grid points (first, last and evenly between) on a seeded
-    sample of ``trial_rows`` rows and scales their mean time linearly with the rows
-    (quadratically, up to ``max_rows``, for kernel SVR). It is an estimate: iterative
-    models (MLP with early stopping, liblinear) need a different number of passes
-    on more data.
+    Fits up to ``n_trials`` grid points (first, last and evenly between) on seeded
+    samples of the two ``trial_rows`` sizes, fits a power law ``t ~ rows**a`` to the
+    summed times (``a`` clipped to [0.3, 2]: iterative models with early stopping
+    need fewer passes on more data, kernel methods grow faster than linearly) and
+    extrapolates to ``n_rows`` (to at most ``max_rows`` for kernel SVR, which
+    subsamples). A rough estimate for planning, not a promise.
     """
     from joulepath.learn._svr import ScalableSVR
 
     points = list(ParameterGrid(grid))
     picks = sorted({round(k) for k in np.linspace(0, len(points) - 1, min(n_trials, len(points)))})
-    m = min(trial_rows, len(y))
-    rows = np.sort(np.random.default_rng(seed).choice(len(y), m, replace=False))
-    seconds = []
-    for k in picks:
-        model = clone(pipeline).set_params(**points[k])
-        t0 = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ConvergenceWarning)
-            warnings.simplefilter("ignore", RuntimeWarning)
-            try:
-                model.fit(X[rows], y[rows])
-            except (ValueError, ArithmeticError, np.linalg.LinAlgError):
-                pass
-        spent = time.perf_counter() - t0
-        est = model.steps[-1][1]
-        if isinstance(est, ScalableSVR) and est.kernel != "linear":
-            spent *= (min(n_rows, est.max_rows) / m) ** 2
-        else:
-            spent *= n_rows / m
-        seconds.append(spent)
-    return float(np.mean(seconds)), m
+    sizes = sorted({min(m, len(y)) for m in trial_rows})
+    rng = np.random.default_rng(seed)
+    spent = dict.fromkeys(sizes, 0.0)
+    target = float(n_rows)
+    for m in sizes:
+        rows = np.sort(rng.choice(len(y), m, replace=False))
+        for k in picks:
+            model = clone(pipeline).set_params(**points[k])
+            est = model.steps[-1][1]
+            if isinstance(est, ScalableSVR) and est.kernel != "linear":
+                target = min(target, float(est.max_rows))
+            t0 = time.perf_counter()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", ConvergenceWarning)
+                warnings.simplefilter("ignore", RuntimeWarning)
+                try:
+                    model.fit(X[rows], y[rows])
+                except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+                    pass
+            spent[m] += time.perf_counter() - t0
+    big = sizes[-1]
+    exponent = 1.0
+    if len(sizes) == 2 and spent[sizes[0]] > 0:
+        exponent = float(np.clip(np.log(spent[big] / spent[sizes[0]]) / np.log(big / sizes[0]), 0.3, 2.0))
+    per_fit = spent[big] / len(picks) * (max(target, 1.0) / big) ** exponent
+    return float(per_fit), big
 
 
 def grid_search(

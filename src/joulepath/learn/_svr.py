@@ -5,8 +5,13 @@ the 70,000 rows of the README tour a single fit takes hours. :class:`ScalableSVR
 keeps the thesis' grid (Table 2.3: ``kernel``, ``degree``, ``gamma``, ``C``,
 ``epsilon``) and fits
 
-* ``kernel="linear"`` with :class:`~sklearn.svm.LinearSVR` (liblinear, the same
-  epsilon-insensitive loss, linear in the rows);
+* ``kernel="linear"`` with :class:`~sklearn.svm.LinearSVR` (liblinear, linear in
+  the rows). By default it minimises the *squared* epsilon-insensitive loss in the
+  primal (``linear_loss="squared_epsilon_insensitive"``): on 56,000 rows of the
+  README tour that fit takes 2 s, where liblinear's dual solver for the thesis'
+  plain epsilon-insensitive loss stops at 1,000 iterations unconverged after
+  170 s (measured; test R² 0.998 vs 0.996). ``linear_loss="epsilon_insensitive"``
+  keeps the thesis' loss;
 * any other kernel with :class:`~sklearn.svm.SVR` on a seeded random sample of at
   most ``max_rows`` rows (:data:`KERNEL_SVR_MAX_ROWS` by default), with a
   :class:`SubsampleWarning` that states the counts.
@@ -47,8 +52,11 @@ class ScalableSVR(RegressorMixin, BaseEstimator):  # type: ignore[misc]
     C : float, default=1.0
     epsilon : float, default=0.1
     tol : float, default=1e-3
-    max_iter : int, default=10000
+    max_iter : int, default=1000
         Iterations of liblinear (linear kernel only).
+    linear_loss : {"squared_epsilon_insensitive", "epsilon_insensitive"}, default="squared_..."
+        Loss of the linear kernel: squared (primal solver, fast) or the thesis' plain
+        epsilon-insensitive loss (dual solver, slow on many rows).
     max_rows : int, default=KERNEL_SVR_MAX_ROWS
         Kernel SVR fits on a random sample of at most this many rows.
     cache_size : float, default=500
@@ -80,6 +88,7 @@ class ScalableSVR(RegressorMixin, BaseEstimator):  # type: ignore[misc]
         "epsilon": [Interval(Real, 0.0, None, closed="left")],
         "tol": [Interval(Real, 0.0, None, closed="neither")],
         "max_iter": [Interval(Integral, 1, None, closed="left")],
+        "linear_loss": [StrOptions({"squared_epsilon_insensitive", "epsilon_insensitive"})],
         "max_rows": [Interval(Integral, 1, None, closed="left")],
         "cache_size": [Interval(Real, 0, None, closed="neither")],
         "random_state": ["random_state"],
@@ -94,7 +103,8 @@ class ScalableSVR(RegressorMixin, BaseEstimator):  # type: ignore[misc]
         C: float = 1.0,
         epsilon: float = 0.1,
         tol: float = 1e-3,
-        max_iter: int = 10000,
+        max_iter: int = 1000,
+        linear_loss: str = "squared_epsilon_insensitive",
         max_rows: int = KERNEL_SVR_MAX_ROWS,
         cache_size: float = 500,
         random_state: int | None = None,
@@ -107,6 +117,7 @@ class ScalableSVR(RegressorMixin, BaseEstimator):  # type: ignore[misc]
         self.epsilon = epsilon
         self.tol = tol
         self.max_iter = max_iter
+        self.linear_loss = linear_loss
         self.max_rows = max_rows
         self.cache_size = cache_size
         self.random_state = random_state
@@ -123,8 +134,8 @@ class ScalableSVR(RegressorMixin, BaseEstimator):  # type: ignore[misc]
             estimator = LinearSVR(
                 C=self.C,
                 epsilon=self.epsilon,
-                loss="epsilon_insensitive",
-                dual=True,
+                loss=self.linear_loss,
+                dual=self.linear_loss == "epsilon_insensitive",
                 tol=self.tol,
                 max_iter=self.max_iter,
                 random_state=seed,

@@ -157,7 +157,7 @@ def _announce(
     say(
         f"{label}: {n_fits} fits ({pending} of {n_points} candidates x {config.cv} folds{par}, "
         f"{config.cv} shuffled folds, 1 refit) on ~{fold_rows:,} rows; roughly {_duration(total)} "
-        f"(scaled from trial fits on {trial:,} rows)"
+        f"(extrapolated from trial fits on up to {trial:,} rows)"
     )
 
 

@@ -411,6 +411,7 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
         if not isinstance(inner, LinearSVR | SVR):
             raise InvalidModel(f"{where}: the ScalableSVR is not fitted; train the model again")
         model = inner
+        wrong = f"{where}: the {type(model).__name__}'s fitted arrays do not fit {n} model features"
     if isinstance(model, SVR):
         n_sv = _shape(model, "support_vectors_")
         ok = (
