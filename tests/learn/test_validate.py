@@ -285,7 +285,7 @@ def _card_list(card):
         (
             "par-E",
             _drop_column,
-            r"has 40 input columns \(unknown: none; missing: \w+; duplicates: 0\), but a model .* reads the 41 columns",
+            r"has 40 input columns \(unknown: none; missing: \w+; duplicates: 0\), but .* reads the 41",
         ),
         ("svr-E", _rename_column, r"unknown: q9; missing: \w+"),
         ("mlp-E", _duplicate_column, r"duplicates: 1"),
