@@ -360,3 +360,26 @@ def test_load_table_flipped_bytes_never_escape_as_other_errors(tmp_path, table_f
             load_table(p)
         except JoulepathError:
             pass
+
+
+# --------------------------------------------------------------------------- the same, as a user runs them
+
+
+def test_cli_time_in_milliseconds_refused(tmp_path, signals, capsys):
+    t, q, qd, tau = signals
+    p = _generic(tmp_path / "ms.csv", t * 1000, q, qd, tau)
+    out = tmp_path / "ms.parquet"
+    _refused(capsys, ["ingest", str(p), "--out", str(out)], "is t in milliseconds? t must be in seconds", out)
+
+
+def test_cli_gap_is_noted_and_no_row_spans_it(tmp_path, signals, capsys):
+    import pandas as pd
+
+    t, q, qd, tau = signals
+    t_gap = t.copy()
+    t_gap[len(t) // 2 :] += 3600.0
+    p = _generic(tmp_path / "gap.csv", t_gap, q, qd, tau)
+    out = tmp_path / "gap.parquet"
+    assert main(["ingest", str(p), "--out", str(out), "--robot", "irb120"]) == 0
+    assert "1 gap(s) in t" in capsys.readouterr().out
+    assert pd.read_parquet(out)["dt"].max() < 0.05
