@@ -213,6 +213,19 @@ def pending_candidates(
     return len(_plan(grid, X, y, groups, family, split, n_splits, seed, cache_dir)[3])
 
 
+def _mlp_epochs_at(model: Any, m: int, n: int) -> float | None:
+    """Epochs an early-stopping MLP fitted on ``m`` rows needs on ``n``: the same number of
+    minibatch updates, but at least ``n_iter_no_change + 1`` epochs; None for other models."""
+    from sklearn.neural_network import MLPRegressor
+
+    est = model.steps[-1][1] if isinstance(model, Pipeline) else model
+    if not isinstance(est, MLPRegressor) or not est.early_stopping or not getattr(est, "n_iter_", 0):
+        return None
+    batch = 200 if est.batch_size == "auto" else int(est.batch_size)
+    updates = est.n_iter_ * np.ceil(m / min(batch, m))
+    return float(max(updates / np.ceil(n / min(batch, n)), est.n_iter_no_change + 1) / est.n_iter_)
+
+
 def estimate_fit_seconds(
     pipeline: Pipeline,
     grid: dict[str, list[Any]],
@@ -227,11 +240,12 @@ def estimate_fit_seconds(
     """Rough seconds one fit of a grid point takes on ``n_rows`` rows, and the largest trial size.
 
     Fits up to ``n_trials`` grid points (first, last and evenly between) on seeded
-    samples of the two ``trial_rows`` sizes, fits a power law ``t ~ rows**a`` to the
-    summed times (``a`` clipped to [0.3, 2]: iterative models with early stopping
-    need fewer passes on more data, kernel methods grow faster than linearly) and
-    extrapolates to ``n_rows`` (to at most ``max_rows`` for kernel SVR, which
-    subsamples). A rough estimate for planning, not a promise.
+    samples of the two ``trial_rows`` sizes and extrapolates each to ``n_rows`` (to
+    at most ``max_rows`` for kernel SVR, which subsamples) with a power law
+    ``t ~ rows**a`` through the two times (``a`` clipped to [0.3, 2]). An MLP with
+    early stopping instead scales its per-epoch time linearly and assumes the same
+    number of minibatch updates (so fewer epochs on more rows). A rough estimate for
+    planning, not a promise.
     """
     from joulepath.learn._svr import ScalableSVR
 
@@ -239,15 +253,12 @@ def estimate_fit_seconds(
     picks = sorted({round(k) for k in np.linspace(0, len(points) - 1, min(n_trials, len(points)))})
     sizes = sorted({min(m, len(y)) for m in trial_rows})
     rng = np.random.default_rng(seed)
-    spent = dict.fromkeys(sizes, 0.0)
-    target = float(n_rows)
-    for m in sizes:
-        rows = np.sort(rng.choice(len(y), m, replace=False))
-        for k in picks:
+    samples = [np.sort(rng.choice(len(y), m, replace=False)) for m in sizes]
+    estimates = []
+    for k in picks:
+        spent = []
+        for rows in samples:
             model = clone(pipeline).set_params(**points[k])
-            est = model.steps[-1][1]
-            if isinstance(est, ScalableSVR) and est.kernel != "linear":
-                target = min(target, float(est.max_rows))
             t0 = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", ConvergenceWarning)
@@ -256,13 +267,21 @@ def estimate_fit_seconds(
                     model.fit(X[rows], y[rows])
                 except (ValueError, ArithmeticError, np.linalg.LinAlgError):
                     pass
-            spent[m] += time.perf_counter() - t0
-    big = sizes[-1]
-    exponent = 1.0
-    if len(sizes) == 2 and spent[sizes[0]] > 0:
-        exponent = float(np.clip(np.log(spent[big] / spent[sizes[0]]) / np.log(big / sizes[0]), 0.3, 2.0))
-    per_fit = spent[big] / len(picks) * (max(target, 1.0) / big) ** exponent
-    return float(per_fit), big
+            spent.append(max(time.perf_counter() - t0, 1e-6))
+        big = sizes[-1]
+        est = model.steps[-1][1]
+        target = float(n_rows)
+        if isinstance(est, ScalableSVR) and est.kernel != "linear":
+            target = min(target, float(est.max_rows))
+        epochs = _mlp_epochs_at(model, big, n_rows)
+        if epochs is not None:
+            estimates.append(spent[-1] * (target / big) * epochs)
+            continue
+        exponent = 1.0
+        if len(sizes) == 2:
+            exponent = float(np.clip(np.log(spent[1] / spent[0]) / np.log(big / sizes[0]), 0.3, 2.0))
+        estimates.append(spent[-1] * (target / big) ** exponent)
+    return float(np.mean(estimates)), sizes[-1]
 
 
 def grid_search(

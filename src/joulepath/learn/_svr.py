@@ -70,6 +70,8 @@ class ScalableSVR(RegressorMixin, BaseEstimator):  # type: ignore[misc]
         The fitted model.
     n_fit_rows_ : int
         Rows the model was fitted on.
+    n_iter_ : int
+        Solver iterations.
 
     Examples
     --------
@@ -163,6 +165,7 @@ class ScalableSVR(RegressorMixin, BaseEstimator):  # type: ignore[misc]
             )
         self.estimator_ = estimator.fit(X, y, sample_weight=weight)
         self.n_fit_rows_ = int(X.shape[0])
+        self.n_iter_ = int(np.max(estimator.n_iter_))
         return self
 
     def predict(self, X: Any) -> FloatArray:

@@ -1,0 +1,71 @@
+"""``joulepath train`` on the command line: plain progress lines without a terminal, one-line refusals."""
+
+import re
+
+import pytest
+
+import joulepath
+from joulepath.cli import main
+from joulepath.data import EnergyTable, ingest, save_table
+from joulepath.errors import InvalidInput
+from joulepath.learn import TrainConfig, train
+from joulepath.sim import simulate
+
+
+@pytest.fixture(scope="module")
+def tables(tmp_path_factory):
+    d = tmp_path_factory.mktemp("cli-train")
+    robot = joulepath.load_robot("irb120")
+    full = ingest([simulate(d / "train.csv", plant="lab", n_moves=6, seed=3).log], robot=robot)
+    test = ingest([simulate(d / "test.csv", plant="lab", n_moves=3, seed=4).log], robot=robot)
+    empty = EnergyTable(frame=test.frame.iloc[:0], feature_set=test.feature_set)
+    return {
+        "train": save_table(full, d / "train.parquet"),
+        "test": save_table(test, d / "test.parquet"),
+        "empty": save_table(empty, d / "empty.parquet"),
+        "tables": (full, test, empty),
+    }
+
+
+def test_train_without_a_terminal_prints_plain_progress_lines(tables, tmp_path, capsys):
+    out = tmp_path / "models"
+    argv = ["train", "--data", str(tables["train"]), "--test", str(tables["test"])]
+    code = main([*argv, "--family", "par", "--cv", "2", "--out", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    lines = captured.err.splitlines()
+    assert not any("\x1b" in line for line in lines)  # no terminal control codes
+    plan = [line for line in lines if " fits (" in line]
+    assert len(plan) == 1
+    assert re.fullmatch(
+        r"par E: 11 fits \(4 of 4 candidates x 2 folds, 2 shuffled folds, 1 refit\) on ~[\d,]+ rows; "
+        r"roughly \d+ (s|min|h) \(extrapolated from trial fits on up to [\d,]+ rows\)",
+        plan[0],
+    ), plan[0]
+    assert "par E: 0/4 candidates" in lines and lines.index(plan[0]) < lines.index("par E: 0/4 candidates")
+    assert any(re.fullmatch(r"par E: 4/4 candidates, \d+ s spent", line) for line in lines), lines
+    assert any(line.startswith("par E: refitting the best candidate on all") for line in lines)
+    assert (out / "par-E" / "card.json").exists()
+    assert "test_r2" not in captured.err and "par" in captured.out  # results stay on stdout
+
+
+@pytest.mark.parametrize(
+    ("data", "test", "option"), [("train", "empty", "--test"), ("empty", "test", "--data")]
+)
+def test_train_refuses_an_empty_table_in_one_line(tables, tmp_path, capsys, data, test, option):
+    out = tmp_path / "models"
+    code = main(["train", "--data", str(tables[data]), "--test", str(tables[test]), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err
+    expected = f"{tables['empty']}: the table has no rows; give {option} a table ingested from logs"
+    assert err.splitlines() == [f"error: {expected} with moves"]
+    assert not out.exists()
+
+
+def test_train_library_refuses_empty_tables(tables, tmp_path):
+    full, test, empty = tables["tables"]
+    with pytest.raises(InvalidInput, match="the test table has no rows"):
+        train(full, empty, TrainConfig(families=("par",), cv=2), tmp_path / "m")
+    with pytest.raises(InvalidInput, match="the training table has no rows"):
+        train(empty, test, TrainConfig(families=("par",), cv=2), tmp_path / "m")
+    assert not (tmp_path / "m").exists()
