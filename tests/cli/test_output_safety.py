@@ -272,3 +272,11 @@ def test_subprocess_ingest_dev_null_exit_code_and_one_line(lab, null_device):
         "choose another output path (--out)"
     ]
     assert stat.S_ISCHR(os.stat(null_device).st_mode)
+
+
+# --------------------------------------------------------------------------- joint arguments (cli/_common.py)
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
+def test_cli_joint_values_must_be_finite(capsys, value):
+    _one_line(capsys, ["robot", "fk", "irb120", "--q", f"{value},0,0,0,0,0"], f"{value} in ")

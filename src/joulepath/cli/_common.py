@@ -29,7 +29,7 @@ PathLike = str | os.PathLike[str]
 
 
 def parse_joints(text: str, *, option: str, degrees: bool, n: int = 6) -> list[float]:
-    """``"0,10,20,0,30,0"`` -> floats in rad (``degrees`` converts); BadParameter otherwise."""
+    """``"0,10,20,0,30,0"`` -> floats in rad (``degrees`` converts); BadParameter otherwise (nan, inf too)."""
     import math
 
     parts = [p for p in text.replace(";", ",").split(",") if p.strip()]
@@ -39,6 +39,11 @@ def parse_joints(text: str, *, option: str, degrees: bool, n: int = 6) -> list[f
         raise typer.BadParameter(
             f"{text!r} is not a comma-separated list of numbers", param_hint=option
         ) from err
+    bad = [p.strip() for p, v in zip(parts, values, strict=True) if not math.isfinite(v)]
+    if bad:
+        raise typer.BadParameter(
+            f"{', '.join(bad)} in {text!r} is not a finite number; give {n} joint values", param_hint=option
+        )
     if len(values) != n:
         raise typer.BadParameter(
             f"expected {n} joint values, got {len(values)} ({text!r})", param_hint=option
