@@ -54,3 +54,30 @@ def test_grid_search_on_a_dask_local_cluster(xy, dask_scheduler):
     local = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3)
     assert res.n_fitted == 4
     np.testing.assert_allclose([c.r2_mean for c in res.candidates], [c.r2_mean for c in local.candidates])
+
+
+def test_pending_candidates_counts_what_is_not_cached(xy, tmp_path):
+    from joulepath.learn._search import pending_candidates
+
+    X, y, groups, cols = xy
+    kwargs = {"family": "par", "n_splits": 3, "cache_dir": tmp_path}
+    assert pending_candidates(GRID, X, y, groups, **kwargs) == 4
+    grid_search(make_pipeline("par", seed=0, columns=cols), GRID, X, y, groups, **kwargs)
+    assert pending_candidates(GRID, X, y, groups, **kwargs) == 0
+    files = sorted(tmp_path.glob("*.json"))
+    files[0].unlink()
+    files[1].write_text("{not json")  # a damaged cache entry is fitted again, not a crash
+    assert pending_candidates(GRID, X, y, groups, **kwargs) == 2
+    assert pending_candidates(GRID, X, y, groups, family="par", n_splits=3, cache_dir=None) == 4
+
+
+def test_estimate_fit_seconds_is_a_positive_time_from_small_trials(xy):
+    from joulepath.learn import QUICK_GRIDS
+    from joulepath.learn._search import estimate_fit_seconds
+
+    X, y, _, cols = xy
+    for family in ("par", "mlp"):
+        pipe = make_pipeline(family, seed=0, columns=cols)
+        seconds, trial = estimate_fit_seconds(pipe, QUICK_GRIDS[family], X, y, n_rows=50_000, seed=0)
+        assert np.isfinite(seconds) and 0 < seconds < 600, (family, seconds)
+        assert trial == min(2000, len(y))
