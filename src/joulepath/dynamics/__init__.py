@@ -1,11 +1,13 @@
 """Rigid-body dynamics: the :class:`Robot`, two inverse-dynamics implementations, friction."""
 
+from joulepath.dynamics._derivatives import DynamicsDerivatives, inverse_dynamics_derivatives
 from joulepath.dynamics._friction import (
     NOMINAL_FRICTION,
     CoulombViscousFriction,
     ElastoPlasticFriction,
     Friction,
     FrictionSum,
+    friction_derivative,
 )
 from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le
 from joulepath.dynamics._rnea import PinocchioRnea
@@ -13,6 +15,7 @@ from joulepath.dynamics._robot import METHODS, Robot, load_robot
 
 __all__ = [
     "CoulombViscousFriction",
+    "DynamicsDerivatives",
     "ElastoPlasticFriction",
     "Friction",
     "FrictionSum",
@@ -20,6 +23,8 @@ __all__ = [
     "NOMINAL_FRICTION",
     "PinocchioRnea",
     "Robot",
+    "friction_derivative",
+    "inverse_dynamics_derivatives",
     "lagrange_euler",
     "load_robot",
     "mass_matrix_le",

@@ -29,6 +29,21 @@ class Friction(Protocol):
     def torque(self, qd: FloatArray) -> FloatArray: ...
 
 
+def friction_derivative(friction: Friction, qd: FloatArray) -> FloatArray:
+    """``d tau_f / d qd`` per joint, same shape as ``qd`` (friction acts joint by joint).
+
+    Uses the term's own ``derivative(qd)`` when it has one; otherwise a central
+    difference of ``torque`` with a step of 1e-6 rad/s.
+    """
+    own = getattr(friction, "derivative", None)
+    if callable(own):
+        out: FloatArray = np.asarray(own(qd), dtype=float)
+        return out
+    h = 1e-6
+    diff: FloatArray = (friction.torque(qd + h) - friction.torque(qd - h)) / (2 * h)
+    return diff
+
+
 class _Addable:
     def __add__(self, other: Friction) -> FrictionSum:
         if not isinstance(other, Friction):
@@ -84,6 +99,17 @@ class ElastoPlasticFriction(_Addable):
         out: FloatArray = mk * np.sign(qd) * shape
         return out
 
+    def derivative(self, qd: FloatArray) -> FloatArray:
+        """``d tau_f / d qd`` away from ``qd = 0`` (the jump at 0 has no derivative)."""
+        mk = _param(self.mu_k, "mu_k")
+        ms = _param(self.mu_s, "mu_s")
+        v = np.abs(qd)
+        if self.form == "listing":
+            out: FloatArray = np.exp(-(v - ms) / mk) * np.ones_like(qd)
+        else:
+            out = np.exp(-v - ms) * np.ones_like(qd)
+        return out
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class CoulombViscousFriction(_Addable):
@@ -110,6 +136,17 @@ class CoulombViscousFriction(_Addable):
         out: FloatArray = fc * sgn + fv * qd
         return out
 
+    def derivative(self, qd: FloatArray) -> FloatArray:
+        """``d tau_f / d qd``: ``coulomb / smoothing · sech²(qd / smoothing) + viscous`` (0 if unsmoothed)."""
+        fc = _param(self.coulomb, "coulomb")
+        fv = _param(self.viscous, "viscous")
+        if self.smoothing > 0:
+            th = np.tanh(qd / self.smoothing)
+            out: FloatArray = fc / self.smoothing * (1.0 - th * th) + fv
+        else:
+            out = fv * np.ones_like(qd)
+        return out
+
 
 @dataclass(frozen=True, slots=True)
 class FrictionSum(_Addable):
@@ -121,6 +158,12 @@ class FrictionSum(_Addable):
         total = np.zeros_like(qd, dtype=float)
         for term in self.terms:
             total = total + term.torque(qd)
+        return total
+
+    def derivative(self, qd: FloatArray) -> FloatArray:
+        total = np.zeros_like(qd, dtype=float)
+        for term in self.terms:
+            total = total + friction_derivative(term, qd)
         return total
 
 

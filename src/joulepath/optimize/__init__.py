@@ -2,6 +2,7 @@
 
 from joulepath.optimize._bench import bench_optimizers, random_tasks, summarize_bench, thesis_configurations
 from joulepath.optimize._features import path_features
+from joulepath.optimize._gradient import GradientResult, GradientSettings, SplineProblem, optimize_spline
 from joulepath.optimize._problem import (
     FITNESS,
     PARAMETRIZATIONS,
@@ -12,33 +13,63 @@ from joulepath.optimize._problem import (
     physics_energy,
 )
 from joulepath.optimize._run import (
-    ALGORITHMS,
+    ACCEL_TIME,
+    RUN_FILES,
     MoveResult,
+    MoveSummary,
     OptimizeConfig,
-    make_algorithm,
+    acceleration_limit,
+    check_default_feasible,
     optimize_move,
     rank_joints_by_energy,
+    verify_move,
     write_run,
+)
+from joulepath.optimize._search import ALGORITHMS, AUTO, AlgorithmSpec, SearchOutcome, resolve_algorithm
+from joulepath.optimize._verify import (
+    FINE_FACTOR,
+    LimitExcess,
+    LimitReport,
+    check_limits,
+    shortest_feasible_duration,
 )
 
 __all__ = [
+    "ACCEL_TIME",
     "ALGORITHMS",
+    "AUTO",
+    "AlgorithmSpec",
+    "FINE_FACTOR",
     "FITNESS",
+    "GradientResult",
+    "GradientSettings",
+    "LimitExcess",
+    "LimitReport",
     "MoveResult",
+    "MoveSummary",
     "OptimizeConfig",
     "PARAMETRIZATIONS",
     "PENALTY",
+    "RUN_FILES",
+    "SearchOutcome",
+    "SplineProblem",
     "TrajectoryProblem",
     "Violation",
+    "acceleration_limit",
     "bench_optimizers",
+    "check_default_feasible",
+    "check_limits",
     "limit_violation",
-    "make_algorithm",
     "optimize_move",
+    "optimize_spline",
     "path_features",
     "physics_energy",
     "random_tasks",
     "rank_joints_by_energy",
+    "resolve_algorithm",
+    "shortest_feasible_duration",
     "summarize_bench",
     "thesis_configurations",
+    "verify_move",
     "write_run",
 ]

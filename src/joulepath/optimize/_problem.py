@@ -26,6 +26,7 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Robot
+from joulepath.energy import path_energy
 from joulepath.errors import InvalidInput
 from joulepath.optimize._features import path_features
 from joulepath.trajectory import GRID_HIGH, GRID_LOW, Trajectory, rest_to_rest, thesis_quintic
@@ -50,8 +51,18 @@ class Violation:
         return out
 
 
-def limit_violation(robot: Robot, traj: Trajectory, tau: FloatArray | None = None) -> Violation:
-    """Violations of paths q, qd (and torques tau) of shape (P, n, 6)."""
+def limit_violation(
+    robot: Robot,
+    traj: Trajectory,
+    tau: FloatArray | None = None,
+    *,
+    acceleration_limit: FloatArray | None = None,
+) -> Violation:
+    """Violations of paths q, qd (and torques tau) of shape (P, n, 6).
+
+    With ``acceleration_limit`` (rad/s², one per joint) the relative over-acceleration
+    counts with the overspeed.
+    """
     q = traj.q if traj.q.ndim == 3 else traj.q[None]
     qd = traj.qd if traj.qd.ndim == 3 else traj.qd[None]
     lo, hi = robot.joint_ranges()
@@ -62,6 +73,11 @@ def limit_violation(robot: Robot, traj: Trajectory, tau: FloatArray | None = Non
     vmax = robot.velocity_limit
     ratio = np.abs(qd) / np.where(np.isfinite(vmax), vmax, np.inf)
     spd_v = np.maximum(ratio.max(axis=1) - 1.0, 0.0).sum(axis=1)
+    if acceleration_limit is not None:
+        qdd = traj.qdd if traj.qdd.ndim == 3 else traj.qdd[None]
+        amax = np.asarray(acceleration_limit, dtype=float)
+        acc = np.abs(qdd) / np.where(np.isfinite(amax) & (amax > 0), amax, np.inf)
+        spd_v = spd_v + np.maximum(acc.max(axis=1) - 1.0, 0.0).sum(axis=1)
     trq_v = np.zeros_like(rng_v)
     emax = robot.effort_limit
     if tau is not None and np.any(np.isfinite(emax)):
@@ -76,7 +92,7 @@ def physics_energy(
 ) -> tuple[FloatArray, FloatArray]:
     """Per-path energy ``Σ |tau qd| dt`` (J) and the torques, for paths (P, n, 6)."""
     tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=friction)
-    e = (np.abs(tau * traj.qd) * traj.dt).sum(axis=(-1, -2))
+    e = path_energy(tau, traj.qd, traj.dt).total
     return np.atleast_1d(e), tau
 
 
@@ -95,6 +111,7 @@ class TrajectoryProblem:
     models: tuple[Any, ...] = ()
     parametrization: str = "rest_to_rest"
     dt: float = 0.025
+    acceleration_limit: FloatArray | None = None
     n_evaluated: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -146,6 +163,6 @@ class TrajectoryProblem:
         traj = self.trajectory(X)
         energy, tau = self.energy(traj)
         self.n_evaluated += energy.size
-        viol = limit_violation(self.robot, traj, tau)
+        viol = limit_violation(self.robot, traj, tau, acceleration_limit=self.acceleration_limit)
         out: FloatArray = energy + PENALTY * viol.total
         return out

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -13,34 +12,59 @@ import numpy as np
 
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
-from joulepath.dynamics import Robot
-from joulepath.errors import InvalidInput, LimitViolation
-from joulepath.evolve import DE, GA, MA, Termination, minimize
-from joulepath.optimize._problem import (
-    FITNESS,
-    PARAMETRIZATIONS,
-    TrajectoryProblem,
-    limit_violation,
-    physics_energy,
+from joulepath.dynamics import NOMINAL_FRICTION, Robot
+from joulepath.energy import joint_power, path_energy
+from joulepath.errors import InvalidInput, InvalidModel, LimitViolation
+from joulepath.optimize._problem import FITNESS, PARAMETRIZATIONS, TrajectoryProblem
+from joulepath.optimize._search import (
+    AUTO,
+    AlgorithmSpec,
+    SearchOutcome,
+    SearchTask,
+    resolve_algorithm,
+    timed,
 )
-from joulepath.trajectory import Trajectory, minimum_jerk
+from joulepath.optimize._verify import (
+    check_limits,
+    default_fine,
+    energy_on_samples,
+    shortest_feasible_duration,
+    tcp_deviation_mm,
+)
+from joulepath.trajectory import DEFAULT_KNOT_SPACING, Trajectory, minimum_jerk, sample_times
+from joulepath.units import SAMPLE_PERIOD
 
-ALGORITHMS = ("ga", "de", "ma-random", "ma-informed")
+ACCEL_TIME = 0.25
+"""s for a joint to reach its speed limit at full acceleration: the acceleration limit
+``v_max / ACCEL_TIME`` that the emulated controller also assumes (ABB publishes none)."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class OptimizeConfig:
-    """Settings of one optimization (defaults: the thesis' best GA settings, §4.5).
+    """Settings of one optimization.
+
+    ``algorithm`` is a name of :data:`ALGORITHMS` or ``"auto"`` (default): the
+    constrained gradient search on the physics fitness, CMA-ES on a learned model.
+    ``knot_spacing``, ``n_starts`` and ``evaluations`` set the B-spline searches;
+    ``pop_size`` … ``informed_joints`` the thesis' evolutionary ones (defaults: its
+    best GA settings, §4.5). ``accel_time`` sets the acceleration limits
+    (``v_max / accel_time``; 0 disables them). ``max_deviation_mm`` keeps the TCP
+    within that distance of the default move's TCP at every sample (gradient search).
 
     ``inject_default`` puts the all-zero chromosome (the minimum-jerk default path of
-    ``rest_to_rest``) into the initial population, so the search never returns a
-    path its fitness rates worse than the default; the thesis' protocol (and
-    ``bench-optimizers``) starts from random chromosomes only.
+    ``rest_to_rest``) into the initial population of the evolutionary searches, so
+    they never return a path their fitness rates worse than the default; the thesis'
+    protocol (and ``bench-optimizers``) starts from random chromosomes only.
     """
 
-    algorithm: str = "ma-random"
+    algorithm: str = AUTO
     fitness: str = "physics"
     parametrization: str = "rest_to_rest"
+    knot_spacing: float = DEFAULT_KNOT_SPACING
+    n_starts: int = 2
+    evaluations: int = 6000
+    accel_time: float = ACCEL_TIME
+    max_deviation_mm: float | None = None
     pop_size: int = 100
     max_gen: int = 200
     n_stagnant: int = 10
@@ -54,63 +78,186 @@ class OptimizeConfig:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        if self.algorithm not in ALGORITHMS:
-            raise InvalidInput(f"algorithm must be one of {', '.join(ALGORITHMS)}, got {self.algorithm!r}")
         if self.fitness not in FITNESS:
             raise InvalidInput(f"fitness must be one of {', '.join(FITNESS)}, got {self.fitness!r}")
+        resolve_algorithm(self.algorithm, self.fitness)
         if self.parametrization not in PARAMETRIZATIONS:
             raise InvalidInput(
                 f"parametrization must be one of {PARAMETRIZATIONS}, got {self.parametrization!r}"
             )
         if self.pop_size < 4 or self.max_gen < 1:
             raise InvalidInput("pop_size must be ≥ 4 and max_gen ≥ 1")
+        if not (np.isfinite(self.knot_spacing) and 0.02 <= self.knot_spacing <= 1.0):
+            raise InvalidInput(f"knot_spacing must be 0.02..1 s, got {self.knot_spacing}")
+        if not 1 <= self.n_starts <= 50 or not 10 <= self.evaluations <= 10_000_000:
+            raise InvalidInput("n_starts must be 1..50 and evaluations 10..10,000,000")
+        if not (np.isfinite(self.accel_time) and 0 <= self.accel_time <= 10):
+            raise InvalidInput(
+                f"accel_time must be 0..10 s (0: no acceleration limit), got {self.accel_time}"
+            )
+        if self.max_deviation_mm is not None and not (
+            np.isfinite(self.max_deviation_mm) and self.max_deviation_mm > 0
+        ):
+            raise InvalidInput(
+                f"max_deviation_mm must be a positive number of mm, got {self.max_deviation_mm}"
+            )
         if any(not 1 <= j <= 6 for j in self.informed_joints):
             raise InvalidInput(f"informed_joints are joint numbers 1..6, got {self.informed_joints}")
 
+    @property
+    def search(self) -> AlgorithmSpec:
+        """The registered search this configuration runs."""
+        return resolve_algorithm(self.algorithm, self.fitness)
 
-def make_algorithm(config: OptimizeConfig, joints: tuple[int, ...]) -> GA | DE | MA:
-    """The search of ``config`` (``joints``: 1-based, most influential first)."""
-    ga = GA(
-        pop_size=config.pop_size,
-        p_crossover=config.p_crossover,
-        p_mutation=config.p_mutation,
-        recombination=config.recombination,
-        F=config.F,
-    )
-    if config.algorithm == "ga":
-        return ga
-    if config.algorithm == "de":
-        return DE(pop_size=config.pop_size)
-    if config.algorithm == "ma-random":
-        return MA(base=ga, local_search="random", n_samples=config.n_local)
-    return MA(base=ga, local_search="informed", joints=tuple(j - 1 for j in joints))
+
+@dataclass(frozen=True, slots=True)
+class MoveSummary:
+    """Everything measured about one optimized move (``result.json``, one key per field).
+
+    Energies are ``Σ |tau qd| dt`` on the physics model (nominal rigid body and
+    ``NOMINAL_FRICTION``) at the 25 ms samples; ``*_fine_J`` is the same on a grid ten
+    times finer (the integral the samples approximate). ``saved_pct`` compares the
+    optimized path with the controller-like minimum-jerk move of the same duration.
+    Limits are checked on the fine grid. ``saved_vs_initial_best_pct`` is the thesis'
+    metric (evolutionary searches only).
+    """
+
+    robot: str
+    start_rad: tuple[float, ...]
+    end_rad: tuple[float, ...]
+    duration_s: float
+    algorithm: str
+    fitness: str
+    representation: str
+    seed: int
+    energy_default_J: float
+    energy_optimized_J: float
+    saved_pct: float
+    energy_default_fine_J: float
+    energy_optimized_fine_J: float
+    energy_default_surrogate_J: float | None
+    energy_optimized_surrogate_J: float | None
+    saved_vs_initial_best_pct: float | None
+    energy_default_lab_J: float | None
+    energy_optimized_lab_J: float | None
+    saved_lab_pct: float | None
+    limits_ok: bool
+    limit_violation: dict[str, float]
+    limit_excess: tuple[str, ...]
+    acceleration_limit_rad_s2: tuple[float, ...] | None
+    max_tcp_deviation_mm: float
+    max_deviation_mm: float | None
+    iterations: int
+    evaluations: int
+    wall_s: float
+    physics_model: str
+    config: dict[str, Any]
+
+    def to_json(self) -> dict[str, Any]:
+        """Plain JSON types; non-finite numbers become ``null`` (strict JSON)."""
+        return _finite(asdict(self))
+
+
+def _finite(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    if isinstance(value, float | np.floating):
+        return float(value) if np.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
 
 
 @dataclass(frozen=True, slots=True)
 class MoveResult:
-    """An optimized move, verified on the physics model."""
+    """An optimized move, verified on the physics model (and the lab plant)."""
 
-    summary: dict[str, Any]
+    summary: MoveSummary
     default: Trajectory
     optimized: Trajectory
     history: FloatArray
-    chromosome: FloatArray
+    parameters: FloatArray
 
 
 def rank_joints_by_energy(robot: Robot, path: Trajectory) -> tuple[int, ...]:
     """Joints (1-based) ordered by their share of a path's physics energy (most first)."""
     tau = robot.inverse_dynamics(path.q, path.qd, path.qdd)
-    per_joint = (np.abs(tau * path.qd) * path.dt).sum(axis=0)
+    per_joint = path_energy(tau, path.qd, path.dt).per_joint
     return tuple(int(j) + 1 for j in np.argsort(-per_joint))
 
 
 def _plant_energy(plant: Any, traj: Trajectory) -> float:
     tau = plant.drive_torque(traj.q, traj.qd, traj.qdd)
-    return float((np.abs(tau * traj.qd) * traj.dt).sum())
+    return float(path_energy(tau, traj.qd, traj.dt).total)
 
 
 MAX_DURATION = 60.0
 """Longest move :func:`optimize_move` accepts, s (2,400 samples at 40 Hz)."""
+
+
+def acceleration_limit(robot: Robot, accel_time: float) -> FloatArray | None:
+    """``v_max / accel_time`` per joint (rad/s²), or None when ``accel_time`` is 0."""
+    if accel_time <= 0:
+        return None
+    out: FloatArray = np.asarray(robot.velocity_limit, dtype=float) / accel_time
+    return out
+
+
+def _check_ends(robot: Robot, q0: FloatArray, qf: FloatArray, duration: float) -> None:
+    lo, hi = robot.joint_ranges()
+    for name, q in (("start", q0), ("end", qf)):
+        if q.shape != (robot.n_joints,):
+            raise InvalidInput(f"{name} needs {robot.n_joints} joint values, got {q.shape}")
+        if not np.all(np.isfinite(q)):
+            raise InvalidInput(f"{name} holds a value that is not a finite number: {q.tolist()}")
+        bad = np.nonzero((q < lo) | (q > hi))[0]
+        if bad.size:
+            j = int(bad[0])
+            raise LimitViolation(
+                f"{name} joint {j + 1} = {np.degrees(q[j]):.2f} deg is outside its range "
+                f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg; "
+                f"move the {name} configuration inside the range"
+            )
+    if not (np.isfinite(duration) and duration > 0):
+        raise InvalidInput(f"duration must be a positive number of seconds, got {duration}")
+    if duration > MAX_DURATION:
+        raise InvalidInput(
+            f"duration {duration:g} s is longer than {MAX_DURATION:g} s; give the move's duration in "
+            "seconds (a point-to-point move of an industrial arm takes well under a minute)"
+        )
+    if np.allclose(q0, qf, rtol=0.0, atol=1e-9):
+        raise InvalidInput("start and end are the same configuration: there is no move to optimize")
+
+
+def check_default_feasible(
+    robot: Robot, q0: FloatArray, qf: FloatArray, duration: float, *, accel_time: float = ACCEL_TIME
+) -> None:
+    """Refuse a move whose default (minimum-jerk) path already breaks a limit.
+
+    The message names the joint, the limit and the excess, and the shortest duration
+    whose default move respects every limit.
+    """
+    dt = SAMPLE_PERIOD
+    amax = acceleration_limit(robot, accel_time)
+    report = check_limits(
+        robot, default_fine(q0, qf, duration, dt), friction=NOMINAL_FRICTION, acceleration_limit=amax
+    )
+    if report.ok:
+        return
+    shortest = shortest_feasible_duration(
+        robot, q0, qf, dt=dt, friction=NOMINAL_FRICTION, acceleration_limit=amax, longest=MAX_DURATION
+    )
+    hint = (
+        f"the shortest duration whose default move respects every limit is {shortest:.3f} s"
+        if shortest is not None
+        else f"no duration up to {MAX_DURATION:g} s makes it feasible"
+    )
+    raise LimitViolation(
+        f"infeasible task: in {duration:g} s the default move already breaks a limit: "
+        f"{report.worst[0].describe()}; {hint}"
+    )
 
 
 def optimize_move(
@@ -125,131 +272,131 @@ def optimize_move(
 ) -> MoveResult:
     """Find the path of least energy between two configurations over a fixed duration.
 
-    The search starts from random chromosomes plus the all-zero one (the default
-    minimum-jerk path, for ``rest_to_rest``); its result is then checked on the
-    physics model (nominal parameters and friction) against the default path, and
-    on the emulated lab robot. ``limits_ok`` says whether the path respects the
-    joint ranges and speed limits.
+    Refuses a task whose default move already breaks a limit (``LimitViolation``).
+    Runs the configured search, then verifies its result independently
+    (:func:`verify_move`): physics energy against the default path, the fine-grid
+    limit check, the emulated lab robot, the TCP deviation.
     """
     q0 = np.asarray(q_start, dtype=float)
     qf = np.asarray(q_end, dtype=float)
-    for name, q in (("start", q0), ("end", qf)):
-        lo, hi = robot.joint_ranges()
-        if q.shape != (robot.n_joints,):
-            raise InvalidInput(f"{name} needs {robot.n_joints} joint values, got {q.shape}")
-        bad = np.nonzero((q < lo) | (q > hi))[0]
-        if bad.size:
-            j = int(bad[0])
-            raise LimitViolation(
-                f"{name} joint {j + 1} = {np.degrees(q[j]):.2f} deg is outside its range "
-                f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg; "
-                f"move the {name} configuration inside the range"
-            )
-    if duration > MAX_DURATION:
-        raise InvalidInput(
-            f"duration {duration:g} s is longer than {MAX_DURATION:g} s; give the move's duration in "
-            "seconds (a point-to-point move of an industrial arm takes well under a minute)"
-        )
+    _check_ends(robot, q0, qf, duration)
+    sample_times(duration, SAMPLE_PERIOD)
+    check_default_feasible(robot, q0, qf, duration, accel_time=config.accel_time)
     default = minimum_jerk(q0, qf, duration)
     joints = tuple(config.informed_joints) or joints_ranked or rank_joints_by_energy(robot, default)
-    problem = TrajectoryProblem(
+    amax = acceleration_limit(robot, config.accel_time)
+    task = SearchTask(
         robot=robot,
         q_start=q0,
         q_end=qf,
         duration=duration,
-        fitness=config.fitness,
+        acceleration_limit=amax if amax is not None else np.full(robot.n_joints, np.inf),
         models=models,
-        parametrization=config.parametrization,
+        joints=joints,
+        dt=SAMPLE_PERIOD,
     )
-    algorithm = make_algorithm(config, joints[:2])
-    initial = (
-        np.zeros((1, 36)) if config.inject_default and config.parametrization == "rest_to_rest" else None
-    )
-    t0 = time.perf_counter()
-    res = minimize(
-        problem,
-        algorithm,
-        Termination(n_max_gen=config.max_gen, n_stagnant=config.n_stagnant),
-        seed=config.seed,
-        initial=initial,
-    )
-    wall = time.perf_counter() - t0
-    best = problem.trajectory(res.x_best)
-    optimized = Trajectory(t=best.t, q=best.q[0], qd=best.qd[0], qdd=best.qdd[0])
-    e_def, _ = physics_energy(robot, default)
-    e_opt, tau_opt = physics_energy(robot, optimized)
-    viol = limit_violation(robot, optimized, tau_opt)
-    surrogate = {}
-    if models:
+    spec = config.search
+    outcome, wall = timed(spec.run, task, config, np.random.default_rng(config.seed))
+    return verify_move(robot, task, default, outcome, config, spec.name, wall)
+
+
+def verify_move(
+    robot: Robot,
+    task: SearchTask,
+    default: Trajectory,
+    outcome: SearchOutcome,
+    config: OptimizeConfig,
+    algorithm: str,
+    wall: float,
+) -> MoveResult:
+    """Measure a search's result: physics energy, fine-grid limits, lab plant, TCP deviation."""
+    optimized = outcome.path
+    amax = None if not np.all(np.isfinite(task.acceleration_limit)) else task.acceleration_limit
+    e_def = energy_on_samples(robot, default, friction=NOMINAL_FRICTION)
+    e_opt = energy_on_samples(robot, optimized, friction=NOMINAL_FRICTION)
+    fine_def = default_fine(task.q_start, task.q_end, task.duration, task.dt)
+    e_def_fine = energy_on_samples(robot, fine_def, friction=NOMINAL_FRICTION)
+    e_opt_fine = energy_on_samples(robot, outcome.fine_path, friction=NOMINAL_FRICTION)
+    report = check_limits(robot, outcome.fine_path, friction=NOMINAL_FRICTION, acceleration_limit=amax)
+    e_sur_def = e_sur_opt = None
+    if task.models:
         stack = Trajectory(
             t=default.t,
             q=np.stack([default.q, optimized.q]),
             qd=np.stack([default.qd, optimized.qd]),
             qdd=np.stack([default.qdd, optimized.qdd]),
         )
-        fit_problem = TrajectoryProblem(
-            robot=robot, q_start=q0, q_end=qf, duration=duration, fitness=config.fitness, models=models
+        fit = TrajectoryProblem(
+            robot=robot,
+            q_start=task.q_start,
+            q_end=task.q_end,
+            duration=task.duration,
+            fitness=config.fitness,
+            models=task.models,
         )
-        e_sur, _ = fit_problem.energy(stack)
-        surrogate = {
-            "energy_default_surrogate_J": float(e_sur[0]),
-            "energy_optimized_surrogate_J": float(e_sur[1]),
-        }
+        e_sur, _ = fit.energy(stack)
+        if not np.all(np.isfinite(e_sur)):
+            raise InvalidModel(
+                "the learned model predicts a non-finite energy for this move; retrain it or use "
+                "--fitness physics"
+            )
+        e_sur_def, e_sur_opt = float(e_sur[0]), float(e_sur[1])
     from joulepath.sim import make_plant
 
     lab = make_plant("lab", robot)
     e_lab_def, e_lab_opt = _plant_energy(lab, default), _plant_energy(lab, optimized)
-    summary: dict[str, Any] = {
-        "robot": robot.name,
-        "start_rad": q0.tolist(),
-        "end_rad": qf.tolist(),
-        "duration_s": duration,
-        "algorithm": config.algorithm,
-        "fitness": config.fitness,
-        "parametrization": config.parametrization,
-        "seed": config.seed,
-        "chromosome": np.asarray(res.x_best).reshape(6, 6).tolist(),
-        "energy_default_physics_J": float(e_def[0]),
-        "energy_optimized_physics_J": float(e_opt[0]),
-        "energy_optimized_surrogate_J": surrogate.get("energy_optimized_surrogate_J"),
-        "energy_default_surrogate_J": surrogate.get("energy_default_surrogate_J"),
-        "improvement_physics_pct": float(100 * (e_def[0] - e_opt[0]) / e_def[0]) if e_def[0] > 0 else 0.0,
-        "improvement_vs_initial_best_pct": float(100 * (res.f_initial_best - res.f_best) / res.f_initial_best)
-        if res.f_initial_best > 0
-        else 0.0,
-        "energy_default_lab_J": e_lab_def,
-        "energy_optimized_lab_J": e_lab_opt,
-        "improvement_lab_pct": float(100 * (e_lab_def - e_lab_opt) / e_lab_def)
-        if e_lab_def and e_lab_opt is not None
-        else None,
-        "limits_ok": bool(viol.total[0] == 0.0),
-        "limit_violation": {
-            "range_rad": float(viol.range[0]),
-            "overspeed": float(viol.speed[0]),
-            "overtorque": float(viol.torque[0]),
+    summary = MoveSummary(
+        robot=robot.name,
+        start_rad=tuple(float(v) for v in task.q_start),
+        end_rad=tuple(float(v) for v in task.q_end),
+        duration_s=float(task.duration),
+        algorithm=algorithm,
+        fitness=config.fitness,
+        representation=outcome.representation,
+        seed=config.seed,
+        energy_default_J=e_def,
+        energy_optimized_J=e_opt,
+        saved_pct=100 * (e_def - e_opt) / e_def if e_def > 0 else 0.0,
+        energy_default_fine_J=e_def_fine,
+        energy_optimized_fine_J=e_opt_fine,
+        energy_default_surrogate_J=e_sur_def,
+        energy_optimized_surrogate_J=e_sur_opt,
+        saved_vs_initial_best_pct=outcome.saved_vs_initial_best_pct,
+        energy_default_lab_J=e_lab_def,
+        energy_optimized_lab_J=e_lab_opt,
+        saved_lab_pct=100 * (e_lab_def - e_lab_opt) / e_lab_def if e_lab_def > 0 else None,
+        limits_ok=report.ok,
+        limit_violation={
+            "range_rad": report.range_rad,
+            "overspeed": report.overspeed,
+            "overtorque": report.overtorque,
         },
-        "informed_joints": list(joints[:2]),
-        "generations": int(res.n_gen),
-        "evaluations": int(res.n_evals),
-        "wall_s": wall,
-        "physics_model": "nominal rigid body + NOMINAL_FRICTION; |tau*qd|*dt summed at dt = 0.025 s",
-        "config": asdict(config),
-    }
+        limit_excess=tuple(w.describe() for w in report.worst),
+        acceleration_limit_rad_s2=None if amax is None else tuple(float(a) for a in amax),
+        max_tcp_deviation_mm=tcp_deviation_mm(robot, optimized, default),
+        max_deviation_mm=config.max_deviation_mm,
+        iterations=outcome.iterations,
+        evaluations=outcome.evaluations,
+        wall_s=wall,
+        physics_model="nominal rigid body + NOMINAL_FRICTION; |tau*qd|*dt summed at dt = 0.025 s",
+        config=asdict(config),
+    )
     return MoveResult(
         summary=summary,
         default=default,
         optimized=optimized,
-        history=np.asarray(res.history),
-        chromosome=np.asarray(res.x_best).reshape(6, 6),
+        history=np.asarray(outcome.history),
+        parameters=np.asarray(outcome.parameters),
     )
 
 
 def _path_csv(traj: Trajectory) -> str:
+    n = traj.q.shape[-1]
     head = [
         "t",
-        *(f"q{i}" for i in range(1, 7)),
-        *(f"qd{i}" for i in range(1, 7)),
-        *(f"qdd{i}" for i in range(1, 7)),
+        *(f"q{i}" for i in range(1, n + 1)),
+        *(f"qd{i}" for i in range(1, n + 1)),
+        *(f"qdd{i}" for i in range(1, n + 1)),
     ]
     data = np.column_stack([traj.t, traj.q, traj.qd, traj.qdd])
     return ",".join(head) + "\n" + "\n".join(",".join(f"{v:.10g}" for v in row) for row in data) + "\n"
@@ -257,41 +404,41 @@ def _path_csv(traj: Trajectory) -> str:
 
 def plot_run(result: MoveResult, robot: Robot, out: Path) -> list[Path]:
     """Joint positions, speeds, accelerations, joint power (default vs optimized), convergence."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     paths = []
     d, o = result.default, result.optimized
-    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    n = robot.n_joints
+    fig = Figure(figsize=(8, 8))
+    axes = fig.subplots(3, 1, sharex=True)
     for ax, a, b, label in zip(
         axes, (d.q, d.qd, d.qdd), (o.q, o.qd, o.qdd), ("q [rad]", "qd [rad/s]", "qdd [rad/s²]"), strict=True
     ):
-        for j in range(6):
+        for j in range(n):
             line = ax.plot(o.t, b[:, j], label=f"J{j + 1}")[0]
             ax.plot(d.t, a[:, j], "--", color=line.get_color(), alpha=0.6)
         ax.set_ylabel(label)
-    axes[0].legend(ncol=6, fontsize=7, title="solid: optimized, dashed: default", title_fontsize=7)
+    axes[0].legend(ncol=n, fontsize=7, title="solid: optimized, dashed: default", title_fontsize=7)
     axes[-1].set_xlabel("t [s]")
     fig.tight_layout()
     paths.append(_save(fig, out / "joints.png"))
-    fig, ax = plt.subplots(figsize=(8, 3.5))
+    fig = Figure(figsize=(8, 3.5))
+    ax = fig.subplots()
     for traj, style, name in ((d, "--", "default"), (o, "-", "optimized")):
-        tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd)
-        ax.plot(traj.t, np.abs(tau * traj.qd).sum(axis=1), style, label=name)
+        tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
+        ax.plot(traj.t, joint_power(tau, traj.qd).sum(axis=1), style, label=name)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("Σ |τ·qd| [W]")
     ax.legend()
     fig.tight_layout()
     paths.append(_save(fig, out / "power.png"))
-    fig, ax = plt.subplots(figsize=(6, 3.5))
+    fig = Figure(figsize=(6, 3.5))
+    ax = fig.subplots()
     ax.plot(np.arange(result.history.size), result.history)
-    ax.set_xlabel("generation")
+    ax.set_xlabel("iteration" if result.summary.representation == "bspline" else "generation")
     ax.set_ylabel("best fitness [J]")
     fig.tight_layout()
     paths.append(_save(fig, out / "convergence.png"))
-    plt.close("all")
     return paths
 
 
@@ -302,33 +449,50 @@ def _save(fig: Any, path: Path) -> Path:
     return path
 
 
+RUN_FILES = (
+    "result.json",
+    "path.csv",
+    "default_path.csv",
+    "convergence.csv",
+    "joints.png",
+    "power.png",
+    "convergence.png",
+    "path.mod",
+)
+"""What :func:`write_run` writes in a run folder (``path.mod`` only for a path within the limits)."""
+
+
 def write_run(
     result: MoveResult, robot: Robot, out_dir: str | os.PathLike[str], *, repeats: int = 5
 ) -> dict[str, Path]:
-    """Write result.json, path.csv, convergence.csv, plots and — only when limits hold — path.mod."""
+    """Write result.json, path.csv, convergence.csv, plots and — only when limits hold — path.mod.
+
+    A refused path also removes a ``path.mod`` left in the folder by an earlier run,
+    so the folder never offers a program for a result that was refused.
+    """
     from joulepath.export import path_module
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     files = {}
-    summary = dict(result.summary)
-    if summary["limits_ok"]:
-        text = path_module(
-            robot, result.optimized.q, result.optimized.qd, summary["duration_s"], repeats=repeats
-        )
+    s = result.summary
+    summary = s.to_json()
+    if s.limits_ok:
+        text = path_module(robot, result.optimized.q, result.optimized.qd, s.duration_s, repeats=repeats)
         files["path.mod"] = atomic_write_text(out / "path.mod", text)
         summary["rapid"] = "path.mod"
     else:
+        stale = out / "path.mod"
+        if stale.is_file() and not stale.is_symlink():
+            stale.unlink()
         summary["rapid"] = None
-        summary["rapid_refused"] = "the optimized path violates a joint limit; no RAPID program written"
-    files["result.json"] = atomic_write_text(out / "result.json", json.dumps(summary, indent=2))
+        summary["rapid_refused"] = "the optimized path violates a limit: " + "; ".join(s.limit_excess)
+    files["result.json"] = atomic_write_text(
+        out / "result.json", json.dumps(summary, indent=2, allow_nan=False)
+    )
     files["path.csv"] = atomic_write_text(out / "path.csv", _path_csv(result.optimized))
     files["default_path.csv"] = atomic_write_text(out / "default_path.csv", _path_csv(result.default))
-    conv = (
-        "generation,best_fitness_J\n"
-        + "\n".join(f"{k},{v:.10g}" for k, v in enumerate(result.history))
-        + "\n"
-    )
+    conv = "step,best_fitness_J\n" + "\n".join(f"{k},{v:.10g}" for k, v in enumerate(result.history)) + "\n"
     files["convergence.csv"] = atomic_write_text(out / "convergence.csv", conv)
     for p in plot_run(result, robot, out):
         files[p.name] = p

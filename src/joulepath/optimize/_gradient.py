@@ -1,0 +1,409 @@
+"""Constrained gradient-based optimization of one move on the physics model.
+
+The path is the minimum-jerk move plus a rest-to-rest B-spline shape
+(:class:`joulepath.trajectory.SplineBasis`); the search variables are the spline's
+free coefficients, ``x = C.ravel()`` with ``C`` of shape (n_free, n_joints).
+
+Objective: the path energy ``Σ_k Σ_i |tau_ki qd_ki| dt`` with ``|p|`` replaced by
+``sqrt(p² + ε²) - ε`` (smooth), solved for a decreasing sequence of ``ε``
+(continuation towards the true objective), each stage warm-started from the last.
+Its gradient is exact: Pinocchio's analytic RNEA derivatives and the friction
+derivative, chained through the linear spline basis.
+
+Constraints (not penalties), solved by SLSQP:
+
+* joint ranges and speed limits — linear in ``x`` — on a grid ``check_factor``
+  times finer than the samples, so they also hold between samples;
+* effort limits (where the robot states them) on the same fine grid;
+* optionally a corridor: the TCP stays within ``max_deviation_m`` of the default
+  move's TCP at every sample.
+
+Fine-grid constraints are generated lazily (active-set style): each solve includes
+the grid points whose value is within ``SCREEN_BAND`` of its limit at the start
+point; after the solve, every fine-grid point is checked, the violated or nearly
+active ones are added, and the solve is repeated from the last point.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import Friction, Robot, inverse_dynamics_derivatives
+from joulepath.energy import path_energy
+from joulepath.errors import InvalidInput
+from joulepath.trajectory import DEFAULT_KNOT_SPACING, GridBasis, SplineBasis, Trajectory, minimum_jerk
+
+SCREEN_BAND = 0.25
+"""A fine-grid constraint enters the solve when its value is within this share of its limit."""
+RANGE_MARGIN = 1e-6
+"""rad kept from each range end inside the solve (solver tolerance)."""
+RATE_MARGIN = 1e-6
+"""Share of the speed and effort limits kept free inside the solve (solver tolerance)."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GradientSettings:
+    """Settings of the gradient search.
+
+    ``continuation`` gives the smoothing ``ε`` of ``|p|`` at each stage as a share of
+    the default move's mean ``|tau_i qd_i|`` (W); ``n_starts`` counts the starting
+    paths (the minimum-jerk move first, then random smooth shapes drawn with the
+    seed); ``check_factor`` is how many times finer than the samples the limits are
+    enforced.
+    """
+
+    knot_spacing: float = DEFAULT_KNOT_SPACING
+    degree: int = 5
+    n_starts: int = 3
+    continuation: tuple[float, ...] = (0.3, 0.03, 0.003)
+    max_iter: int = 200
+    ftol: float = 1e-10
+    check_factor: int = 10
+    max_rounds: int = 6
+    start_scale: float = 0.15
+
+    def __post_init__(self) -> None:
+        if self.n_starts < 1 or self.max_iter < 1 or self.max_rounds < 1:
+            raise InvalidInput("n_starts, max_iter and max_rounds must be ≥ 1")
+        if not self.continuation or any(not e > 0 for e in self.continuation):
+            raise InvalidInput(f"continuation must be positive shares, got {self.continuation}")
+        if self.check_factor < 1:
+            raise InvalidInput(f"check_factor must be ≥ 1, got {self.check_factor}")
+
+
+@dataclass(frozen=True, slots=True)
+class GradientResult:
+    """Best coefficients found, the path, its true (non-smooth) energy and the search's record."""
+
+    coefficients: FloatArray
+    path: Trajectory
+    energy_J: float
+    feasible: bool
+    history: FloatArray
+    n_evaluations: int
+    n_iterations: int
+    wall_s: float
+    starts: tuple[float, ...]
+
+
+def _smooth_abs(p: FloatArray, eps: float) -> tuple[FloatArray, FloatArray]:
+    r = np.sqrt(p * p + eps * eps)
+    return r - eps, p / r
+
+
+@dataclass(eq=False)
+class SplineProblem:
+    """Energy, limits and corridor of one move as functions of the spline coefficients."""
+
+    robot: Robot
+    q_start: FloatArray
+    q_end: FloatArray
+    duration: float
+    friction: Friction | None
+    basis: SplineBasis
+    check_factor: int = 10
+    max_deviation_m: float | None = None
+    acceleration_limit: FloatArray | None = None
+    n_evaluations: int = field(default=0, init=False)
+
+    def __post_init__(self) -> None:
+        self.q_start = np.asarray(self.q_start, dtype=float)
+        self.q_end = np.asarray(self.q_end, dtype=float)
+        self.n = self.robot.n_joints
+        self.m = self.basis.n_free
+        self.samples: GridBasis = self.basis.samples
+        self.fine: GridBasis = self.basis.grid(self.basis.dt / self.check_factor)
+        self.default = minimum_jerk(self.q_start, self.q_end, self.duration, dt=self.basis.dt)
+        self.default_fine = minimum_jerk(
+            self.q_start, self.q_end, self.duration, dt=self.basis.dt / self.check_factor
+        )
+        self.lo, self.hi = self.robot.joint_ranges()
+        self.vmax = np.where(
+            np.isfinite(self.robot.velocity_limit), np.asarray(self.robot.velocity_limit, dtype=float), 1e9
+        )
+        amax = self.acceleration_limit
+        self.amax = np.full(self.n, 1e9) if amax is None else np.where(np.isfinite(amax), amax, 1e9)
+        self.emax = np.asarray(self.robot.effort_limit, dtype=float)
+        self.has_effort = bool(np.any(np.isfinite(self.emax)))
+        self.dt = self.basis.dt
+        if self.max_deviation_m is not None:
+            self.tcp_default = self.robot.fk(self.default.q).position_m
+        self.hull = self._hull()
+
+    @property
+    def n_var(self) -> int:
+        return self.m * self.n
+
+    def coefficients(self, x: FloatArray) -> FloatArray:
+        return np.asarray(x, dtype=float).reshape(self.m, self.n)
+
+    def path(self, x: FloatArray, *, fine: bool = False) -> Trajectory:
+        c = self.coefficients(x)
+        grid, base = (self.fine, self.default_fine) if fine else (self.samples, self.default)
+        return Trajectory(
+            t=grid.t, q=base.q + grid.B @ c, qd=base.qd + grid.Bd @ c, qdd=base.qdd + grid.Bdd @ c
+        )
+
+    # ------------------------------------------------------------------ energy
+    def true_energy(self, x: FloatArray) -> float:
+        """The reported metric: ``Σ |tau qd| dt`` on the samples, no smoothing."""
+        p = self.path(x)
+        tau = self.robot.inverse_dynamics(p.q, p.qd, p.qdd, friction=self.friction)
+        return float(path_energy(tau, p.qd, self.dt).total)
+
+    def smooth_energy(self, x: FloatArray, eps: float) -> tuple[float, FloatArray]:
+        """Smoothed energy (J) and its exact gradient with respect to ``x``."""
+        self.n_evaluations += 1
+        p = self.path(x)
+        d = inverse_dynamics_derivatives(self.robot, p.q, p.qd, p.qdd, friction=self.friction)
+        power = d.tau * p.qd
+        phi, dphi = _smooth_abs(power, eps)
+        w = dphi * self.dt  # dE/dp
+        wq = w * p.qd  # dE/dtau
+        # dE/dq_k = Tq_kᵀ wq_k, dE/dqd_k = Tv_kᵀ wq_k + w_k tau_k, dE/dqdd_k = Ta_kᵀ wq_k
+        a = np.einsum("kij,ki->kj", d.dq, wq)
+        b = np.einsum("kij,ki->kj", d.dqd, wq) + w * d.tau
+        c = np.einsum("kij,ki->kj", d.dqdd, wq)
+        g = self.samples.B.T @ a + self.samples.Bd.T @ b + self.samples.Bdd.T @ c
+        return float(phi.sum() * self.dt), g.ravel()
+
+    # ------------------------------------------------------------- constraints
+    def _hull(self) -> tuple[FloatArray, FloatArray]:
+        """``A x + b ≥ 0``: every control point of q, qd, qdd inside its bounds (holds at every instant)."""
+        maps = self.basis.control_maps
+        offsets = self.basis.minimum_jerk_control(self.q_start, self.q_end)
+        upper = (self.hi - RANGE_MARGIN, self.vmax * (1 - RATE_MARGIN), self.amax * (1 - RATE_MARGIN))
+        lower = (self.lo + RANGE_MARGIN, -self.vmax * (1 - RATE_MARGIN), -self.amax * (1 - RATE_MARGIN))
+        span = np.where(np.isfinite(self.hi - self.lo), self.hi - self.lo, 2 * np.pi)
+        scales = (span, self.vmax, self.amax)
+        rows_a, rows_b, rows_s = [], [], []
+        eye = np.eye(self.n)
+        for M, P, hi, lo, sc in zip(maps, offsets, upper, lower, scales, strict=True):
+            # control point (r, i) = P[r, i] + Σ_j M[r, j] C[j, i];  x[j * n + i] = C[j, i]
+            full = np.kron(M, eye)  # rows r * n + i
+            for sign, bound in ((-1.0, hi), (1.0, lo)):
+                finite = np.isfinite(np.broadcast_to(bound, P.shape)).ravel()
+                b = (sign * (P - bound)).ravel()
+                rows_a.append(sign * full[finite])
+                rows_b.append(b[finite])
+                rows_s.append(np.broadcast_to(sc, P.shape).ravel()[finite])
+        self.hull_scale = np.concatenate(rows_s)
+        return np.concatenate(rows_a), np.concatenate(rows_b)
+
+    def hull_slack(self, x: FloatArray) -> FloatArray:
+        A, b = self.hull
+        out: FloatArray = A @ x + b
+        return out
+
+    def effort_slack(self, x: FloatArray) -> FloatArray:
+        """Effort slack (2K, n): ``emax - tau`` then ``tau + emax`` on the fine grid (inf where unlimited)."""
+        p = self.path(x, fine=True)
+        tau = self.robot.inverse_dynamics(p.q, p.qd, p.qdd, friction=self.friction)
+        e = np.where(np.isfinite(self.emax), self.emax * (1.0 - RATE_MARGIN), np.inf)
+        return np.concatenate([e - tau, tau + e])
+
+    def deviation(self, x: FloatArray) -> FloatArray:
+        """TCP distance (m) from the default move's TCP at each sample."""
+        p = self.path(x)
+        tcp = self.robot.fk(p.q).position_m
+        out: FloatArray = np.linalg.norm(tcp - self._tcp_default(), axis=-1)
+        return out
+
+    def _tcp_default(self) -> FloatArray:
+        tcp: FloatArray = self.robot.fk(self.default.q).position_m
+        return tcp
+
+    def constraints(self, x0: FloatArray, active: dict[str, np.ndarray]) -> list[dict[str, Any]]:
+        """SLSQP constraint dicts for the active fine-grid points ``active[kind]`` (flat indices)."""
+        cons: list[dict[str, Any]] = []
+        rows = active.get("hull")
+        if rows is not None and rows.size:
+            A, b = self.hull[0][rows], self.hull[1][rows]
+            cons.append({"type": "ineq", "fun": lambda x: A @ x + b, "jac": lambda x: A})
+        eff = active.get("tau")
+        if eff is not None and eff.size:
+            cons.append(
+                {
+                    "type": "ineq",
+                    "fun": lambda x, idx=eff: self._effort_rows(x, idx)[0],
+                    "jac": lambda x, idx=eff: self._effort_rows(x, idx)[1],
+                }
+            )
+        dev = active.get("tcp")
+        if dev is not None and dev.size and self.max_deviation_m is not None:
+            cons.append(
+                {
+                    "type": "ineq",
+                    "fun": lambda x, idx=dev: self._corridor_rows(x, idx)[0],
+                    "jac": lambda x, idx=dev: self._corridor_rows(x, idx)[1],
+                }
+            )
+        return cons
+
+    def _effort_rows(self, x: FloatArray, idx: np.ndarray) -> tuple[FloatArray, FloatArray]:
+        """Effort slack and its gradient at flat indices into the (2K, n) effort-slack array."""
+        K, n, m = self.fine.t.size, self.n, self.m
+        half, i = np.divmod(idx, n)
+        upper = half < K
+        k = np.where(upper, half, half - K)
+        uk, inv = np.unique(k, return_inverse=True)
+        c = self.coefficients(x)
+        B, Bd, Bdd = self.fine.B[uk], self.fine.Bd[uk], self.fine.Bdd[uk]
+        q = self.default_fine.q[uk] + B @ c
+        qd = self.default_fine.qd[uk] + Bd @ c
+        qdd = self.default_fine.qdd[uk] + Bdd @ c
+        d = inverse_dynamics_derivatives(self.robot, q, qd, qdd, friction=self.friction)
+        e = self.emax[i] * (1.0 - RATE_MARGIN)
+        tau = d.tau[inv, i]
+        sign = np.where(upper, -1.0, 1.0)
+        val = e + sign * tau
+        # d tau_i(k) / d C[j, l] = dq[k,i,l] B[k,j] + dqd[k,i,l] Bd[k,j] + dqdd[k,i,l] Bdd[k,j]
+        grad = (
+            d.dq[inv, i][:, None, :] * B[inv][:, :, None]
+            + d.dqd[inv, i][:, None, :] * Bd[inv][:, :, None]
+            + d.dqdd[inv, i][:, None, :] * Bdd[inv][:, :, None]
+        ).reshape(idx.size, m * n)
+        return val, sign[:, None] * grad
+
+    def _corridor_rows(self, x: FloatArray, idx: np.ndarray) -> tuple[FloatArray, FloatArray]:
+        """``d² - |tcp - tcp_default|²`` (m²) at sample indices ``idx`` and its gradient."""
+        assert self.max_deviation_m is not None
+        c = self.coefficients(x)
+        q = self.default.q[idx] + self.samples.B[idx] @ c
+        tcp = self.robot.fk(q).position_m
+        delta = tcp - self.tcp_default[idx]
+        jac = self.robot.jacobian(q)[:, :3, :]  # (k, 3, n)
+        dd = 2.0 * np.einsum("ka,kal->kl", delta, jac)  # d|delta|²/dq (k, n)
+        grad = -(self.samples.B[idx][:, :, None] * dd[:, None, :]).reshape(idx.size, self.m * self.n)
+        return self.max_deviation_m**2 - (delta * delta).sum(axis=1), grad
+
+    def screen(self, x: FloatArray, band: float) -> dict[str, np.ndarray]:
+        """Indices of the constraints within ``band`` of their limits, or violated."""
+        out = {"hull": np.flatnonzero(self.hull_slack(x) < band * self.hull_scale)}
+        if self.has_effort:
+            e = self.effort_slack(x)
+            lim = np.where(np.isfinite(self.emax), self.emax, np.inf)
+            out["tau"] = np.flatnonzero((e < band * lim).ravel())
+        if self.max_deviation_m is not None:
+            out["tcp"] = np.flatnonzero(self.deviation(x) > (1.0 - band) * self.max_deviation_m)
+        return out
+
+    def violation(self, x: FloatArray) -> float:
+        """Largest constraint violation on the fine grid (rad, rad/s, N·m or m; 0 when feasible)."""
+        worst = max(0.0, float(-self.hull_slack(x).min()) - 1e-9)
+        if self.has_effort:
+            worst = max(worst, float(-self.effort_slack(x).min()))
+        if self.max_deviation_m is not None:
+            worst = max(worst, float(self.deviation(x).max() - self.max_deviation_m) - 1e-9)
+        return max(worst, 0.0)
+
+
+def _merge(a: dict[str, np.ndarray], b: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    return {
+        k: np.union1d(a.get(k, np.empty(0, int)), b.get(k, np.empty(0, int))) for k in a.keys() | b.keys()
+    }
+
+
+def _solve_from(
+    problem: SplineProblem,
+    x0: FloatArray,
+    settings: GradientSettings,
+    scale: float,
+    eps_unit: float,
+    history: list[float],
+) -> tuple[FloatArray, int]:
+    """Continuation stages from ``x0``; each stage regenerates constraints until none is violated."""
+    from scipy.optimize import minimize
+
+    x = x0.copy()
+    n_iter = 0
+    active = problem.screen(x, SCREEN_BAND)
+    for share in settings.continuation:
+        eps = share * eps_unit
+
+        def fun(z: FloatArray, eps: float = eps) -> tuple[float, FloatArray]:
+            f, g = problem.smooth_energy(z, eps)
+            return f / scale, g / scale
+
+        for _ in range(settings.max_rounds):
+            res = minimize(
+                fun,
+                x,
+                jac=True,
+                method="SLSQP",
+                constraints=problem.constraints(x, active),
+                options={"maxiter": settings.max_iter, "ftol": settings.ftol},
+            )
+            n_iter += int(res.nit)
+            cand = np.asarray(res.x, dtype=float)
+            if np.all(np.isfinite(cand)):
+                x = cand
+            history.append(problem.true_energy(x))
+            new = problem.screen(x, SCREEN_BAND)
+            grown = _merge(active, new)
+            added = sum(grown[k].size - active.get(k, np.empty(0)).size for k in grown)
+            active = grown
+            if added == 0 or problem.violation(x) == 0.0:
+                if problem.violation(x) == 0.0:
+                    break
+    return x, n_iter
+
+
+def optimize_spline(
+    problem: SplineProblem,
+    settings: GradientSettings,
+    *,
+    rng: np.random.Generator,
+    progress: Callable[[int, int], None] | None = None,
+) -> GradientResult:
+    """Multi-start continuation SLSQP on ``problem``; returns the best feasible start.
+
+    The first start is the minimum-jerk move (all-zero coefficients); further starts
+    add random smooth shapes of about ``start_scale`` times each joint's travel
+    (at least 0.05 rad), drawn from ``rng``. A start's result counts only if it
+    satisfies every constraint on the fine grid; the minimum-jerk move itself is
+    the fall-back when none does and it is feasible.
+    """
+    t0 = time.perf_counter()
+    zero = np.zeros(problem.n_var)
+    e_default = problem.true_energy(zero)
+    p0 = problem.path(zero)
+    tau0 = problem.robot.inverse_dynamics(p0.q, p0.qd, p0.qdd, friction=problem.friction)
+    eps_unit = float(np.mean(np.abs(tau0 * p0.qd))) or 1.0
+    scale = max(e_default, 1e-9)
+    travel = np.maximum(np.abs(problem.q_end - problem.q_start), 0.05 / max(settings.start_scale, 1e-9))
+    starts = [zero]
+    for _ in range(settings.n_starts - 1):
+        bump = rng.standard_normal((problem.m, problem.n)) * settings.start_scale * travel
+        starts.append(bump.ravel())
+    history: list[float] = [e_default]
+    best_x, best_e, best_ok = zero, e_default, problem.violation(zero) == 0.0
+    finals: list[float] = []
+    n_iter = 0
+    for s, x0 in enumerate(starts):
+        x, it = _solve_from(problem, x0, settings, scale, eps_unit, history)
+        n_iter += it
+        e = problem.true_energy(x)
+        ok = problem.violation(x) == 0.0
+        finals.append(e if ok else float("inf"))
+        if ok and (not best_ok or e < best_e):
+            best_x, best_e, best_ok = x, e, True
+        if progress is not None:
+            progress(s + 1, len(starts))
+    return GradientResult(
+        coefficients=problem.coefficients(best_x),
+        path=problem.path(best_x),
+        energy_J=best_e,
+        feasible=best_ok,
+        history=np.minimum.accumulate(np.asarray(history)),
+        n_evaluations=problem.n_evaluations,
+        n_iterations=n_iter,
+        wall_s=time.perf_counter() - t0,
+        starts=tuple(finals),
+    )

@@ -1,0 +1,300 @@
+"""The searches behind ``optimize_move``, one registry entry each.
+
+* ``gradient`` — constrained SLSQP with exact derivatives over the rest-to-rest
+  B-spline (physics fitness): :mod:`joulepath.optimize._gradient`;
+* ``cmaes`` — pycma's CMA-ES over the same B-spline, derivative-free, for any
+  fitness (the learned models included); limits by penalty during the search and a
+  hard check of the result;
+* ``ga``, ``de``, ``ma-random``, ``ma-informed`` — the thesis' evolutionary searches
+  over its 36-coefficient chromosomes (:mod:`joulepath.evolve`).
+
+Every search returns a :class:`SearchOutcome`: the path on the samples and on the
+fine verification grid, the parameters, and its own record. Verification and
+reporting are not its business.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import NOMINAL_FRICTION, Robot
+from joulepath.errors import InvalidInput, MissingDependency
+from joulepath.evolve import DE, GA, MA, Termination, minimize
+from joulepath.optimize._gradient import GradientSettings, SplineProblem, optimize_spline
+from joulepath.optimize._problem import PENALTY, TrajectoryProblem, limit_violation
+from joulepath.optimize._verify import FINE_FACTOR
+from joulepath.trajectory import SplineBasis, Trajectory, rest_to_rest, thesis_quintic
+
+if TYPE_CHECKING:
+    from joulepath.optimize._run import OptimizeConfig
+
+
+@dataclass(frozen=True, slots=True)
+class SearchOutcome:
+    """What a search found: its path (samples and fine grid), parameters and record."""
+
+    path: Trajectory
+    fine_path: Trajectory
+    parameters: FloatArray
+    representation: str
+    history: FloatArray
+    iterations: int
+    evaluations: int
+    saved_vs_initial_best_pct: float | None
+
+
+@dataclass(frozen=True, slots=True)
+class SearchTask:
+    """One move to search: robot, ends, duration, limits, fitness models, informed joints."""
+
+    robot: Robot
+    q_start: FloatArray
+    q_end: FloatArray
+    duration: float
+    acceleration_limit: FloatArray
+    models: tuple[Any, ...]
+    joints: tuple[int, ...]
+    dt: float
+
+
+Search = Callable[["SearchTask", "OptimizeConfig", np.random.Generator], SearchOutcome]
+
+
+@dataclass(frozen=True, slots=True)
+class AlgorithmSpec:
+    """A registered search: its name, what it needs and does, and the function that runs it."""
+
+    name: str
+    kind: str
+    fitness: tuple[str, ...]
+    description: str
+    run: Search
+
+
+def _gradient(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+    basis = SplineBasis(task.duration, knot_spacing=config.knot_spacing, dt=task.dt)
+    problem = SplineProblem(
+        task.robot,
+        task.q_start,
+        task.q_end,
+        task.duration,
+        NOMINAL_FRICTION,
+        basis,
+        check_factor=FINE_FACTOR,
+        max_deviation_m=None if config.max_deviation_mm is None else config.max_deviation_mm / 1000.0,
+        acceleration_limit=task.acceleration_limit,
+    )
+    res = optimize_spline(problem, GradientSettings(n_starts=config.n_starts), rng=rng)
+    x = res.coefficients.ravel()
+    return SearchOutcome(
+        path=res.path,
+        fine_path=problem.path(x, fine=True),
+        parameters=res.coefficients,
+        representation="bspline",
+        history=res.history,
+        iterations=res.n_iterations,
+        evaluations=res.n_evaluations,
+        saved_vs_initial_best_pct=None,
+    )
+
+
+def _fitness_problem(task: SearchTask, config: OptimizeConfig, parametrization: str) -> TrajectoryProblem:
+    return TrajectoryProblem(
+        robot=task.robot,
+        q_start=task.q_start,
+        q_end=task.q_end,
+        duration=task.duration,
+        fitness=config.fitness,
+        models=task.models,
+        parametrization=parametrization,
+        dt=task.dt,
+        acceleration_limit=task.acceleration_limit,
+    )
+
+
+def _cmaes(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+    try:
+        import cma
+    except ImportError as err:  # pragma: no cover - cma is a core dependency
+        raise MissingDependency("the cmaes search needs pycma: pip install cma") from err
+    basis = SplineBasis(task.duration, knot_spacing=config.knot_spacing, dt=task.dt)
+    fit = _fitness_problem(task, config, "rest_to_rest")
+    m, n = basis.n_free, task.robot.n_joints
+    travel = float(np.max(np.abs(task.q_end - task.q_start)))
+    sigma0 = max(0.02, 0.05 * travel)
+    history: list[float] = []
+
+    def evaluate(X: FloatArray) -> FloatArray:
+        traj = basis.trajectory(X.reshape(-1, m, n), task.q_start, task.q_end)
+        energy, tau = fit.energy(traj)
+        viol = limit_violation(task.robot, traj, tau, acceleration_limit=task.acceleration_limit)
+        out: FloatArray = energy + PENALTY * viol.total
+        return out
+
+    f0 = float(evaluate(np.zeros((1, m * n)))[0])
+    history.append(f0)
+    es = cma.CMAEvolutionStrategy(
+        np.zeros(m * n),
+        sigma0,
+        {
+            "seed": int(rng.integers(1, 2**31 - 1)),
+            "maxfevals": config.evaluations,
+            "verbose": -9,
+            "tolfun": 1e-9,
+            "tolx": 1e-9,
+        },
+    )
+    best_x, best_f = np.zeros(m * n), f0
+    n_gen = 0
+    while not es.stop():
+        X = np.asarray(es.ask())
+        F = evaluate(X)
+        es.tell(list(X), F.tolist())
+        n_gen += 1
+        k = int(np.argmin(F))
+        if F[k] < best_f:
+            best_x, best_f = X[k].copy(), float(F[k])
+        history.append(best_f)
+    C = best_x.reshape(m, n)
+    return SearchOutcome(
+        path=basis.trajectory(C, task.q_start, task.q_end),
+        fine_path=basis.trajectory(C, task.q_start, task.q_end, dt=task.dt / FINE_FACTOR),
+        parameters=C,
+        representation="bspline",
+        history=np.asarray(history),
+        iterations=n_gen,
+        evaluations=int(es.countevals) + 1,
+        saved_vs_initial_best_pct=None,
+    )
+
+
+def _evolutionary(name: str) -> Search:
+    def run(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+        ga = GA(
+            pop_size=config.pop_size,
+            p_crossover=config.p_crossover,
+            p_mutation=config.p_mutation,
+            recombination=config.recombination,
+            F=config.F,
+        )
+        algorithm: GA | DE | MA
+        if name == "ga":
+            algorithm = ga
+        elif name == "de":
+            algorithm = DE(pop_size=config.pop_size)
+        elif name == "ma-random":
+            algorithm = MA(base=ga, local_search="random", n_samples=config.n_local)
+        else:
+            algorithm = MA(base=ga, local_search="informed", joints=tuple(j - 1 for j in task.joints[:2]))
+        problem = _fitness_problem(task, config, config.parametrization)
+        n_var = problem.n_var
+        initial = (
+            np.zeros((1, n_var))
+            if config.inject_default and config.parametrization == "rest_to_rest"
+            else None
+        )
+        res = minimize(
+            problem,
+            algorithm,
+            Termination(n_max_gen=config.max_gen, n_stagnant=config.n_stagnant),
+            seed=config.seed,
+            initial=initial,
+        )
+        chrom = np.asarray(res.x_best).reshape(task.robot.n_joints, -1)
+        build = rest_to_rest if config.parametrization == "rest_to_rest" else thesis_quintic
+        path = build(chrom, task.q_start, task.q_end, task.duration, dt=task.dt)
+        fine = build(chrom, task.q_start, task.q_end, task.duration, dt=task.dt / FINE_FACTOR)
+        vs_initial = (
+            float(100 * (res.f_initial_best - res.f_best) / res.f_initial_best)
+            if res.f_initial_best > 0
+            else 0.0
+        )
+        return SearchOutcome(
+            path=path,
+            fine_path=fine,
+            parameters=chrom,
+            representation=config.parametrization,
+            history=np.asarray(res.history),
+            iterations=int(res.n_gen),
+            evaluations=int(res.n_evals),
+            saved_vs_initial_best_pct=vs_initial,
+        )
+
+    return run
+
+
+ALL_FITNESS = ("surrogate", "surrogate-joints", "physics")
+
+ALGORITHMS: dict[str, AlgorithmSpec] = {
+    spec.name: spec
+    for spec in (
+        AlgorithmSpec(
+            "gradient",
+            "gradient",
+            ("physics",),
+            "SLSQP with exact RNEA derivatives over a rest-to-rest B-spline, limits as constraints",
+            _gradient,
+        ),
+        AlgorithmSpec(
+            "cmaes",
+            "evolution strategy",
+            ALL_FITNESS,
+            "pycma CMA-ES over the same B-spline (any fitness, learned models included)",
+            _cmaes,
+        ),
+        AlgorithmSpec(
+            "ga", "evolutionary", ALL_FITNESS, "the thesis' genetic algorithm", _evolutionary("ga")
+        ),
+        AlgorithmSpec(
+            "de", "evolutionary", ALL_FITNESS, "differential evolution rand/1/bin", _evolutionary("de")
+        ),
+        AlgorithmSpec(
+            "ma-random",
+            "evolutionary",
+            ALL_FITNESS,
+            "memetic GA, random local search",
+            _evolutionary("ma-random"),
+        ),
+        AlgorithmSpec(
+            "ma-informed",
+            "evolutionary",
+            ALL_FITNESS,
+            "memetic GA, local search on the most influential joints",
+            _evolutionary("ma-informed"),
+        ),
+    )
+}
+"""Every search ``optimize_move`` can run, by name (the CLI, experiment files and bench read it)."""
+
+AUTO = "auto"
+"""The default: ``gradient`` on the physics fitness, ``cmaes`` on a learned model."""
+
+
+def resolve_algorithm(name: str, fitness: str) -> AlgorithmSpec:
+    """The search for ``name`` (``auto`` picks by fitness); refuses a search that cannot use the fitness."""
+    if name == AUTO:
+        name = "gradient" if fitness == "physics" else "cmaes"
+    spec = ALGORITHMS.get(name)
+    if spec is None:
+        raise InvalidInput(f"algorithm must be one of {AUTO}, {', '.join(ALGORITHMS)}, got {name!r}")
+    if fitness not in spec.fitness:
+        raise InvalidInput(
+            f"algorithm {name!r} needs fitness {' or '.join(spec.fitness)}, got {fitness!r}; "
+            "use --algo cmaes (or auto) with a learned model"
+        )
+    return spec
+
+
+def timed(
+    run: Search, task: SearchTask, config: OptimizeConfig, rng: np.random.Generator
+) -> tuple[SearchOutcome, float]:
+    """Run a search and measure its wall time (s)."""
+    t0 = time.perf_counter()
+    out = run(task, config, rng)
+    return out, time.perf_counter() - t0
