@@ -226,6 +226,20 @@ def _mlp_epochs_at(model: Any, m: int, n: int) -> float | None:
     return float(max(updates / np.ceil(n / min(batch, n)), est.n_iter_no_change + 1) / est.n_iter_)
 
 
+def _timed_fit(model: Pipeline, X: FloatArray, y: FloatArray) -> float:
+    """Seconds ``model.fit(X, y)`` takes (a failing fit counts the time until it failed)."""
+    t0 = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        warnings.simplefilter("ignore", SubsampleWarning)
+        try:
+            model.fit(X, y)
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+            pass
+    return max(time.perf_counter() - t0, 1e-6)
+
+
 def estimate_fit_seconds(
     pipeline: Pipeline,
     grid: dict[str, list[Any]],
@@ -240,12 +254,13 @@ def estimate_fit_seconds(
     """Rough seconds one fit of a grid point takes on ``n_rows`` rows, and the largest trial size.
 
     Fits up to ``n_trials`` grid points (first, last and evenly between) on seeded
-    samples of the two ``trial_rows`` sizes and extrapolates each to ``n_rows`` (to
-    at most ``max_rows`` for kernel SVR, which subsamples) with a power law
-    ``t ~ rows**a`` through the two times (``a`` clipped to [0.3, 2]). An MLP with
-    early stopping instead scales its per-epoch time linearly and assumes the same
-    number of minibatch updates (so fewer epochs on more rows). A rough estimate for
-    planning, not a promise.
+    samples of the two ``trial_rows`` sizes, fits ``t = c + b * rows**a`` through the
+    two times (``c``: per-fit overhead such as loading the robot or setting up 500
+    trees; ``a = 1``, or 2 for kernel SVR, extrapolated to at most ``max_rows`` since
+    it subsamples) and extrapolates each to ``n_rows``. An MLP with early stopping
+    instead scales its per-epoch time linearly and assumes the same number of
+    minibatch updates (so fewer epochs on more rows). A rough estimate for planning,
+    not a promise.
     """
     from joulepath.learn._svr import ScalableSVR
 
@@ -255,32 +270,29 @@ def estimate_fit_seconds(
     rng = np.random.default_rng(seed)
     samples = [np.sort(rng.choice(len(y), m, replace=False)) for m in sizes]
     estimates = []
+    warm = samples[0][: min(100, len(samples[0]))]
+    _timed_fit(clone(pipeline).set_params(**points[picks[0]]), X[warm], y[warm])  # loads robot, imports
     for k in picks:
         spent = []
         for rows in samples:
             model = clone(pipeline).set_params(**points[k])
-            t0 = time.perf_counter()
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", ConvergenceWarning)
-                warnings.simplefilter("ignore", RuntimeWarning)
-                try:
-                    model.fit(X[rows], y[rows])
-                except (ValueError, ArithmeticError, np.linalg.LinAlgError):
-                    pass
-            spent.append(max(time.perf_counter() - t0, 1e-6))
+            spent.append(_timed_fit(model, X[rows], y[rows]))
         big = sizes[-1]
         est = model.steps[-1][1]
-        target = float(n_rows)
+        target, power = float(n_rows), 1.0
         if isinstance(est, ScalableSVR) and est.kernel != "linear":
-            target = min(target, float(est.max_rows))
+            target, power = min(target, float(est.max_rows)), 2.0
         epochs = _mlp_epochs_at(model, big, n_rows)
         if epochs is not None:
             estimates.append(spent[-1] * (target / big) * epochs)
             continue
-        exponent = 1.0
+        slope = 0.0
         if len(sizes) == 2:
-            exponent = float(np.clip(np.log(spent[1] / spent[0]) / np.log(big / sizes[0]), 0.3, 2.0))
-        estimates.append(spent[-1] * (target / big) ** exponent)
+            slope = max((spent[1] - spent[0]) / (big**power - sizes[0] ** power), 0.0)
+        overhead = max(spent[-1] - slope * big**power, 0.0)
+        if len(sizes) == 1:  # one trial size: all of it scales
+            overhead, slope = 0.0, spent[-1] / big**power
+        estimates.append(overhead + slope * target**power)
     return float(np.mean(estimates)), sizes[-1]
 
 
