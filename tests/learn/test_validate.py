@@ -173,6 +173,7 @@ def test_load_accepts_the_untampered_xgboost_model(trained, tmp_path, lab_tables
 
 
 _OPTIMIZE = ["optimize", "--start", "0,0,0,0,0,0", "--end", "0.3,0.2,0.1,0,0,0", "--duration", "1.5"]
+_OPTIMIZE += ["--fitness", "surrogate", "--generations", "1", "--population", "4"]
 
 
 @pytest.mark.parametrize("tamper", [_left_child_out_of_range, _cycle, _right_child_negative])
@@ -190,7 +191,7 @@ def test_cli_with_a_tampered_xgboost_model_exits_2_not_a_crash(trained, tmp_path
             "--model",
             str(models),
             "--out",
-            str(tmp_path / "run"),
+            str(tmp_path / "r"),
         ],
         capture_output=True,
         text=True,
