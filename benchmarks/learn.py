@@ -10,6 +10,9 @@
   lab data (train: 100 lab moves, test: 50 other lab moves), both input kinds.
 
 Usage: python benchmarks/learn.py
+       python benchmarks/learn.py --tour DATA TEST   (README tour: time ``joulepath train
+       --family all --grid quick`` on DATA/TEST, e.g. the tables of ``simulate --plan
+       thesis``; prints the timed progress lines, wall and CPU time; writes nothing)
 """
 
 from __future__ import annotations
@@ -138,5 +141,34 @@ def main() -> None:
     write_section("learn", text)
 
 
+def tour(data: str, test: str) -> None:
+    """Time the README tour's train command as a user runs it (a real process, no terminal)."""
+    import os
+    import resource
+    import subprocess
+
+    with tempfile.TemporaryDirectory() as tmp:
+        argv = [sys.executable, "-m", "joulepath", "train", "--data", data, "--test", test]
+        argv += ["--family", "all", "--grid", "quick", "--out", str(Path(tmp) / "models")]
+        t0 = time.perf_counter()
+        threads = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+        env = {k: v for k, v in os.environ.items() if k not in threads}  # as a user runs it
+        proc = subprocess.Popen(argv, stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
+        assert proc.stderr is not None
+        for line in proc.stderr:
+            print(f"[{time.perf_counter() - t0:6.0f} s] {line.rstrip()}", flush=True)
+        out = proc.communicate()[0]
+        wall = time.perf_counter() - t0
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    print(out)
+    print(
+        f"exit {proc.returncode}; wall {wall:.0f} s, CPU {usage.ru_utime + usage.ru_stime:.0f} s "
+        f"({(usage.ru_utime + usage.ru_stime) / wall:.0%} of one core); machine: {machine()}"
+    )
+
+
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:2] == ["--tour"] and len(sys.argv) == 4:
+        tour(sys.argv[2], sys.argv[3])
+    else:
+        main()
