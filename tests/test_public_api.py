@@ -47,10 +47,10 @@ ALLOWED = {
     "kinematics": {"description"},
     "dynamics": {"description", "kinematics", "energy"},
     "trajectory": {"description", "kinematics", "dynamics"},
-    "data": {"dynamics"},  # annotations only (TYPE_CHECKING); robot passed in by the caller
+    "data": {"dynamics", "energy"},  # dynamics: annotations only (TYPE_CHECKING)
     "export": {"description", "kinematics", "dynamics", "trajectory", "data"},
     "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb"},
-    "learn": {"data", "dynamics"},
+    "learn": {"data", "dynamics", "energy"},
     "synth": {"data", "description", "kinematics", "dynamics"},
     "evolve": set(),
     "optimize": {
@@ -63,6 +63,7 @@ ALLOWED = {
         "learn",
         "export",
         "sim",
+        "energy",
     },
     "energy": set(),
     "units": set(),

@@ -18,9 +18,9 @@ def result(irb120):
 
 def test_short_optimization_beats_the_default_path_on_physics(result):
     s = result.summary
-    assert s["energy_optimized_physics_J"] < s["energy_default_physics_J"]
-    assert s["improvement_physics_pct"] > 2.0
-    assert s["limits_ok"]
+    assert s.energy_optimized_J < s.energy_default_J
+    assert s.saved_pct > 2.0
+    assert s.limits_ok
     # the optimized path keeps the cycle time and starts and ends at rest
     np.testing.assert_allclose(result.optimized.t[-1], 1.5)
     np.testing.assert_allclose(result.optimized.q[[0, -1]], [Q0, QF], atol=1e-12)
@@ -32,8 +32,8 @@ def test_algorithms_run_and_seed_reproduces(irb120, algorithm):
     cfg = OptimizeConfig(algorithm=algorithm, max_gen=4, pop_size=12, n_local=50, seed=5)
     a = optimize_move(irb120, Q0, QF, 1.0, cfg)
     b = optimize_move(irb120, Q0, QF, 1.0, cfg)
-    np.testing.assert_array_equal(a.chromosome, b.chromosome)
-    assert a.summary["energy_optimized_physics_J"] <= a.summary["energy_default_physics_J"] + 1e-12
+    np.testing.assert_array_equal(a.parameters, b.parameters)
+    assert a.summary.energy_optimized_J <= a.summary.energy_default_J + 1e-12
 
 
 def test_write_run_files(result, irb120, tmp_path):
@@ -47,18 +47,19 @@ def test_write_run_files(result, irb120, tmp_path):
         "duration_s",
         "algorithm",
         "seed",
-        "chromosome",
-        "energy_default_physics_J",
-        "energy_optimized_physics_J",
+        "energy_default_J",
+        "energy_optimized_J",
+        "energy_optimized_fine_J",
         "energy_optimized_surrogate_J",
-        "improvement_physics_pct",
+        "saved_pct",
         "limits_ok",
-        "generations",
+        "max_tcp_deviation_mm",
+        "iterations",
         "evaluations",
         "wall_s",
     ):
         assert key in summary
-    assert np.array(summary["chromosome"]).shape == (6, 6)
+    assert summary["representation"] == "rest_to_rest"
     path = np.loadtxt(tmp_path / "path.csv", delimiter=",", skiprows=1)
     assert path.shape == (61, 19)
     np.testing.assert_allclose(path[:, 0], np.arange(61) * 0.025)
@@ -81,10 +82,22 @@ def test_path_module_refuses_violations(irb120, result):
 def test_write_run_refuses_rapid_for_violating_path(result, irb120, tmp_path):
     from dataclasses import replace
 
-    bad = replace(result, summary={**result.summary, "limits_ok": False})
+    write_run(result, irb120, tmp_path)
+    assert (tmp_path / "path.mod").exists()  # an earlier, good run left a program
+    bad = replace(result, summary=replace(result.summary, limits_ok=False, limit_excess=("joint 2 ...",)))
     files = write_run(bad, irb120, tmp_path)
     assert "path.mod" not in files and not (tmp_path / "path.mod").exists()
     assert json.loads((tmp_path / "result.json").read_text())["rapid"] is None
+
+
+def test_result_json_is_strict_json(result, irb120, tmp_path):
+    from dataclasses import replace
+
+    odd = replace(result, summary=replace(result.summary, energy_default_lab_J=float("nan")))
+    write_run(odd, irb120, tmp_path)
+    text = (tmp_path / "result.json").read_text()
+    assert "NaN" not in text and "Infinity" not in text
+    assert json.loads(text)["energy_default_lab_J"] is None
 
 
 def test_optimize_move_refuses_start_outside_the_range(irb120):
@@ -92,3 +105,7 @@ def test_optimize_move_refuses_start_outside_the_range(irb120):
         optimize_move(irb120, np.radians([0, 120, 0, 0, 0, 0]), QF, 1.0, OptimizeConfig())
     with pytest.raises(InvalidInput, match="algorithm must be one of"):
         OptimizeConfig(algorithm="pso")
+    with pytest.raises(InvalidInput, match="needs fitness physics"):
+        OptimizeConfig(algorithm="gradient", fitness="surrogate")
+    with pytest.raises(InvalidInput, match="same configuration"):
+        optimize_move(irb120, QF, QF, 1.0, OptimizeConfig())

@@ -5,12 +5,12 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import typer
 
 from joulepath.cli._common import check_out_folder, console, parse_joints
+from joulepath.cli._robot import load_robot_for_cli, unchecked_option
 
 
 def _models(
@@ -40,28 +40,6 @@ def _models(
     return models, joints
 
 
-def _check_reachable(robot: Any, q0: np.ndarray, qf: np.ndarray, duration: float) -> None:
-    """Refuse a duration in which no path can make the move within the joint speed limits."""
-    from joulepath.errors import LimitViolation
-    from joulepath.units import SAMPLE_PERIOD
-
-    lo, hi = robot.joint_ranges()
-    outside = any(np.any((q < lo) | (q > hi)) for q in (q0, qf))
-    if outside or not (np.isfinite(duration) and duration > 0):
-        return  # optimize_move reports these
-    vmax = robot.velocity_limit
-    need = np.abs(qf - q0) / np.where(np.isfinite(vmax) & (vmax > 0), vmax, np.inf)
-    j = int(np.argmax(need))
-    if need[j] > duration:
-        jerk = np.ceil(1.875 * need[j] / SAMPLE_PERIOD - 1e-9) * SAMPLE_PERIOD
-        raise LimitViolation(
-            f"--duration {duration:g} s is too short: joint {j + 1} must turn "
-            f"{np.degrees(abs(qf[j] - q0[j])):.1f} deg, and at its speed limit of "
-            f"{np.degrees(vmax[j]):.0f} deg/s no path does that in less than {need[j]:.3f} s; "
-            f"give a longer --duration (the minimum-jerk path needs {jerk:.3f} s)"
-        )
-
-
 def _status(status: object, label: str) -> Callable[[int, int], None]:
     def update(done: int, total: int) -> None:
         status.update(f"{label}: {done}/{total} runs")  # type: ignore[attr-defined]
@@ -70,55 +48,85 @@ def _status(status: object, label: str) -> Callable[[int, int], None]:
 
 
 def optimize(
-    start: str = typer.Option(..., "--start", help="Start configuration q1,...,q6."),
-    end: str = typer.Option(..., "--end", help="End configuration q1,...,q6."),
+    start: str = typer.Option(..., "--start", help="Start configuration q1,...,qn."),
+    end: str = typer.Option(..., "--end", help="End configuration q1,...,qn."),
     duration: float = typer.Option(..., "--duration", help="Duration T in s (a multiple of 0.025)."),
     degrees: bool = typer.Option(False, "--degrees", help="--start/--end are in degrees (default rad)."),
     model: Path = typer.Option(None, "--model", help="Folder of trained models (`joulepath train --out`)."),
     family: str = typer.Option("", help="Model family to use (default: best grouped-CV score)."),
-    fitness: str = typer.Option("surrogate", help="surrogate, surrogate-joints or physics."),
-    algo: str = typer.Option("ma-random", "--algo", help="ga, de, ma-random or ma-informed."),
-    parametrization: str = typer.Option("rest_to_rest", help="rest_to_rest (default) or thesis."),
-    generations: int = typer.Option(200, min=1, help="Generation cap."),
-    population: int = typer.Option(100, min=4),
+    fitness: str = typer.Option("physics", help="physics (default), surrogate or surrogate-joints."),
+    algo: str = typer.Option(
+        "auto",
+        "--algo",
+        help="auto (gradient on physics, cmaes on a learned model), gradient, cmaes, ga, de, "
+        "ma-random or ma-informed.",
+    ),
+    parametrization: str = typer.Option("rest_to_rest", help="GA/DE/MA chromosomes: rest_to_rest or thesis."),
+    knot_spacing: float = typer.Option(
+        0.05, "--knot-spacing", help="s between B-spline knots (gradient, cmaes)."
+    ),
+    starts: int = typer.Option(2, "--starts", min=1, max=50, help="Starting paths of the gradient search."),
+    max_deviation: float = typer.Option(
+        None, "--max-deviation", help="mm: keep the TCP this close to the default move's TCP (gradient)."
+    ),
+    accel_time: float = typer.Option(
+        0.25,
+        "--accel-time",
+        help="s to reach the speed limit at full acceleration (0: no acceleration limit).",
+    ),
+    generations: int = typer.Option(200, min=1, help="Generation cap (ga, de, ma-*)."),
+    population: int = typer.Option(100, min=4, help="Population (ga, de, ma-*)."),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     robot: str = typer.Option("irb120", help="Robot name or .irml/.urdf path."),
+    unchecked: bool = unchecked_option(),
     out: Path = typer.Option(..., "--out", help="Run folder."),
 ) -> int:
-    """Find the least-energy path between two configurations in a fixed time; verify; export RAPID."""
-    from joulepath import load_robot
+    """Find the least-energy path between two configurations in a fixed time; verify; export RAPID.
+
+    Exit code 0: the optimized path respects every limit and path.mod was written;
+    1: it ran, but the result breaks a limit and no program was written; 2: bad input
+    (an infeasible task included).
+    """
     from joulepath.optimize import OptimizeConfig, optimize_move, write_run
 
     check_out_folder(out)
-    r = load_robot(robot)
+    r = load_robot_for_cli(robot, unchecked=unchecked)
     q0 = parse_joints(start, option="--start", degrees=degrees, n=r.n_joints)
     qf = parse_joints(end, option="--end", degrees=degrees, n=r.n_joints)
     config = OptimizeConfig(
         algorithm=algo,
         fitness=fitness,
         parametrization=parametrization,
+        knot_spacing=knot_spacing,
+        n_starts=starts,
+        max_deviation_mm=max_deviation,
+        accel_time=accel_time,
         max_gen=generations,
         pop_size=population,
         seed=seed,
     )
-    _check_reachable(r, np.array(q0), np.array(qf), duration)
     models, joints = _models(model, fitness, family, r.name)
-    with console.status(f"optimizing with {algo} on the {fitness} fitness..."):
+    with console.status(f"optimizing with {config.search.name} on the {fitness} fitness..."):
         result = optimize_move(
             r, np.array(q0), np.array(qf), duration, config, models=models, joints_ranked=joints
         )
     files = write_run(result, r, out)
     s = result.summary
+    if not s.limits_ok:
+        console.print(
+            f"REFUSED: the optimized path breaks a limit ({'; '.join(s.limit_excess)}); "
+            f"path.mod was NOT written and no saving is claimed (default {s.energy_default_J:.3f} J)"
+        )
+        console.print(f"wrote {', '.join(sorted(files))} in {out}")
+        return 1
     console.print(
-        f"default path {s['energy_default_physics_J']:.3f} J, "
-        f"optimized {s['energy_optimized_physics_J']:.3f} J "
-        f"on physics: {s['improvement_physics_pct']:.1f} % saved at equal cycle time "
-        f"({s['generations']} generations, {s['evaluations']:,} evaluations, {s['wall_s']:.2f} s)"
+        f"default path {s.energy_default_J:.3f} J, optimized {s.energy_optimized_J:.3f} J "
+        f"on physics: {s.saved_pct:.1f} % saved at equal cycle time "
+        f"({s.algorithm}, {s.iterations} iterations, {s.evaluations:,} evaluations, {s.wall_s:.2f} s); "
+        f"within every limit; largest TCP deviation {s.max_tcp_deviation_mm:.1f} mm"
     )
-    if s["energy_optimized_lab_J"] is not None:
-        console.print(f"on the emulated lab robot: {s['improvement_lab_pct']:.1f} % saved")
-    if not s["limits_ok"]:
-        console.print("the optimized path violates a joint limit: path.mod was NOT written")
+    if s.saved_lab_pct is not None:
+        console.print(f"on the emulated lab robot: {s.saved_lab_pct:.1f} % saved")
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
     return 0
 

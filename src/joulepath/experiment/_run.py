@@ -693,6 +693,7 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
         joints = _joints(ctx)
         rows = []
         tasks = random_tasks(robot, o.tasks, seed=exp.seed, range_set=o.range_set)
+        seeds = np.random.SeedSequence(exp.seed).spawn(len(tasks))
         for k, (q0, qf, T) in enumerate(tasks):
             ctx.progress("optimize", k, len(tasks))
             cfg = OptimizeConfig(
@@ -700,7 +701,7 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
                 fitness=o.fitness,
                 max_gen=o.generations,
                 pop_size=o.population,
-                seed=exp.seed + k,
+                seed=int(seeds[k].generate_state(1)[0]),
             )
             res = optimize_move(robot, q0, qf, T, cfg, models=models, joints_ranked=joints)
             write_run(res, robot, folder / f"task-{k:03d}")
@@ -711,20 +712,24 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
                     "q_start_deg": " ".join(f"{v:.1f}" for v in np.degrees(q0)),
                     "q_end_deg": " ".join(f"{v:.1f}" for v in np.degrees(qf)),
                     "duration_s": T,
-                    "default_J": s["energy_default_physics_J"],
-                    "optimized_J": s["energy_optimized_physics_J"],
-                    "saved_pct": s["improvement_physics_pct"],
-                    "saved_lab_pct": s["improvement_lab_pct"],
-                    "saved_vs_initial_pct": s["improvement_vs_initial_best_pct"],
-                    "limits_ok": s["limits_ok"],
-                    "generations": s["generations"],
-                    "wall_s": s["wall_s"],
+                    "algorithm": s.algorithm,
+                    "default_J": s.energy_default_J,
+                    "optimized_J": s.energy_optimized_J,
+                    "saved_pct": s.saved_pct if s.limits_ok else 0.0,
+                    "saved_lab_pct": s.saved_lab_pct if s.limits_ok else 0.0,
+                    "saved_vs_initial_pct": s.saved_vs_initial_best_pct,
+                    "limits_ok": s.limits_ok,
+                    "max_tcp_deviation_mm": s.max_tcp_deviation_mm,
+                    "iterations": s.iterations,
+                    "wall_s": s.wall_s,
                 }
             )
-            ctx.tell(
-                f"optimize: task {k} ({T:g} s): {s['improvement_physics_pct']:.1f} % saved on physics, "
-                f"{s['improvement_lab_pct']:.1f} % on the lab robot, limits ok {s['limits_ok']}"
+            verdict = (
+                f"{s.saved_pct:.1f} % saved on physics, {s.saved_lab_pct or 0.0:.1f} % on the lab robot"
+                if s.limits_ok
+                else "REFUSED (breaks a limit: " + "; ".join(s.limit_excess) + "), no saving claimed"
             )
+            ctx.tell(f"optimize: task {k} ({T:g} s, {s.algorithm}): {verdict}")
         ctx.progress("optimize", len(tasks), len(tasks))
         frame = pd.DataFrame(rows)
         atomic_write_text(folder / "tasks.csv", frame.to_csv(index=False))
@@ -762,11 +767,17 @@ def _bench_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str
     )
 
     def body(folder: Path) -> dict[str, Any]:
-        from joulepath.optimize import bench_optimizers, summarize_bench, thesis_configurations
+        from joulepath.optimize import (
+            bench_optimizers,
+            default_configuration,
+            summarize_bench,
+            thesis_configurations,
+        )
 
         configs = thesis_configurations(b.fitness)
         if b.configurations == "compact":
             configs = [c for c in configs if c[0] in COMPACT_CONFIGURATIONS]
+        configs = [default_configuration(b.fitness), *configs]
         runs = bench_optimizers(
             robot=exp.robot,
             n_tasks=b.tasks,

@@ -1,6 +1,12 @@
 """The energy-optimal trajectory optimizer: fitness problems, one-move optimization, benchmarks."""
 
-from joulepath.optimize._bench import bench_optimizers, random_tasks, summarize_bench, thesis_configurations
+from joulepath.optimize._bench import (
+    bench_optimizers,
+    default_configuration,
+    random_tasks,
+    summarize_bench,
+    thesis_configurations,
+)
 from joulepath.optimize._features import path_features
 from joulepath.optimize._gradient import GradientResult, GradientSettings, SplineProblem, optimize_spline
 from joulepath.optimize._problem import (
@@ -59,6 +65,7 @@ __all__ = [
     "bench_optimizers",
     "check_default_feasible",
     "check_limits",
+    "default_configuration",
     "limit_violation",
     "optimize_move",
     "optimize_spline",

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -38,6 +38,7 @@ from joulepath.dynamics import Friction, Robot, inverse_dynamics_derivatives
 from joulepath.energy import path_energy
 from joulepath.errors import InvalidInput
 from joulepath.trajectory import DEFAULT_KNOT_SPACING, GridBasis, SplineBasis, Trajectory, minimum_jerk
+from joulepath.units import SAMPLE_PERIOD
 
 SCREEN_BAND = 0.25
 """A fine-grid constraint enters the solve when its value is within this share of its limit."""
@@ -51,6 +52,11 @@ RATE_MARGIN = 1e-6
 class GradientSettings:
     """Settings of the gradient search.
 
+    Coarse to fine: with ``coarse_factor > 1`` the starts are first solved on knots
+    ``coarse_factor`` times wider apart (fewer variables, fewer local minima), and
+    the best result is refined on the ``knot_spacing`` knots through the last
+    ``refine_stages`` continuation stages.
+
     ``continuation`` gives the smoothing ``ε`` of ``|p|`` at each stage as a share of
     the default move's mean ``|tau_i qd_i|`` (W); ``n_starts`` counts the starting
     paths (the minimum-jerk move first, then random smooth shapes drawn with the
@@ -60,13 +66,15 @@ class GradientSettings:
 
     knot_spacing: float = DEFAULT_KNOT_SPACING
     degree: int = 5
-    n_starts: int = 3
+    n_starts: int = 2
     continuation: tuple[float, ...] = (0.3, 0.03, 0.003)
     max_iter: int = 200
     ftol: float = 1e-10
     check_factor: int = 10
     max_rounds: int = 6
     start_scale: float = 0.15
+    coarse_factor: int = 2
+    refine_stages: int = 2
 
     def __post_init__(self) -> None:
         if self.n_starts < 1 or self.max_iter < 1 or self.max_rounds < 1:
@@ -176,12 +184,12 @@ class SplineProblem:
     # ------------------------------------------------------------- constraints
     def _hull(self) -> tuple[FloatArray, FloatArray]:
         """``A x + b ≥ 0``: every control point of q, qd, qdd inside its bounds (holds at every instant)."""
-        maps = self.basis.control_maps
-        offsets = self.basis.minimum_jerk_control(self.q_start, self.q_end)
-        upper = (self.hi - RANGE_MARGIN, self.vmax * (1 - RATE_MARGIN), self.amax * (1 - RATE_MARGIN))
-        lower = (self.lo + RANGE_MARGIN, -self.vmax * (1 - RATE_MARGIN), -self.amax * (1 - RATE_MARGIN))
+        maps = self.basis.control_maps[:2]
+        offsets = self.basis.minimum_jerk_control(self.q_start, self.q_end)[:2]
+        upper = (self.hi - RANGE_MARGIN, self.vmax * (1 - RATE_MARGIN))
+        lower = (self.lo + RANGE_MARGIN, -self.vmax * (1 - RATE_MARGIN))
         span = np.where(np.isfinite(self.hi - self.lo), self.hi - self.lo, 2 * np.pi)
-        scales = (span, self.vmax, self.amax)
+        scales = (span, self.vmax)
         rows_a, rows_b, rows_s = [], [], []
         eye = np.eye(self.n)
         for M, P, hi, lo, sc in zip(maps, offsets, upper, lower, scales, strict=True):
@@ -195,6 +203,25 @@ class SplineProblem:
                 rows_s.append(np.broadcast_to(sc, P.shape).ravel()[finite])
         self.hull_scale = np.concatenate(rows_s)
         return np.concatenate(rows_a), np.concatenate(rows_b)
+
+    def accel_slack(self, x: FloatArray) -> FloatArray:
+        """Acceleration slack on the fine grid: ``amax - qdd`` then ``qdd + amax``, shape (2K, n)."""
+        qdd = self.default_fine.qdd + self.fine.Bdd @ self.coefficients(x)
+        a = self.amax * (1.0 - RATE_MARGIN)
+        return np.concatenate([a - qdd, qdd + a])
+
+    def _accel_rows(self, idx: np.ndarray) -> tuple[FloatArray, FloatArray]:
+        """``A x + b ≥ 0`` for flat indices into :meth:`accel_slack` (linear in ``x``)."""
+        K, n, m = self.fine.t.size, self.n, self.m
+        half, i = np.divmod(idx, n)
+        upper = half < K
+        k = np.where(upper, half, half - K)
+        sign = np.where(upper, -1.0, 1.0)
+        A = np.zeros((idx.size, m * n))
+        cols = np.arange(m)[None, :] * n + i[:, None]
+        np.put_along_axis(A, cols, sign[:, None] * self.fine.Bdd[k], axis=1)
+        b = self.amax[i] * (1.0 - RATE_MARGIN) + sign * self.default_fine.qdd[k, i]
+        return A, b
 
     def hull_slack(self, x: FloatArray) -> FloatArray:
         A, b = self.hull
@@ -226,6 +253,10 @@ class SplineProblem:
         if rows is not None and rows.size:
             A, b = self.hull[0][rows], self.hull[1][rows]
             cons.append({"type": "ineq", "fun": lambda x: A @ x + b, "jac": lambda x: A})
+        acc = active.get("qdd")
+        if acc is not None and acc.size:
+            Aa, ba = self._accel_rows(acc)
+            cons.append({"type": "ineq", "fun": lambda x: Aa @ x + ba, "jac": lambda x: Aa})
         eff = active.get("tau")
         if eff is not None and eff.size:
             cons.append(
@@ -285,7 +316,10 @@ class SplineProblem:
 
     def screen(self, x: FloatArray, band: float) -> dict[str, np.ndarray]:
         """Indices of the constraints within ``band`` of their limits, or violated."""
-        out = {"hull": np.flatnonzero(self.hull_slack(x) < band * self.hull_scale)}
+        out = {
+            "hull": np.flatnonzero(self.hull_slack(x) < band * self.hull_scale),
+            "qdd": np.flatnonzero((self.accel_slack(x) < band * np.tile(self.amax, 1)).ravel()),
+        }
         if self.has_effort:
             e = self.effort_slack(x)
             lim = np.where(np.isfinite(self.emax), self.emax, np.inf)
@@ -296,7 +330,7 @@ class SplineProblem:
 
     def violation(self, x: FloatArray) -> float:
         """Largest constraint violation on the fine grid (rad, rad/s, N·m or m; 0 when feasible)."""
-        worst = max(0.0, float(-self.hull_slack(x).min()) - 1e-9)
+        worst = max(0.0, float(-self.hull_slack(x).min()) - 1e-9, float(-self.accel_slack(x).min()) - 1e-9)
         if self.has_effort:
             worst = max(worst, float(-self.effort_slack(x).min()))
         if self.max_deviation_m is not None:
@@ -361,6 +395,7 @@ def optimize_spline(
     *,
     rng: np.random.Generator,
     progress: Callable[[int, int], None] | None = None,
+    initial: FloatArray | None = None,
 ) -> GradientResult:
     """Multi-start continuation SLSQP on ``problem``; returns the best feasible start.
 
@@ -370,6 +405,22 @@ def optimize_spline(
     satisfies every constraint on the fine grid; the minimum-jerk move itself is
     the fall-back when none does and it is feasible.
     """
+    from threadpoolctl import threadpool_limits
+
+    # the solver's small dense linear algebra runs many times faster on one BLAS
+    # thread than on a pool that competes with other work for the same cores
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _optimize_spline(problem, settings, rng=rng, progress=progress, initial=initial)
+
+
+def _optimize_spline(
+    problem: SplineProblem,
+    settings: GradientSettings,
+    *,
+    rng: np.random.Generator,
+    progress: Callable[[int, int], None] | None,
+    initial: FloatArray | None,
+) -> GradientResult:
     t0 = time.perf_counter()
     zero = np.zeros(problem.n_var)
     e_default = problem.true_energy(zero)
@@ -378,7 +429,7 @@ def optimize_spline(
     eps_unit = float(np.mean(np.abs(tau0 * p0.qd))) or 1.0
     scale = max(e_default, 1e-9)
     travel = np.maximum(np.abs(problem.q_end - problem.q_start), 0.05 / max(settings.start_scale, 1e-9))
-    starts = [zero]
+    starts = [zero] if initial is None else [np.asarray(initial, dtype=float).ravel()]
     for _ in range(settings.n_starts - 1):
         bump = rng.standard_normal((problem.m, problem.n)) * settings.start_scale * travel
         starts.append(bump.ravel())
@@ -407,3 +458,58 @@ def optimize_spline(
         wall_s=time.perf_counter() - t0,
         starts=tuple(finals),
     )
+
+
+def solve_move(
+    robot: Robot,
+    q_start: FloatArray,
+    q_end: FloatArray,
+    duration: float,
+    *,
+    friction: Friction | None,
+    settings: GradientSettings,
+    rng: np.random.Generator,
+    acceleration_limit: FloatArray | None = None,
+    max_deviation_m: float | None = None,
+    dt: float = SAMPLE_PERIOD,
+) -> tuple[GradientResult, SplineProblem]:
+    """Coarse-to-fine gradient search of one move; the result and the problem it lives in."""
+
+    def make(spacing: float) -> SplineProblem:
+        basis = SplineBasis(duration, knot_spacing=spacing, degree=settings.degree, dt=dt)
+        return SplineProblem(
+            robot,
+            q_start,
+            q_end,
+            duration,
+            friction,
+            basis,
+            check_factor=settings.check_factor,
+            max_deviation_m=max_deviation_m,
+            acceleration_limit=acceleration_limit,
+        )
+
+    fine = make(settings.knot_spacing)
+    coarse_spacing = settings.knot_spacing * settings.coarse_factor
+    if settings.coarse_factor <= 1 or round(duration / coarse_spacing) < 2:
+        return optimize_spline(fine, settings, rng=rng), fine
+    coarse = make(coarse_spacing)
+    first = optimize_spline(coarse, settings, rng=rng)
+    # the coarse path in the fine basis: least squares on the fine grid (exact for nested knots)
+    target = coarse.fine.B @ first.coefficients
+    start: FloatArray = np.asarray(np.linalg.lstsq(fine.fine.B, target, rcond=None)[0], dtype=float)
+    refine = replace(settings, n_starts=1, continuation=settings.continuation[-settings.refine_stages :])
+    second = optimize_spline(fine, refine, rng=rng, initial=start)
+    merged_history = np.minimum.accumulate(np.concatenate([first.history, second.history]))
+    best, problem = (
+        (second, fine) if second.feasible and second.energy_J <= first.energy_J else (first, coarse)
+    )
+    result = replace(
+        best,
+        history=merged_history,
+        n_evaluations=first.n_evaluations + second.n_evaluations,
+        n_iterations=first.n_iterations + second.n_iterations,
+        wall_s=first.wall_s + second.wall_s,
+        starts=first.starts,
+    )
+    return result, problem

@@ -155,7 +155,8 @@ class MoveSummary:
 
     def to_json(self) -> dict[str, Any]:
         """Plain JSON types; non-finite numbers become ``null`` (strict JSON)."""
-        return _finite(asdict(self))
+        out: dict[str, Any] = _finite(asdict(self))
+        return out
 
 
 def _finite(value: Any) -> Any:

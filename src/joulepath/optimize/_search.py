@@ -26,13 +26,17 @@ from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Robot
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.evolve import DE, GA, MA, Termination, minimize
-from joulepath.optimize._gradient import GradientSettings, SplineProblem, optimize_spline
+from joulepath.optimize._gradient import GradientSettings, solve_move
 from joulepath.optimize._problem import PENALTY, TrajectoryProblem, limit_violation
 from joulepath.optimize._verify import FINE_FACTOR
 from joulepath.trajectory import SplineBasis, Trajectory, rest_to_rest, thesis_quintic
 
 if TYPE_CHECKING:
     from joulepath.optimize._run import OptimizeConfig
+
+
+CMAES_KNOT_FACTOR = 4
+"""CMA-ES searches knots this many times wider apart than ``knot_spacing`` (fewer variables)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -78,19 +82,21 @@ class AlgorithmSpec:
 
 
 def _gradient(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
-    basis = SplineBasis(task.duration, knot_spacing=config.knot_spacing, dt=task.dt)
-    problem = SplineProblem(
+    settings = GradientSettings(
+        knot_spacing=config.knot_spacing, n_starts=config.n_starts, check_factor=FINE_FACTOR
+    )
+    res, problem = solve_move(
         task.robot,
         task.q_start,
         task.q_end,
         task.duration,
-        NOMINAL_FRICTION,
-        basis,
-        check_factor=FINE_FACTOR,
-        max_deviation_m=None if config.max_deviation_mm is None else config.max_deviation_mm / 1000.0,
+        friction=NOMINAL_FRICTION,
+        settings=settings,
+        rng=rng,
         acceleration_limit=task.acceleration_limit,
+        max_deviation_m=None if config.max_deviation_mm is None else config.max_deviation_mm / 1000.0,
+        dt=task.dt,
     )
-    res = optimize_spline(problem, GradientSettings(n_starts=config.n_starts), rng=rng)
     x = res.coefficients.ravel()
     return SearchOutcome(
         path=res.path,
@@ -123,7 +129,7 @@ def _cmaes(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -
         import cma
     except ImportError as err:  # pragma: no cover - cma is a core dependency
         raise MissingDependency("the cmaes search needs pycma: pip install cma") from err
-    basis = SplineBasis(task.duration, knot_spacing=config.knot_spacing, dt=task.dt)
+    basis = SplineBasis(task.duration, knot_spacing=CMAES_KNOT_FACTOR * config.knot_spacing, dt=task.dt)
     fit = _fitness_problem(task, config, "rest_to_rest")
     m, n = basis.n_free, task.robot.n_joints
     travel = float(np.max(np.abs(task.q_end - task.q_start)))

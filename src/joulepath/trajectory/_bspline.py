@@ -1,7 +1,7 @@
 """Rest-to-rest B-spline shape: the representation the gradient optimizer searches.
 
 Joint ``j`` follows the minimum-jerk move plus a clamped B-spline of degree ``k``
-(default 5) on uniform knots about ``knot_spacing`` apart (default 0.1 s)::
+(default 5) on uniform knots about ``knot_spacing`` apart (default 0.05 s)::
 
     q_j(t) = q0_j (1 - s(t/T)) + qf_j s(t/T)  +  Σ_m c_mj N_m(t)
 
@@ -30,8 +30,8 @@ from joulepath.errors import InvalidInput
 from joulepath.trajectory._minimum_jerk import Trajectory, minimum_jerk, sample_times
 from joulepath.units import SAMPLE_PERIOD
 
-DEFAULT_KNOT_SPACING = 0.1
-"""s between knots of the shape spline (about four 25 ms samples per interval)."""
+DEFAULT_KNOT_SPACING = 0.05
+"""s between knots of the shape spline (two 25 ms samples per interval)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,7 +66,7 @@ class SplineBasis:
     Examples
     --------
     >>> import numpy as np
-    >>> basis = SplineBasis(1.6)
+    >>> basis = SplineBasis(1.6, knot_spacing=0.1)
     >>> basis.n_intervals, basis.n_free
     (16, 15)
     >>> q0, qf = np.zeros(6), np.ones(6)

@@ -1,0 +1,188 @@
+"""The default (gradient) search: exact gradients, limits between samples, reproducibility, feasibility."""
+
+import json
+
+import numpy as np
+import pytest
+from scipy.interpolate import BSpline
+
+from joulepath.dynamics import NOMINAL_FRICTION, inverse_dynamics_derivatives
+from joulepath.errors import LimitViolation
+from joulepath.optimize import (
+    OptimizeConfig,
+    SplineProblem,
+    acceleration_limit,
+    check_default_feasible,
+    check_limits,
+    optimize_move,
+    random_tasks,
+    shortest_feasible_duration,
+    write_run,
+)
+from joulepath.trajectory import SplineBasis, minimum_jerk
+
+Q0 = np.array([0.3, 0.2, -0.4, 0.5, -0.6, 1.0])
+QF = np.array([-0.9, 0.6, 0.3, -1.2, 0.8, -1.5])
+
+
+def test_rnea_derivatives_match_finite_differences(irb120, rng):
+    q, qd, qdd = rng.standard_normal((3, 4, 6))
+    d = inverse_dynamics_derivatives(irb120, q, qd, qdd, friction=NOMINAL_FRICTION)
+    np.testing.assert_allclose(
+        d.tau, irb120.inverse_dynamics(q, qd, qdd, friction=NOMINAL_FRICTION), atol=1e-12
+    )
+    h = 1e-6
+    for which, jac in ((0, d.dq), (1, d.dqd), (2, d.dqdd)):
+        for j in range(6):
+            args_p = [q.copy(), qd.copy(), qdd.copy()]
+            args_m = [q.copy(), qd.copy(), qdd.copy()]
+            args_p[which][:, j] += h
+            args_m[which][:, j] -= h
+            fd = (
+                irb120.inverse_dynamics(*args_p, friction=NOMINAL_FRICTION)
+                - irb120.inverse_dynamics(*args_m, friction=NOMINAL_FRICTION)
+            ) / (2 * h)
+            np.testing.assert_allclose(jac[:, :, j], fd, rtol=1e-5, atol=1e-5)
+
+
+@pytest.mark.parametrize("eps", [0.5, 0.01])
+def test_energy_gradient_matches_finite_differences(irb120, rng, eps):
+    basis = SplineBasis(1.0, knot_spacing=0.1)
+    problem = SplineProblem(irb120, Q0, QF, 1.0, NOMINAL_FRICTION, basis)
+    x = rng.standard_normal(problem.n_var) * 0.05
+    _, g = problem.smooth_energy(x, eps)
+    h = 1e-6
+    for i in rng.choice(problem.n_var, size=12, replace=False):
+        e = np.zeros_like(x)
+        e[i] = h
+        fd = (problem.smooth_energy(x + e, eps)[0] - problem.smooth_energy(x - e, eps)[0]) / (2 * h)
+        assert g[i] == pytest.approx(fd, rel=1e-5, abs=1e-8)
+
+
+def test_zero_coefficients_are_the_default_and_every_path_rests_at_both_ends(irb120, rng):
+    basis = SplineBasis(1.6, knot_spacing=0.1)
+    zero = basis.trajectory(np.zeros((basis.n_free, 6)), Q0, QF)
+    np.testing.assert_allclose(zero.q, minimum_jerk(Q0, QF, 1.6).q, atol=1e-12)
+    tr = basis.trajectory(rng.standard_normal((basis.n_free, 6)), Q0, QF)
+    np.testing.assert_allclose(tr.q[[0, -1]], [Q0, QF], atol=1e-12)
+    np.testing.assert_allclose(tr.qd[[0, -1]], 0.0, atol=1e-10)
+    np.testing.assert_allclose(tr.qdd[[0, -1]], 0.0, atol=1e-8)
+
+
+def test_control_point_hull_bounds_the_path_everywhere(rng):
+    basis = SplineBasis(1.2, knot_spacing=0.1)
+    C = rng.standard_normal((basis.n_free, 6))
+    Mq, Mv, Ma = basis.control_maps
+    Pq, Pv, Pa = basis.minimum_jerk_control(Q0, QF)
+    t = np.linspace(0, 1.2, 2001)
+    for deg, (M, P), trim in ((5, (Mq, Pq), 0), (4, (Mv, Pv), 1), (3, (Ma, Pa), 2)):
+        ctrl = P + M @ C
+        knots = basis.knots[trim : basis.knots.size - trim]
+        values = BSpline(knots, ctrl, deg)(t)
+        assert np.all(values <= ctrl.max(axis=0) + 1e-9) and np.all(values >= ctrl.min(axis=0) - 1e-9)
+        expect = basis.trajectory(C, Q0, QF, dt=0.0006).q if deg == 5 else None
+        if expect is not None:
+            np.testing.assert_allclose(BSpline(knots, ctrl, deg)(np.arange(2001) * 0.0006), expect, atol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def fixed(irb120):
+    return optimize_move(irb120, Q0, QF, 1.6, OptimizeConfig(seed=1))
+
+
+def test_default_search_saves_energy_within_every_limit(fixed, irb120):
+    s = fixed.summary
+    assert s.algorithm == "gradient" and s.representation == "bspline"
+    assert s.limits_ok and s.saved_pct > 5.0
+    assert abs(s.energy_optimized_fine_J - s.energy_optimized_J) < 0.01 * s.energy_optimized_J
+    np.testing.assert_allclose(fixed.optimized.q[[0, -1]], [Q0, QF], atol=1e-10)
+
+
+def test_limits_hold_on_a_ten_times_finer_grid(fixed, irb120):
+    """Evaluated independently: the spline itself at 10x the sample rate, by SciPy."""
+    spline = _result_spline(fixed)
+    t = np.arange(641) * 0.0025
+    q, qd, qdd = spline(t), spline.derivative()(t), spline.derivative(2)(t)
+    np.testing.assert_allclose(q[::10], fixed.optimized.q, atol=1e-9)
+    lo, hi = irb120.joint_ranges()
+    amax = acceleration_limit(irb120, OptimizeConfig().accel_time)
+    assert np.all(q <= hi + 1e-9) and np.all(q >= lo - 1e-9)
+    assert np.all(np.abs(qd) <= irb120.velocity_limit * (1 + 1e-7))
+    assert np.all(np.abs(qdd) <= amax * (1 + 1e-7))
+
+
+def test_same_seed_same_result(irb120):
+    cfg = OptimizeConfig(seed=4, knot_spacing=0.1, n_starts=2)
+    a = optimize_move(irb120, Q0, QF, 1.0, cfg)
+    b = optimize_move(irb120, Q0, QF, 1.0, cfg)
+    np.testing.assert_array_equal(a.parameters, b.parameters)
+    np.testing.assert_array_equal(a.optimized.q, b.optimized.q)
+
+
+def _result_spline(result):
+    c = result.parameters
+    for spacing in (OptimizeConfig().knot_spacing, 2 * OptimizeConfig().knot_spacing):
+        basis = SplineBasis(1.6, knot_spacing=spacing)
+        if basis.n_free == c.shape[0]:
+            ctrl = basis.minimum_jerk_control(Q0, QF)[0] + basis.control_maps[0] @ c
+            return BSpline(basis.knots, ctrl, 5)
+    raise AssertionError("coefficients fit no basis")
+
+
+def test_path_csv_derivatives_are_those_of_its_positions(fixed, irb120, tmp_path):
+    """path.csv's qd and qdd are the exact derivatives of the curve through its q (SciPy, independently)."""
+    write_run(fixed, irb120, tmp_path)
+    data = np.loadtxt(tmp_path / "path.csv", delimiter=",", skiprows=1)
+    t, q, qd, qdd = data[:, 0], data[:, 1:7], data[:, 7:13], data[:, 13:19]
+    spline = _result_spline(fixed)
+    np.testing.assert_allclose(q, spline(t), atol=1e-8)
+    np.testing.assert_allclose(qd, spline.derivative()(t), atol=1e-7)
+    np.testing.assert_allclose(qdd, spline.derivative(2)(t), atol=1e-6)
+    # and, to the sampling error, integrating qd gives q back
+    q_int = q[0] + np.concatenate(
+        [[np.zeros(6)], np.cumsum((qd[1:] + qd[:-1]) / 2 * np.diff(t)[:, None], axis=0)]
+    )
+    assert np.abs(q_int - q).max() < 2e-3
+    summary = json.loads((tmp_path / "result.json").read_text())
+    assert summary["algorithm"] == "gradient" and summary["rapid"] == "path.mod"
+
+
+def test_corridor_keeps_the_tcp_near_the_default(irb120):
+    free = optimize_move(irb120, Q0, QF, 1.0, OptimizeConfig(knot_spacing=0.1, n_starts=1))
+    bound = 0.4 * free.summary.max_tcp_deviation_mm
+    held = optimize_move(
+        irb120, Q0, QF, 1.0, OptimizeConfig(knot_spacing=0.1, n_starts=1, max_deviation_mm=bound)
+    )
+    assert held.summary.limits_ok
+    tcp = irb120.fk(held.optimized.q).position_m
+    ref = irb120.fk(held.default.q).position_m
+    assert 1000 * np.linalg.norm(tcp - ref, axis=1).max() <= bound * (1 + 1e-6)
+    assert held.summary.max_tcp_deviation_mm <= bound * (1 + 1e-6)
+    assert held.summary.energy_optimized_J <= held.summary.energy_default_J
+
+
+def test_infeasible_default_is_refused_with_the_shortest_feasible_duration(irb120):
+    with pytest.raises(
+        LimitViolation, match=r"infeasible task: .*joint \d (speed|acceleration).*shortest duration"
+    ):
+        optimize_move(irb120, Q0, QF, 0.5, OptimizeConfig())
+    T = shortest_feasible_duration(
+        irb120,
+        Q0,
+        QF,
+        dt=0.025,
+        friction=NOMINAL_FRICTION,
+        acceleration_limit=acceleration_limit(irb120, 0.25),
+    )
+    assert T is not None
+    check_default_feasible(irb120, Q0, QF, T)
+    with pytest.raises(LimitViolation):
+        check_default_feasible(irb120, Q0, QF, round(T - 0.025, 3))
+
+
+def test_random_tasks_are_feasible(irb120):
+    amax = acceleration_limit(irb120, 0.25)
+    tasks = random_tasks(irb120, 20, seed=3, durations=(0.5, 1.5))
+    for q0, qf, T in tasks:
+        fine = minimum_jerk(q0, qf, T, dt=0.0025)
+        assert check_limits(irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok

@@ -1,0 +1,38 @@
+"""The fast default optimizer against the slow reference (CasADi transcription + IPOPT)."""
+
+import numpy as np
+import pytest
+
+pytest.importorskip("casadi")
+
+from joulepath.dynamics import NOMINAL_FRICTION  # noqa: E402
+from joulepath.optimize import OptimizeConfig, acceleration_limit, optimize_move  # noqa: E402
+from joulepath.optimize._reference import casadi_rnea, reference_optimum  # noqa: E402
+
+
+def test_casadi_rnea_agrees_with_pinocchio(irb120, rng):
+    f = casadi_rnea(irb120)
+    for _ in range(20):
+        q, qd, qdd = rng.standard_normal((3, 6)) * 2
+        np.testing.assert_allclose(
+            np.asarray(f(q, qd, qdd)).ravel(), irb120.inverse_dynamics(q, qd, qdd), atol=1e-10
+        )
+
+
+def test_default_optimizer_reaches_the_reference_optimum_on_a_small_move(irb120):
+    q0 = np.array([0.2, -0.1, 0.1, 0.4, -0.3, 0.5])
+    qf = np.array([-0.6, 0.4, -0.3, -0.5, 0.6, -0.8])
+    T = 0.8
+    ours = optimize_move(irb120, q0, qf, T, OptimizeConfig()).summary
+    ref = reference_optimum(
+        irb120, q0, qf, T, friction=NOMINAL_FRICTION, acceleration_limit=acceleration_limit(irb120, 0.25)
+    )
+    assert ref.status == "Solve_Succeeded" and ref.max_violation < 1e-6
+    # the reference optimizes the integral (fine grid); compare like with like
+    assert ref.energy_fine_J < ours.energy_default_fine_J
+    share = (ours.energy_default_fine_J - ours.energy_optimized_fine_J) / (
+        ours.energy_default_fine_J - ref.energy_fine_J
+    )
+    assert share > 0.85, f"reached {share:.1%} of the reference saving"
+    # and the reference, an independent solver, never finds a path much worse than ours
+    assert ref.energy_fine_J <= ours.energy_optimized_fine_J * 1.01
