@@ -276,6 +276,10 @@ def _card_list(card):
     card.clear()
 
 
+def _robot_number(card):
+    card["robot_source"] = 7
+
+
 @pytest.mark.parametrize(
     ("name", "tamper", "pattern"),
     [
@@ -298,6 +302,7 @@ def _card_list(card):
         ("par-E", _feature_set_unknown, r"feature_set is 'full41'"),
         ("par-E", _columns_not_list, r"input_columns must be a list of column names"),
         ("par-E", _card_list, r"the card lacks 'family'"),
+        ("xgb-E", _robot_number, r"robot_source must be a robot name, got 7"),
     ],
 )
 def test_load_refuses_a_card_that_does_not_match_its_model(trained, tmp_path, name, tamper, pattern):

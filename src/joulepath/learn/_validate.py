@@ -86,6 +86,9 @@ def check_card(card: Any, card_path: Path) -> dict[str, Any]:
                 f"{card_path}: {key} is {card[key]!r}, expected one of {', '.join(allowed)}; "
                 "the card was edited or comes from another tool"
             )
+    for key in ("robot", "robot_source"):
+        if key in card and card[key] is not None and not isinstance(card[key], str):
+            raise InvalidModel(f"{card_path}: {key} must be a robot name, got {card[key]!r}")
     cv = card["cv_grouped"]
     if not isinstance(cv, dict) or not _is_number(cv.get("r2_mean")):
         raise InvalidModel(
