@@ -69,3 +69,20 @@ def test_train_library_refuses_empty_tables(tables, tmp_path):
     with pytest.raises(InvalidInput, match="the training table has no rows"):
         train(empty, test, TrainConfig(families=("par",), cv=2), tmp_path / "m")
     assert not (tmp_path / "m").exists()
+
+
+def test_train_reports_search_progress_as_numbers(tables, tmp_path):
+    """Progress bars get (family, target, done, total) without parsing the messages."""
+    full, test, _ = tables["tables"]
+    events, messages = [], []
+    train(
+        full,
+        test,
+        TrainConfig(families=("par",), cv=2),
+        tmp_path / "m",
+        progress=messages.append,
+        on_search=lambda *event: events.append(event),
+    )
+    assert events[0] == ("par", "E", 0, 4) and events[-1] == ("par", "E", 4, 4)
+    assert [e[2] for e in events] == [0, 1, 2, 3, 4]
+    assert len([m for m in messages if re.match(r"par E: \d/4 candidates", m)]) == len(events)

@@ -101,12 +101,19 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h"
 
 
-def _progress(say: Callable[[str], None], family: str, target: str) -> Callable[[int, int], None]:
+def _progress(
+    say: Callable[[str], None],
+    family: str,
+    target: str,
+    on_search: Callable[[str, str, int, int], None] | None,
+) -> Callable[[int, int], None]:
     """A grid-search progress callback that says done/total, time spent and time left."""
     start = time.perf_counter()
     first: list[int] = []
 
     def report(done: int, total: int) -> None:
+        if on_search is not None:
+            on_search(family, target, done, total)
         if not first:
             first.append(done)
             cached = f" ({done} from the cache)" if done else ""
@@ -172,12 +179,26 @@ def train(
     out_dir: str | os.PathLike[str],
     *,
     progress: Callable[[str], None] | None = None,
+    on_search: Callable[[str, str, int, int], None] | None = None,
 ) -> TrainingReport:
     """Grid-search, cross-validate, refit and test every (family, target); save models and reports.
 
     Writes ``<out>/<family>-<target>/`` (model + card), ``results.csv`` (thesis
     Tables 4.1–4.4 layout plus the honest metrics), ``report.json`` and bar plots
     of the test scores (thesis Figs 4.11–4.17).
+
+    Parameters
+    ----------
+    train_table, test_table : EnergyTable
+        Non-empty, of one feature set.
+    config : TrainConfig
+    out_dir : path
+    progress : callable(message), optional
+        Receives one-line messages for people: before each search the number of
+        fits and a rough time, then candidates done, time spent and time left.
+    on_search : callable(family, target, done, total), optional
+        Receives the grid search's progress as numbers (for progress bars; no
+        need to parse ``progress`` messages).
     """
     from joulepath.dynamics import NOMINAL_FRICTION, load_robot
 
@@ -224,7 +245,7 @@ def train(
                 cache_dir=cache_dir,
                 n_jobs=config.n_jobs,
                 scheduler=config.scheduler,
-                progress=_progress(say, family, target),
+                progress=_progress(say, family, target, on_search),
             )
             best = search.best
             say(f"{family} {target}: shuffled-fold CV of the best candidate ({config.cv} fits)")
