@@ -46,7 +46,7 @@ def _write(tmp_path, text, name="exp.toml"):
         (lambda t: t.replace("tasks = 2", 'tasks = "two"'), r"\[optimize\] tasks must be an integer"),
         (
             lambda t: t.replace("[optimize]", '[optimize]\nalgorithm = "pso"'),
-            r"algorithm = 'pso' is not allowed; use one of ga, de",
+            r"algorithm = 'pso' is not allowed; use one of auto, gradient, cmaes, ga, de",
         ),
         (lambda t: t + "\n[plots]\nx = 1\n", r"unknown section \[plots\]; allowed: \[data\], \[synth\]"),
         (lambda t: t.replace('name = "tiny"', ""), r"missing key 'name'"),
@@ -70,7 +70,9 @@ def _write(tmp_path, text, name="exp.toml"):
             "not valid TOML",
         ),
         (
-            lambda t: t.replace('families = ["par"]', "families = []"),
+            lambda t: t.replace('families = ["par"]', "families = []").replace(
+                "[optimize]", '[optimize]\nfitness = "surrogate"'
+            ),
             r"fitness = 'surrogate' needs models of E",
         ),
         (
@@ -125,9 +127,10 @@ def test_tiny_demo_run_writes_every_stage(tiny_run):
     for row in tasks.itertuples():
         assert (tiny_run / "optimize" / f"task-{row.task:03d}" / "path.mod").exists() == bool(row.limits_ok)
     bench = pd.read_csv(tiny_run / "bench" / "table.csv")
-    assert len(bench) == 6 and bench["configuration"].str.startswith("MA").sum() == 2
+    assert len(bench) == 7 and bench["configuration"].str.startswith("MA").sum() == 2
+    assert bench["configuration"].iloc[0] == "joulepath default (gradient)"
     runs = pd.read_csv(tiny_run / "bench" / "runs.csv")
-    assert len(runs) == 6 * 2 and set(runs["task"]) == {0, 1}
+    assert len(runs) == 7 * 2 and set(runs["task"]) == {0, 1}
     assert np.allclose(
         runs.groupby("configuration", sort=False)["vs_default"].mean(), bench["vs_default_mean"]
     )

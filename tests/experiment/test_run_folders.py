@@ -103,6 +103,7 @@ def test_run_experiment_dropped_family_and_stage_leave_nothing_behind(tiny_run, 
     assert not (run / "synth").exists() and not (run / "bench").exists()
     assert any(s.startswith("synth: no longer in the experiment") for s in said)
     ran = [s.split(":")[0] for s in said if s.split(":")[0] in STAGES and "done in" in s]
-    assert ran == ["train", "optimize"]  # data and importance did not change
+    # data and importance did not change; optimize uses physics fitness, so no model change reaches it
+    assert ran == ["train"]
     assert list(summary["stages"]) == ["data", "train", "importance", "optimize"]
     assert not [p for p in run.iterdir() if p.name.endswith((".partial", ".old", ".stale"))]

@@ -57,6 +57,9 @@ def _root(
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI with ``argv`` (default: ``sys.argv[1:]``); return the exit code."""
     args = list(sys.argv[1:] if argv is None else argv)
+    if not args:
+        print("error: no command given; see 'joulepath --help' for the commands", file=sys.stderr)
+        return 2
     debug = "--debug" in args
     if debug:  # accepted anywhere on the line, handled as a root option
         args = ["--debug", *(a for a in args if a != "--debug")]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from pathlib import Path
 
@@ -14,12 +13,17 @@ from joulepath.cli._robot import load_robot_for_cli, unchecked_option
 
 
 def _models(
-    model_dir: Path | None, fitness: str, family: str, robot_name: str
+    model_dir: Path | None, fitness: str, family: str, robot_name: str, n_joints: int = 6
 ) -> tuple[tuple[object, ...], tuple[int, ...] | None]:
     from joulepath.errors import InvalidModel
-    from joulepath.learn import best_model
+    from joulepath.learn import best_model, read_joints_json
 
     if fitness == "physics":
+        if model_dir is not None:
+            raise typer.BadParameter(
+                "--fitness physics does not use a learned model; drop --model, or add --fitness surrogate",
+                param_hint="--model",
+            )
         return (), None
     if model_dir is None:
         raise typer.BadParameter(
@@ -36,7 +40,7 @@ def _models(
     joints = None
     jf = model_dir / "joints.json"
     if jf.exists():
-        joints = tuple(int(j) for j in json.loads(jf.read_text())["joints_by_influence"])
+        joints = read_joints_json(jf, n_joints)
     return models, joints
 
 
@@ -65,7 +69,7 @@ def optimize(
     knot_spacing: float = typer.Option(
         0.05, "--knot-spacing", help="s between B-spline knots (gradient, cmaes)."
     ),
-    starts: int = typer.Option(2, "--starts", min=1, max=50, help="Starting paths of the gradient search."),
+    starts: int = typer.Option(1, "--starts", min=1, max=50, help="Starting paths of the gradient search."),
     max_deviation: float = typer.Option(
         None, "--max-deviation", help="mm: keep the TCP this close to the default move's TCP (gradient)."
     ),
@@ -105,7 +109,7 @@ def optimize(
         pop_size=population,
         seed=seed,
     )
-    models, joints = _models(model, fitness, family, r.name)
+    models, joints = _models(model, fitness, family, r.name, r.n_joints)
     with console.status(f"optimizing with {config.search.name} on the {fitness} fitness..."):
         result = optimize_move(
             r, np.array(q0), np.array(qf), duration, config, models=models, joints_ranked=joints

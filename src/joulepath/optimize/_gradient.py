@@ -66,7 +66,7 @@ class GradientSettings:
 
     knot_spacing: float = DEFAULT_KNOT_SPACING
     degree: int = 5
-    n_starts: int = 2
+    n_starts: int = 1
     continuation: tuple[float, ...] = (0.3, 0.03, 0.003)
     max_iter: int = 200
     ftol: float = 1e-10

@@ -175,7 +175,7 @@ def reference_optimum(
     *,
     friction: Friction | None,
     initial: Trajectory | None = None,
-    continuation: tuple[float, ...] = (0.3, 0.03, 0.003, 0.0003),
+    continuation: tuple[float, ...] = (0.1, 0.003),
     dt: float = SAMPLE_PERIOD,
     acceleration_limit: FloatArray | None = None,
     substeps: int = 4,

@@ -61,7 +61,7 @@ class OptimizeConfig:
     fitness: str = "physics"
     parametrization: str = "rest_to_rest"
     knot_spacing: float = DEFAULT_KNOT_SPACING
-    n_starts: int = 2
+    n_starts: int = 1
     evaluations: int = 6000
     accel_time: float = ACCEL_TIME
     max_deviation_mm: float | None = None
@@ -251,7 +251,8 @@ def check_default_feasible(
         robot, q0, qf, dt=dt, friction=NOMINAL_FRICTION, acceleration_limit=amax, longest=MAX_DURATION
     )
     hint = (
-        f"the shortest duration whose default move respects every limit is {shortest:.3f} s"
+        f"the shortest duration whose default move respects every limit is {shortest:.3f} s: "
+        f"give a duration of at least {shortest:.3f} s"
         if shortest is not None
         else f"no duration up to {MAX_DURATION:g} s makes it feasible"
     )
