@@ -11,6 +11,7 @@ from scipy.signal import find_peaks
 from joulepath._typing import FloatArray
 from joulepath.data._logs import JointLog
 from joulepath.data._schema import FEATURE_SETS, N_JOINTS, TARGETS, table_columns
+from joulepath.energy import joint_energy
 
 REST_SPEED = 1.0 * np.pi / 180.0
 """Joint speed (rad/s) below which every joint counts as at rest: 1 deg/s."""
@@ -229,7 +230,7 @@ def log_to_frame(
         cols.update(
             tcp_columns(pos, quat, np.unwrap(eul, axis=0), lambda v: _differentiate(v, t, first, last))
         )
-    energy = np.abs(tau * qd) * dt[:, None]
+    energy = joint_energy(tau, qd, dt)  # the one definition: |tau_i qd_i| dt
     for i in range(N_JOINTS):
         cols[f"E{i + 1}"] = energy[:, i]
     cols["E"] = energy.sum(axis=1)

@@ -13,6 +13,7 @@ from sklearn.metrics import mean_absolute_error, r2_score
 
 from joulepath._typing import FloatArray
 from joulepath.data import EnergyTable
+from joulepath.energy import joint_energy
 
 N_JOINTS = 6
 
@@ -65,7 +66,7 @@ def physics_predict(table: EnergyTable, robot: Any, *, friction: Any = None) -> 
     qd = f[[f"dq{i}" for i in j]].to_numpy()
     qdd = f[[f"ddq{i}" for i in j]].to_numpy()
     tau = robot.inverse_dynamics(q, qd, qdd, friction=friction)
-    e = np.abs(tau * qd) * f["dt"].to_numpy()[:, None]
+    e = joint_energy(tau, qd, f["dt"].to_numpy())
     out = {f"E{i}": e[:, i - 1] for i in j}
     out["E"] = e.sum(axis=1)
     return out

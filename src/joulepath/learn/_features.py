@@ -21,6 +21,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from joulepath._typing import FloatArray
 from joulepath.data import FEATURE_SETS
+from joulepath.energy import joint_energy
 
 INPUTS = ("thesis", "physics")
 PHYSICS_VERSION = 2
@@ -102,9 +103,10 @@ def physics_transform(X: FloatArray, index: dict[str, int], robot: Any) -> Float
     from joulepath.dynamics import NOMINAL_FRICTION
 
     tau = robot.inverse_dynamics(q, qd, qdd, friction=NOMINAL_FRICTION)
-    energy = np.abs(tau * qd) * dt
+    energy = joint_energy(tau, qd, dt[:, 0])  # the one definition: |tau_i qd_i| dt
+    signed = joint_energy(tau, qd, dt[:, 0], mode="signed")
     out: FloatArray = np.concatenate(
-        [X, energy, energy.sum(axis=1, keepdims=True), tau * qd * dt, np.abs(qd) * dt, qd * qd * dt],
+        [X, energy, energy.sum(axis=1, keepdims=True), signed, np.abs(qd) * dt, qd * qd * dt],
         axis=1,
     )
     return out
