@@ -69,7 +69,7 @@ class GradientSettings:
     n_starts: int = 1
     continuation: tuple[float, ...] = (0.3, 0.03, 0.003)
     max_iter: int = 200
-    ftol: float = 1e-10
+    ftol: float = 1e-7
     check_factor: int = 10
     max_rounds: int = 6
     start_scale: float = 0.15
