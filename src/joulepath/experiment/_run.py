@@ -462,7 +462,7 @@ def _plot_quality(scores: pd.DataFrame, path: Path) -> None:
     ax2.set_xticks(x, scores["method"])
     ax2.set_ylim(low, 1.05)
     ax2.legend(fontsize="small", loc="lower right")
-    ax2.set_title(f"train on synthetic, test on real: R²(E) (bars clipped at {low})")
+    ax2.set_title(f"trained on synthetic, tested on real:\nR²(E), bars clipped at {low}", fontsize="medium")
     fig.tight_layout()
     _save(fig, path)
 

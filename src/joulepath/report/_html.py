@@ -66,7 +66,7 @@ DIFFERENCES = (
     (
         "Dynamics",
         "App. B's Lagrange–Euler listing has a sum where a product is meant and wraps torques in "
-        "abs(); here RNEA (Pinocchio) and a corrected Lagrange–Euler agree to 1e-8.",
+        "abs(); here RNEA (Pinocchio) and a corrected Lagrange–Euler agree to about 1e-14 N·m.",
     ),
     (
         "Robot description",
@@ -643,9 +643,12 @@ def _optimize(run: _Run) -> str:
         if len(ok):
             first = f"optimize/task-{int(ok['task'].iloc[0]):03d}"
             ours += _image(
-                run.path(f"{first}/joints.png"), "Joint paths of the first task (default vs optimized)"
+                run.path(f"{first}/joints.png"),
+                f"Joint paths of task {int(ok['task'].iloc[0])} (default vs optimized)",
             )
-            ours += _image(run.path(f"{first}/power.png"), "Mechanical power along the first task")
+            ours += _image(
+                run.path(f"{first}/power.png"), f"Mechanical power along task {int(ok['task'].iloc[0])}"
+            )
             ours += (
                 f'<p class="note">RAPID program of each task within the limits: '
                 f"<code>{_e(first)}/path.mod</code> (and the other task folders).</p>"
