@@ -838,8 +838,12 @@ def _bench_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str
         best = table.sort_values("vs_default_mean", ascending=False).iloc[0]
         ctx.tell(
             f"bench: best at equal cycle time: {best['configuration']} "
-            f"{best['vs_default_mean']:.1f} % vs the default move ({best['vs_initial_mean']:.1f} % by "
-            "the thesis' metric)"
+            f"{best['vs_default_mean']:.1f} % vs the default move"
+            + (
+                f" ({best['vs_initial_mean']:.1f} % by the thesis' metric)"
+                if np.isfinite(best["vs_initial_mean"])
+                else ""
+            )
         )
         return {}
 
