@@ -198,3 +198,19 @@ def test_h3_verdict_pairs_the_configurations_task_by_task(tmp_path):
     pd.DataFrame(rows).to_csv(run / "bench" / "runs.csv", index=False)
     h3 = verdicts(run)[2]
     assert h3.verdict == "supported" and "MA better on 6 of 6 tasks" in h3.evidence
+
+
+def test_h3_verdict_leaves_out_joulepaths_own_default(tmp_path):
+    """H3 compares the thesis' MA with its GA/DE; a better default search must not stand in for the GA."""
+    run = _bench_run(tmp_path, 8.0, 5.0, 2.0, 100)
+    table = pd.read_csv(run / "bench" / "table.csv")
+    default = {
+        "configuration": "joulepath default (gradient)",
+        "vs_initial_mean": float("nan"),
+        "vs_initial_std": float("nan"),
+        "vs_default_mean": 20.0,
+        "vs_default_std": 2.0,
+    }
+    pd.concat([pd.DataFrame([default]), table]).to_csv(run / "bench" / "table.csv", index=False)
+    h3 = verdicts(run)[2]
+    assert h3.verdict == "supported" and "joulepath default" not in h3.evidence
