@@ -71,9 +71,7 @@ def _run(experiment: str, out: Path | None, quiet: bool, scheduler: str | None) 
             + f"report: {summary['report']}",
             markup=False,
         )
-    else:
-        console.print(f"\nreport: {summary['report']}", markup=False)
-    return 0
+    return 0  # without --quiet, the run's last line already names the report
 
 
 def run(

@@ -91,7 +91,8 @@ def optimize(
     1: it ran, but the result breaks a limit and no program was written; 2: bad input
     (an infeasible task included).
     """
-    from joulepath.optimize import OptimizeConfig, optimize_move, write_run
+    from joulepath.optimize import MAX_DURATION, OptimizeConfig, optimize_move, write_run
+    from joulepath.trajectory import sample_times
 
     check_out_folder(out)
     r = load_robot_for_cli(robot, unchecked=unchecked)
@@ -109,6 +110,8 @@ def optimize(
         pop_size=population,
         seed=seed,
     )
+    if np.isfinite(duration) and 0 < duration <= MAX_DURATION:
+        sample_times(duration)  # a whole number of samples: checked before any model is loaded
     models, joints = _models(model, fitness, family, r.name, r.n_joints)
     with console.status(f"optimizing with {config.search.name} on the {fitness} fitness..."):
         result = optimize_move(

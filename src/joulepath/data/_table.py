@@ -39,8 +39,13 @@ TCP_TOLERANCE_M = 0.005
 RANGE_TOLERANCE_RAD = 0.05
 """How far (rad, about 3 deg) a logged joint may sit outside the robot's range before ingestion refuses it."""
 
-SPEED_TOLERANCE = 1.5
-"""How many times its speed limit a logged joint speed may reach before ingestion refuses it."""
+SPEED_TOLERANCE = 3.0
+"""How many times its speed limit a logged joint speed may reach before ingestion refuses it.
+
+Degrees in a radian log read 57 times too fast; a genuine log may pass the nominal
+limit for a few samples (the emulated controller's zone blends reach about 1.7 times
+it on joint 6, and differentiated positions are noisy), so the bound is set well
+between the two."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -228,14 +233,14 @@ def _check_limits(log: JointLog, robot: Robot) -> None:
                 )
     if problems:
         unit = (
-            "controller logs are in deg and deg/s"
+            "controller logs are read as deg and deg/s"
             if log.kind == "controller"
             else "generic logs are in rad and rad/s: degrees in q and dq?"
         )
         shown = problems[:5] + ([f"and {len(problems) - 5} more"] if len(problems) > 5 else [])
         raise InvalidLog(
             f"{log.source}: {'; '.join(shown)}; {unit} (is this log from {robot.name}? pass the right "
-            "robot, or none to skip the check)"
+            "--robot, or leave --robot out to skip the check)"
         )
 
 

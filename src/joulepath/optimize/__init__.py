@@ -20,6 +20,7 @@ from joulepath.optimize._problem import (
 )
 from joulepath.optimize._run import (
     ACCEL_TIME,
+    MAX_DURATION,
     RUN_FILES,
     MoveResult,
     MoveSummary,
@@ -51,6 +52,7 @@ __all__ = [
     "GradientSettings",
     "LimitExcess",
     "LimitReport",
+    "MAX_DURATION",
     "MoveResult",
     "MoveSummary",
     "OptimizeConfig",

@@ -312,7 +312,8 @@ class SplineProblem:
         jac = self.robot.jacobian(q)[:, :3, :]  # (k, 3, n)
         dd = 2.0 * np.einsum("ka,kal->kl", delta, jac)  # d|delta|²/dq (k, n)
         grad = -(self.samples.B[idx][:, :, None] * dd[:, None, :]).reshape(idx.size, self.m * self.n)
-        return self.max_deviation_m**2 - (delta * delta).sum(axis=1), grad
+        bound = self.max_deviation_m * (1.0 - RATE_MARGIN)  # solver tolerance, as for the rates
+        return bound**2 - (delta * delta).sum(axis=1), grad
 
     def screen(self, x: FloatArray, band: float) -> dict[str, np.ndarray]:
         """Indices of the constraints within ``band`` of their limits, or violated."""
