@@ -74,3 +74,14 @@ def test_thesis_grid_sizes():
     sizes = {f: len(ParameterGrid(g)) for f, g in THESIS_GRIDS.items()}
     assert sizes == {"mlp": 3456, "svr": 384, "par": 192, "xgb": 58320}
     assert np.prod([len(v) for v in THESIS_GRIDS["xgb"].values()]) == 58320
+
+
+def test_training_again_leaves_only_this_runs_models(lab_tables, tmp_path):
+    """A folder trained with par and xgb, then with par alone, holds par alone: best_model cannot pick xgb."""
+    from joulepath.learn import best_model, load_models, train
+
+    train(*lab_tables, TrainConfig(families=("par", "xgb"), targets=("E",), cv=2, seed=0), tmp_path)
+    assert {"par-E", "xgb-E"} <= set(load_models(tmp_path))
+    train(*lab_tables, TrainConfig(families=("par",), targets=("E",), cv=2, seed=0), tmp_path)
+    assert set(load_models(tmp_path)) == {"par-E"}
+    assert best_model(tmp_path, "E").family == "par"

@@ -355,7 +355,22 @@ def train(
     }
     atomic_write_text(out / "report.json", json.dumps(report, indent=2, default=str))
     plot_test_scores(results, baselines, out)
+    _remove_stale_models(out, set(saved))
     return TrainingReport(results=results, baselines=baselines, out_dir=out, models=saved)
+
+
+def _remove_stale_models(out: Path, kept: set[str]) -> None:
+    """Remove model folders (a ``card.json`` inside) of an earlier run that this run did not produce.
+
+    ``results.csv`` and ``report.json`` describe this run only, so a model left from an
+    earlier one would otherwise still be found by :func:`best_model`.
+    """
+    import shutil
+
+    for card in out.glob("*/card.json"):
+        folder = card.parent
+        if folder.name not in kept and folder.is_dir() and not folder.is_symlink():
+            shutil.rmtree(folder)
 
 
 def plot_test_scores(results: pd.DataFrame, baselines: Sequence[dict[str, Any]], out: Path) -> list[Path]:
