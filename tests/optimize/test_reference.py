@@ -36,3 +36,21 @@ def test_default_optimizer_reaches_the_reference_optimum_on_a_small_move(irb120)
     assert share > 0.85, f"reached {share:.1%} of the reference saving"
     # and the reference, an independent solver, never finds a path much worse than ours
     assert ref.energy_fine_J <= ours.energy_optimized_fine_J * 1.01
+
+
+def test_experiment_states_the_share_of_the_optimum(irb120):
+    """The `[optimize] reference = true` columns: the optimum's saving and the share of it reached."""
+    from joulepath.experiment._run import _optimum
+
+    q0 = np.array([0.1, 0.0, 0.0, 0.3, 0.2, 0.0])
+    qf = np.array([-0.3, 0.2, -0.2, -0.2, 0.5, 0.6])
+    res = optimize_move(irb120, q0, qf, 0.5, OptimizeConfig())
+    row = _optimum(irb120, res)
+    assert set(row) == {"optimum_J", "optimum_saved_pct", "share_of_optimum_pct", "optimum_wall_s"}
+    assert row["optimum_J"] <= res.summary.energy_default_fine_J
+    assert 0 < row["optimum_saved_pct"] < 100
+    expected = 100 * (res.summary.energy_default_fine_J - res.summary.energy_optimized_fine_J) / (
+        res.summary.energy_default_fine_J - row["optimum_J"]
+    )
+    assert row["share_of_optimum_pct"] == pytest.approx(expected)
+    assert row["share_of_optimum_pct"] > 80
