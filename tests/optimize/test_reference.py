@@ -49,8 +49,10 @@ def test_experiment_states_the_share_of_the_optimum(irb120):
     assert set(row) == {"optimum_J", "optimum_saved_pct", "share_of_optimum_pct", "optimum_wall_s"}
     assert row["optimum_J"] <= res.summary.energy_default_fine_J
     assert 0 < row["optimum_saved_pct"] < 100
-    expected = 100 * (res.summary.energy_default_fine_J - res.summary.energy_optimized_fine_J) / (
-        res.summary.energy_default_fine_J - row["optimum_J"]
+    expected = (
+        100
+        * (res.summary.energy_default_fine_J - res.summary.energy_optimized_fine_J)
+        / (res.summary.energy_default_fine_J - row["optimum_J"])
     )
     assert row["share_of_optimum_pct"] == pytest.approx(expected)
     assert row["share_of_optimum_pct"] > 80
