@@ -70,9 +70,10 @@ def inverse_dynamics_derivatives(
         d_v[k] = dv
         d_a[k] = da
         tau[k] = data.tau
-    # Pinocchio fills the inertia matrix's upper triangle only
-    upper = np.triu(d_a)
-    d_a = upper + np.swapaxes(np.triu(d_a, 1), 1, 2)
+    # Pinocchio's algorithm fills the inertia matrix's upper triangle (its Python binding
+    # may already mirror it): mirror it here either way
+    low_i, low_j = np.tril_indices(n, -1)
+    d_a[:, low_i, low_j] = d_a[:, low_j, low_i]
     if friction is not None:
         tau = tau + friction.torque(va)
         idx = np.arange(n)

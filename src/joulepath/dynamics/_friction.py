@@ -11,7 +11,7 @@ Parameters are scalars (every joint) or sequences of one value per joint.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -122,24 +122,25 @@ class CoulombViscousFriction(_Addable):
     coulomb: PerJoint = 0.0
     viscous: PerJoint = 0.0
     smoothing: float = 0.0
+    _fc: FloatArray = field(init=False, repr=False, compare=False)
+    _fv: FloatArray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        _param(self.coulomb, "coulomb")
-        _param(self.viscous, "viscous")
+        # validated once; the optimizer calls torque() and derivative() thousands of times
+        object.__setattr__(self, "_fc", _param(self.coulomb, "coulomb"))
+        object.__setattr__(self, "_fv", _param(self.viscous, "viscous"))
         if not self.smoothing >= 0:
             raise InvalidInput("smoothing must be ≥ 0 rad/s")
 
     def torque(self, qd: FloatArray) -> FloatArray:
-        fc = _param(self.coulomb, "coulomb")
-        fv = _param(self.viscous, "viscous")
+        fc, fv = self._fc, self._fv
         sgn = np.tanh(qd / self.smoothing) if self.smoothing > 0 else np.sign(qd)
         out: FloatArray = fc * sgn + fv * qd
         return out
 
     def derivative(self, qd: FloatArray) -> FloatArray:
         """``d tau_f / d qd``: ``coulomb / smoothing · sech²(qd / smoothing) + viscous`` (0 if unsmoothed)."""
-        fc = _param(self.coulomb, "coulomb")
-        fv = _param(self.viscous, "viscous")
+        fc, fv = self._fc, self._fv
         if self.smoothing > 0:
             th = np.tanh(qd / self.smoothing)
             out: FloatArray = fc / self.smoothing * (1.0 - th * th) + fv
