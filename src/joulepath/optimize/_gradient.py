@@ -35,8 +35,8 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Friction, Robot, inverse_dynamics_derivatives
-from joulepath.energy import path_energy
 from joulepath.errors import InvalidInput
+from joulepath.optimize._verify import energy_on_samples
 from joulepath.trajectory import DEFAULT_KNOT_SPACING, GridBasis, SplineBasis, Trajectory, minimum_jerk
 from joulepath.units import SAMPLE_PERIOD
 
@@ -161,9 +161,7 @@ class SplineProblem:
     # ------------------------------------------------------------------ energy
     def true_energy(self, x: FloatArray) -> float:
         """The reported metric: ``Σ |tau qd| dt`` on the samples, no smoothing."""
-        p = self.path(x)
-        tau = self.robot.inverse_dynamics(p.q, p.qd, p.qdd, friction=self.friction)
-        return float(path_energy(tau, p.qd, self.dt).total)
+        return energy_on_samples(self.robot, self.path(x), friction=self.friction)
 
     def smooth_energy(self, x: FloatArray, eps: float) -> tuple[float, FloatArray]:
         """Smoothed energy (J) and its exact gradient with respect to ``x``."""
@@ -239,14 +237,10 @@ class SplineProblem:
         """TCP distance (m) from the default move's TCP at each sample."""
         p = self.path(x)
         tcp = self.robot.fk(p.q).position_m
-        out: FloatArray = np.linalg.norm(tcp - self._tcp_default(), axis=-1)
+        out: FloatArray = np.linalg.norm(tcp - self.tcp_default, axis=-1)
         return out
 
-    def _tcp_default(self) -> FloatArray:
-        tcp: FloatArray = self.robot.fk(self.default.q).position_m
-        return tcp
-
-    def constraints(self, x0: FloatArray, active: dict[str, np.ndarray]) -> list[dict[str, Any]]:
+    def constraints(self, active: dict[str, np.ndarray]) -> list[dict[str, Any]]:
         """SLSQP constraint dicts for the active fine-grid points ``active[kind]`` (flat indices)."""
         cons: list[dict[str, Any]] = []
         rows = active.get("hull")
@@ -372,7 +366,7 @@ def _solve_from(
                 x,
                 jac=True,
                 method="SLSQP",
-                constraints=problem.constraints(x, active),
+                constraints=problem.constraints(active),
                 options={"maxiter": settings.max_iter, "ftol": settings.ftol},
             )
             n_iter += int(res.nit)
@@ -380,13 +374,9 @@ def _solve_from(
             if np.all(np.isfinite(cand)):
                 x = cand
             history.append(problem.true_energy(x))
-            new = problem.screen(x, SCREEN_BAND)
-            grown = _merge(active, new)
-            added = sum(grown[k].size - active.get(k, np.empty(0)).size for k in grown)
-            active = grown
-            if added == 0 or problem.violation(x) == 0.0:
-                if problem.violation(x) == 0.0:
-                    break
+            active = _merge(active, problem.screen(x, SCREEN_BAND))
+            if problem.violation(x) == 0.0:
+                break
     return x, n_iter
 
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Friction, Robot
-from joulepath.energy import path_energy
+from joulepath.optimize._problem import physics_energy
 from joulepath.trajectory import Trajectory, minimum_jerk, sample_times
 
 FINE_FACTOR = 10
@@ -109,8 +109,8 @@ def check_limits(
 
 def energy_on_samples(robot: Robot, path: Trajectory, *, friction: Friction | None) -> float:
     """The reported metric: ``Σ |tau qd| dt`` over the path's samples (J)."""
-    tau = robot.inverse_dynamics(path.q, path.qd, path.qdd, friction=friction)
-    return float(path_energy(tau, path.qd, path.dt).total)
+    energy, _ = physics_energy(robot, path, friction=friction)
+    return float(energy[0])
 
 
 def tcp_deviation_mm(robot: Robot, path: Trajectory, reference: Trajectory) -> float:
