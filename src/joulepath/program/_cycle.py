@@ -1,0 +1,608 @@
+"""Optimizing a cycle: the default as the controller runs it, then shapes and durations.
+
+* The default: :func:`plan_cycle` (the controller emulation), evaluated on a 2.5 ms
+  grid; energy per move ``Σ |tau qd| dt`` (:func:`joulepath.energy.path_energy`) on the
+  physics model (nominal rigid body with the tool's load, ``NOMINAL_FRICTION``) and
+  with the lab plant's drive torque, over each move's time slot (from its start to
+  the next move's start; waits are at rest and cost nothing).
+* Optimized: every ``MoveAbsJ`` / ``MoveJ`` that occurs once in the cycle is
+  reshaped by the single-move gradient optimizer (:func:`joulepath.optimize.solve_move`,
+  rest to rest, fixed duration, limits as constraints). ``MoveL`` moves and moves
+  that occur more than once are kept: same path, same controller profile. Every move
+  of the optimized program stops at its target (the optimizer is rest to rest:
+  zones are replaced by ``fine``) and dwells as the controller does.
+* Time: the optimized moves share ``budget = cycle time - kept moves - dwells - waits``
+  (with ``use_waits`` the waits are set to 0 and their time joins the budget). Each
+  optimized move is solved at a few durations from the shortest one whose
+  minimum-jerk move respects every limit; ``E_i(T) = a + b/T + c/T²`` (a, b, c ≥ 0)
+  is fitted to them; SciPy's SLSQP shares the budget on the fitted curves; the moves
+  are solved again at the shared durations (25 ms steps), and the better of that and
+  the best combination of the solved table (dynamic programming) is kept.
+* Verified: every optimized move's path on a 2.5 ms grid against the joint ranges,
+  speed and acceleration limits; its energy on physics and on the lab plant.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import NOMINAL_FRICTION, Robot
+from joulepath.energy import path_energy
+from joulepath.errors import InvalidInput, LimitViolation
+from joulepath.optimize import ACCEL_TIME, GradientSettings, acceleration_limit, check_limits
+from joulepath.optimize._gradient import solve_move
+from joulepath.optimize._verify import shortest_feasible_duration
+from joulepath.program._resolve import CycleSpec, Step
+from joulepath.program._timing import (
+    FINE_DT,
+    PlannedCycle,
+    PlannedMove,
+    evaluate_cycle,
+    plan_cycle,
+    standalone,
+)
+from joulepath.sim import ControllerConfig, Plant, make_plant
+from joulepath.trajectory import Trajectory
+from joulepath.units import SAMPLE_PERIOD
+
+STEP = SAMPLE_PERIOD
+"""s: optimized durations are whole numbers of 25 ms samples."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CycleSettings:
+    """Settings of a cycle optimization.
+
+    ``cycle_time``: s, or None for the default program's cycle time. ``use_waits``:
+    spend ``WaitTime`` slack on the moves. ``table_points``: durations solved per
+    move; ``via_every``: samples (25 ms) between the via points written per optimized
+    move.
+    """
+
+    cycle_time: float | None = None
+    use_waits: bool = False
+    table_points: int = 4
+    via_every: int = 2
+    accel_time: float = ACCEL_TIME
+    gradient: GradientSettings = field(default_factory=GradientSettings)
+    controller: ControllerConfig = field(default_factory=ControllerConfig)
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.cycle_time is not None and not (np.isfinite(self.cycle_time) and 0 < self.cycle_time <= 3600):
+            raise InvalidInput(f"cycle time must be a positive number of seconds, got {self.cycle_time}")
+        if not 2 <= self.table_points <= 20:
+            raise InvalidInput(f"table_points must be 2..20, got {self.table_points}")
+        if not 1 <= self.via_every <= 40:
+            raise InvalidInput(f"via_every must be 1..40, got {self.via_every}")
+        if not 0 < self.accel_time <= 10:
+            raise InvalidInput(f"accel_time must be in (0, 10] s, got {self.accel_time}")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Solved:
+    """One optimized move at one duration, verified."""
+
+    duration: float
+    energy_J: float
+    energy_lab_J: float
+    limits_ok: bool
+    limit_excess: tuple[str, ...]
+    samples: Trajectory  # 25 ms
+    fine: Trajectory  # 2.5 ms
+
+
+@dataclass(frozen=True, slots=True)
+class MoveOutcome:
+    """One move of the cycle: default against optimized (s, J)."""
+
+    line: int
+    label: str
+    optimized: bool
+    note: str
+    default_duration_s: float
+    optimized_duration_s: float
+    default_energy_J: float
+    optimized_energy_J: float
+    default_lab_J: float
+    optimized_lab_J: float
+    limits_ok: bool
+    limit_excess: tuple[str, ...]
+    via_points: int
+    via_max_joint_dev_deg: float
+    via_max_tcp_dev_mm: float
+
+
+@dataclass(frozen=True, slots=True)
+class Allocation:
+    """Durations (s) of the optimized moves, by step index, and the verified cycle energies (J)."""
+
+    durations: dict[int, float]
+    energy_J: float
+    energy_lab_J: float
+    cycle_time_s: float
+
+
+@dataclass(frozen=True, slots=True)
+class Breakdown:
+    """Where the saving comes from (J on physics): E0 default, E1 shapes at the default's
+    proportions of time, E2 re-allocated durations, E3 with the waits spent."""
+
+    default_J: float
+    shape_J: float
+    allocation_J: float
+    waits_J: float | None
+
+    @property
+    def by_shape_pct(self) -> float:
+        return 100 * (self.default_J - self.shape_J) / self.default_J
+
+    @property
+    def by_allocation_pct(self) -> float:
+        return 100 * (self.shape_J - self.allocation_J) / self.default_J
+
+    @property
+    def by_waits_pct(self) -> float | None:
+        return None if self.waits_J is None else 100 * (self.allocation_J - self.waits_J) / self.default_J
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CycleResult:
+    """A verified cycle optimization."""
+
+    moves: tuple[MoveOutcome, ...]
+    default_cycle_s: float
+    target_cycle_s: float
+    optimized_cycle_s: float
+    default_energy_J: float
+    optimized_energy_J: float
+    default_lab_J: float
+    optimized_lab_J: float
+    breakdown: Breakdown
+    waits: tuple[tuple[int, float, float], ...]  # (line, default s, optimized s)
+    fixed_lines: tuple[int, ...]
+    limits_ok: bool
+    shortest_cycle_s: float
+    wall_s: float
+    n_solves: int
+    paths: dict[int, Solved]  # by step index: the optimized moves
+    spec: CycleSpec
+
+    @property
+    def saved_pct(self) -> float:
+        return 100 * (self.default_energy_J - self.optimized_energy_J) / self.default_energy_J
+
+    @property
+    def saved_lab_pct(self) -> float:
+        return 100 * (self.default_lab_J - self.optimized_lab_J) / self.default_lab_J
+
+
+@dataclass(frozen=True, slots=True)
+class ParetoPoint:
+    """Energy at one cycle time (every move a verified solve of the table)."""
+
+    cycle_time_s: float
+    energy_J: float
+    energy_lab_J: float
+    durations: tuple[float, ...]
+
+
+def _energy(robot: Robot, plant: Plant, traj: Trajectory) -> tuple[float, float]:
+    tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
+    lab = plant.drive_torque(traj.q, traj.qd, traj.qdd)
+    return float(path_energy(tau, traj.qd, traj.dt).total), float(path_energy(lab, traj.qd, traj.dt).total)
+
+
+class CycleOptimizer:
+    """Default cycle, duration table, allocations and verification of one program on one robot."""
+
+    def __init__(
+        self,
+        spec: CycleSpec,
+        settings: CycleSettings,
+        *,
+        progress: Callable[[str], None] | None = None,
+    ) -> None:
+        self.spec = spec
+        self.settings = settings
+        self.progress = progress or (lambda msg: None)
+        self.plan: PlannedCycle = plan_cycle(spec, settings.controller)
+        self._plants: dict[int, Plant] = {}
+        self.cache: dict[tuple[int, int], Solved] = {}
+        self.n_solves = 0
+        moves = self.plan.moves
+        self.by_index = {m.index: m for m in moves}
+        self.optimizable = [
+            m.index for m in moves if not m.step.linear and not m.step.repeated and m.profile.duration > 0
+        ]
+        self.kept = [m.index for m in moves if m.index not in self.optimizable]
+        self.dwell = settings.controller.fine_dwell
+        self.wait_total = float(sum(s for _, _, s in self.plan.waits))
+        self.kept_time = float(sum(self.by_index[i].profile.duration for i in self.kept))
+        self.n_stops = sum(1 for m in moves if m.stops)
+        self.fixed_time = self.n_stops * self.dwell + self.kept_time
+        self.t_lo: dict[int, float] = {}
+        for i in self.optimizable:
+            m = self.by_index[i]
+            robot = self._robot(m)
+            shortest = shortest_feasible_duration(
+                robot,
+                m.path.q0,
+                m.path.q1,
+                dt=STEP,
+                friction=NOMINAL_FRICTION,
+                acceleration_limit=self._amax(robot),
+            )
+            if shortest is None:
+                raise LimitViolation(f"{spec.source}:{m.step.line}: {m.step.label}: no feasible duration found")
+            self.t_lo[i] = shortest
+        self.shortest_cycle = self.fixed_time + sum(self.t_lo.values())
+
+    # ------------------------------------------------------------ helpers
+    def _robot(self, m: PlannedMove) -> Robot:
+        assert m.step.robot is not None
+        return m.step.robot
+
+    def _amax(self, robot: Robot) -> FloatArray | None:
+        return acceleration_limit(robot, self.settings.accel_time)
+
+    def plant(self, robot: Robot) -> Plant:
+        key = id(robot)
+        if key not in self._plants:
+            self._plants[key] = make_plant("lab", robot)
+        return self._plants[key]
+
+    def solve(self, i: int, duration: float) -> Solved:
+        """The optimized move ``i`` at ``duration`` (a whole number of 25 ms samples), verified; cached."""
+        units = int(round(duration / STEP))
+        key = (i, units)
+        if key in self.cache:
+            return self.cache[key]
+        m = self.by_index[i]
+        robot = self._robot(m)
+        T = units * STEP
+        amax = self._amax(robot)
+        seq = np.random.SeedSequence([self.settings.seed, i, units])
+        res, problem = solve_move(
+            robot,
+            m.path.q0,
+            m.path.q1,
+            T,
+            friction=NOMINAL_FRICTION,
+            settings=self.settings.gradient,
+            rng=np.random.default_rng(seq),
+            acceleration_limit=amax,
+        )
+        self.n_solves += 1
+        x = res.coefficients.ravel()
+        fine = problem.path(x, fine=True)
+        report = check_limits(robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax)
+        e, e_lab = _energy(robot, self.plant(robot), fine)
+        out = Solved(T, e, e_lab, report.ok and res.feasible, tuple(w.describe() for w in report.worst), problem.path(x), fine)
+        self.cache[key] = out
+        return out
+
+    # ------------------------------------------------------------ default
+    def default_energies(self) -> dict[int, tuple[float, float, float]]:
+        """Per move (step index): (slot duration s, physics J, lab J) of the default cycle."""
+        plan = self.plan
+        n = int(np.ceil(plan.cycle_time / FINE_DT)) + 1
+        t = np.linspace(0.0, plan.cycle_time, n)
+        traj = evaluate_cycle(plan, t)
+        starts = [m.t0 for m in plan.moves] + [plan.cycle_time]
+        out: dict[int, tuple[float, float, float]] = {}
+        for k, m in enumerate(plan.moves):
+            a = int(np.searchsorted(t, starts[k], side="left"))
+            b = int(np.searchsorted(t, starts[k + 1], side="left"))
+            if b - a < 2:
+                out[m.index] = (m.profile.duration, 0.0, 0.0)
+                continue
+            sl = slice(a, b)
+            part = Trajectory(t=t[sl], q=traj.q[sl], qd=traj.qd[sl], qdd=traj.qdd[sl])
+            robot = self._robot(m)
+            e, e_lab = _energy(robot, self.plant(robot), part)
+            out[m.index] = (m.profile.duration, e, e_lab)
+        return out
+
+    def kept_energies(self) -> dict[int, tuple[float, float]]:
+        """Kept moves run on their own (rest to rest): physics and lab J."""
+        out = {}
+        for i in self.kept:
+            m = self.by_index[i]
+            if m.profile.duration == 0:
+                out[i] = (0.0, 0.0)
+                continue
+            robot = self._robot(m)
+            out[i] = _energy(robot, self.plant(robot), standalone(m))
+        return out
+
+    # ------------------------------------------------------------ allocation
+    def budget(self, cycle_time: float, use_waits: bool) -> float:
+        return cycle_time - self.fixed_time - (0.0 if use_waits else self.wait_total)
+
+    def table(self, extra: float) -> dict[int, list[Solved]]:
+        """Each optimized move solved at ``table_points`` durations from its shortest to shortest + ``extra``."""
+        k = self.settings.table_points
+        shares = np.concatenate([[0.0], np.geomspace(0.06, 1.0, k - 1)])
+        out: dict[int, list[Solved]] = {}
+        for n_move, i in enumerate(self.optimizable, start=1):
+            self.progress(f"move {n_move}/{len(self.optimizable)}: solving at {k} durations")
+            units = sorted({int(round((self.t_lo[i] + s * extra) / STEP)) for s in shares})
+            units = [u for u in units if u * STEP >= self.t_lo[i] - 1e-9] or [int(round(self.t_lo[i] / STEP))]
+            out[i] = [self.solve(i, u * STEP) for u in units]
+        return out
+
+    def dp(self, table: dict[int, list[Solved]], budget: float) -> dict[int, float] | None:
+        """The least-energy choice of one solved duration per move with Σ ≤ budget (feasible solves only)."""
+        cap = int(np.floor(budget / STEP + 1e-9))
+        if cap < 0:
+            return None
+        best = np.full(cap + 1, np.inf)
+        best[0] = 0.0
+        choice: list[np.ndarray] = []
+        for i in self.optimizable:
+            new = np.full(cap + 1, np.inf)
+            pick = np.full(cap + 1, -1)
+            for k, s in enumerate(table[i]):
+                if not s.limits_ok:
+                    continue
+                u = int(round(s.duration / STEP))
+                if u > cap:
+                    continue
+                cand = np.full(cap + 1, np.inf)
+                cand[u:] = best[: cap + 1 - u] + s.energy_J
+                better = cand < new
+                new[better] = cand[better]
+                pick[better] = k
+            choice.append(pick)
+            best = new
+        end = int(np.argmin(best))
+        if not np.isfinite(best[end]):
+            return None
+        out: dict[int, float] = {}
+        u = end
+        for i, pick in zip(reversed(self.optimizable), reversed(choice), strict=True):
+            s = table[i][int(pick[u])]
+            out[i] = s.duration
+            u -= int(round(s.duration / STEP))
+        return out
+
+    def continuous(self, table: dict[int, list[Solved]], budget: float) -> dict[int, float]:
+        """Share the budget on the fitted curves ``a + b/T + c/T²`` (SLSQP), in 25 ms steps."""
+        from scipy.optimize import minimize, nnls
+
+        idx = self.optimizable
+        coef = []
+        for i in idx:
+            pts = [(s.duration, s.energy_J) for s in table[i] if s.limits_ok]
+            T = np.array([p[0] for p in pts])
+            E = np.array([p[1] for p in pts])
+            A = np.column_stack([np.ones_like(T), 1 / T, 1 / T**2])
+            c, _ = nnls(A, E) if T.size >= 2 else (np.array([E[0], 0.0, 0.0]), 0.0)
+            coef.append(c)
+        C = np.array(coef)
+        lo = np.array([self.t_lo[i] for i in idx])
+        hi = np.array([max(s.duration for s in table[i]) for i in idx])
+        hi = np.maximum(hi, lo)
+
+        def f(T: FloatArray) -> tuple[float, FloatArray]:
+            e = C[:, 0] + C[:, 1] / T + C[:, 2] / T**2
+            g = -C[:, 1] / T**2 - 2 * C[:, 2] / T**3
+            return float(e.sum()), g
+
+        x0 = np.clip(lo + (budget - lo.sum()) * (hi - lo) / max((hi - lo).sum(), 1e-9), lo, hi)
+        res = minimize(
+            f,
+            x0,
+            jac=True,
+            method="SLSQP",
+            bounds=list(zip(lo, hi, strict=True)),
+            constraints=[{"type": "ineq", "fun": lambda T: budget - T.sum(), "jac": lambda T: -np.ones_like(T)}],
+            options={"maxiter": 200, "ftol": 1e-10},
+        )
+        T = np.clip(np.asarray(res.x, dtype=float), lo, hi)
+        units = np.maximum(np.floor(T / STEP + 1e-9), np.ceil(lo / STEP - 1e-9)).astype(int)
+        spare = int(np.floor(budget / STEP + 1e-9)) - int(units.sum())
+        while spare > 0:  # hand the remaining 25 ms steps to the steepest curves
+            _, g = f(units * STEP)
+            k = int(np.argmin(g))
+            units[k] += 1
+            spare -= 1
+        return {i: float(u * STEP) for i, u in zip(idx, units, strict=True)}
+
+    def evaluate(self, durations: dict[int, float], kept: dict[int, tuple[float, float]], waits: float) -> Allocation:
+        """Verified cycle energies for given durations of the optimized moves."""
+        e = e_lab = 0.0
+        for i, T in durations.items():
+            s = self.solve(i, T)
+            e += s.energy_J
+            e_lab += s.energy_lab_J
+        for a, b in kept.values():
+            e += a
+            e_lab += b
+        cycle = self.fixed_time + waits + sum(durations.values())
+        return Allocation(dict(durations), e, e_lab, cycle)
+
+    def proportional(self, budget: float) -> dict[int, float]:
+        """The default's durations scaled by one factor to fill the budget (never below the shortest)."""
+        base = {i: self.by_index[i].profile.duration for i in self.optimizable}
+
+        def total(k: float) -> float:
+            return sum(max(self.t_lo[i], k * base[i]) for i in base)
+
+        lo, hi = 0.0, 100.0
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if total(mid) <= budget else (lo, mid)
+        return {i: max(STEP * np.ceil(self.t_lo[i] / STEP - 1e-9), STEP * np.floor(max(self.t_lo[i], lo * base[i]) / STEP + 1e-9)) for i in base}
+
+    def best(self, table: dict[int, list[Solved]], budget: float, kept: dict[int, tuple[float, float]], waits: float) -> Allocation:
+        candidates = []
+        d = self.dp(table, budget)
+        if d is not None:
+            candidates.append(self.evaluate(d, kept, waits))
+        c = self.continuous(table, budget)
+        alloc = self.evaluate(c, kept, waits)
+        if all(self.solve(i, T).limits_ok for i, T in c.items()):
+            candidates.append(alloc)
+        if not candidates:
+            raise LimitViolation(
+                f"{self.spec.source}: no allocation of the durations keeps every optimized move within its limits"
+            )
+        return min(candidates, key=lambda a: a.energy_J)
+
+
+def optimize_cycle(
+    spec: CycleSpec,
+    settings: CycleSettings,
+    *,
+    progress: Callable[[str], None] | None = None,
+) -> tuple[CycleResult, CycleOptimizer]:
+    """Optimize a cycle at the default's cycle time (or ``settings.cycle_time``); verified."""
+    t_start = time.perf_counter()
+    opt = CycleOptimizer(spec, settings, progress=progress)
+    plan = opt.plan
+    target = plan.cycle_time if settings.cycle_time is None else settings.cycle_time
+    wait_budget = opt.wait_total if settings.use_waits else 0.0
+    if not opt.optimizable:
+        raise InvalidInput(f"{spec.source}: the cycle has no MoveJ or MoveAbsJ that can be optimized")
+    shortest = opt.shortest_cycle + (0.0 if settings.use_waits else opt.wait_total)
+    if target < shortest - 1e-9:
+        raise LimitViolation(
+            f"{spec.source}: cycle time {target:.3f} s is shorter than the shortest this program reaches with "
+            f"moves that stop at every target ({shortest:.3f} s; the default runs {plan.cycle_time:.3f} s); "
+            f"give --cycle-time {np.ceil(shortest * 1000) / 1000:.3f} or more"
+            + ("" if settings.use_waits else ", or allow --use-waits")
+        )
+    default = opt.default_energies()
+    kept = opt.kept_energies()
+    e0 = sum(v[1] for v in default.values())
+    e0_lab = sum(v[2] for v in default.values())
+    b_plain = opt.budget(target, use_waits=False)
+    b_waits = opt.budget(target, use_waits=True)
+    b_max = b_waits if settings.use_waits else b_plain
+    lo_sum = sum(opt.t_lo.values())
+    table = opt.table(max(b_max - lo_sum, 0.0))
+    opt.progress("sharing the cycle time")
+    shape: Allocation | None = None
+    if b_plain >= lo_sum - 1e-9:
+        shape = opt.evaluate(opt.proportional(b_plain), kept, opt.wait_total)
+        plain = opt.best(table, b_plain, kept, opt.wait_total)
+    final = plain if not settings.use_waits else opt.best(table, b_waits, kept, 0.0)
+    if settings.use_waits and shape is None:
+        shape = opt.evaluate(opt.proportional(b_waits), kept, 0.0)
+        plain = final
+    assert shape is not None
+    breakdown = Breakdown(
+        default_J=e0,
+        shape_J=shape.energy_J,
+        allocation_J=plain.energy_J,
+        waits_J=final.energy_J if settings.use_waits else None,
+    )
+    outcomes: list[MoveOutcome] = []
+    paths: dict[int, Solved] = {}
+    ok = True
+    for m in plan.moves:
+        d_T, d_e, d_lab = default[m.index]
+        if m.index in final.durations:
+            s = opt.solve(m.index, final.durations[m.index])
+            paths[m.index] = s
+            n_via, dev_q, dev_mm = via_deviation(m.step, s, settings.via_every)
+            ok = ok and s.limits_ok
+            outcomes.append(
+                MoveOutcome(
+                    m.step.line, m.step.label, True, "reshaped and re-timed", d_T, s.duration, d_e,
+                    s.energy_J, d_lab, s.energy_lab_J, s.limits_ok, s.limit_excess, n_via, dev_q, dev_mm,
+                )
+            )
+        else:
+            note = (
+                "MoveL: kept (straight line, controller timing), stops at its target"
+                if m.step.linear
+                else "occurs more than once in the cycle: kept, stops at its target"
+                if m.step.repeated
+                else "no motion"
+            )
+            a, b = kept[m.index]
+            outcomes.append(
+                MoveOutcome(m.step.line, m.step.label, False, note, d_T, m.profile.duration, d_e, a, d_lab, b, True, (), 0, 0.0, 0.0)
+            )
+    waits = tuple(
+        (spec.steps[i].line, sec, 0.0 if settings.use_waits else sec) for i, _, sec in plan.waits
+    )
+    result = CycleResult(
+        moves=tuple(outcomes),
+        default_cycle_s=plan.cycle_time,
+        target_cycle_s=target,
+        optimized_cycle_s=final.cycle_time_s,
+        default_energy_J=e0,
+        optimized_energy_J=final.energy_J,
+        default_lab_J=e0_lab,
+        optimized_lab_J=final.energy_lab_J,
+        breakdown=breakdown,
+        waits=waits,
+        fixed_lines=spec.fixed_lines,
+        limits_ok=ok,
+        shortest_cycle_s=shortest,
+        wall_s=time.perf_counter() - t_start,
+        n_solves=opt.n_solves,
+        paths=paths,
+        spec=spec,
+    )
+    return result, opt
+
+
+def via_points(samples: Trajectory, every: int) -> list[int]:
+    """Sample indices written as via points (every ``every`` samples and the last)."""
+    n = samples.t.size
+    return list(range(every, n - 1, every)) + [n - 1]
+
+
+def via_deviation(step: Step, solved: Solved, every: int) -> tuple[int, float, float]:
+    """Via points, and the largest joint (deg) and TCP (mm) distance of their joint-linear
+    interpolation from the optimized path (what the controller's interpolation between
+    via points departs from it, before its zones round the corners)."""
+    assert step.robot is not None and step.tcp is not None
+    idx = [0, *via_points(solved.samples, every)]
+    tv = solved.samples.t[idx]
+    qv = solved.samples.q[idx]
+    fine = solved.fine
+    lin = np.column_stack([np.interp(fine.t, tv, qv[:, j]) for j in range(qv.shape[1])])
+    dev_q = float(np.degrees(np.abs(lin - fine.q).max()))
+    a = step.robot.fk(lin)
+    b = step.robot.fk(fine.q)
+    pa = a.position_m + np.einsum("kij,j->ki", a.rotation, step.tcp[:3, 3])
+    pb = b.position_m + np.einsum("kij,j->ki", b.rotation, step.tcp[:3, 3])
+    return len(idx) - 1, dev_q, float(1000 * np.linalg.norm(pa - pb, axis=1).max())
+
+
+def pareto(opt: CycleOptimizer, *, points: int = 10, span: float = 0.3, use_waits: bool = False) -> list[ParetoPoint]:
+    """Energy against cycle time from the shortest feasible cycle to ``(1 + span)`` times it.
+
+    One table of solved, verified moves covers the whole range; each point is the
+    least-energy combination of table entries within its budget (dynamic programming),
+    so every point is made of verified solves.
+    """
+    waits = 0.0 if use_waits else opt.wait_total
+    c_min = opt.shortest_cycle + waits
+    kept = opt.kept_energies()
+    lo_sum = sum(opt.t_lo.values())
+    c_max = c_min * (1 + span)
+    table = opt.table(opt.budget(c_max, use_waits) - lo_sum)
+    out = []
+    for c in np.linspace(c_min, c_max, points):
+        d = opt.dp(table, opt.budget(float(c), use_waits) + 1e-9)
+        if d is None:
+            continue
+        a = opt.evaluate(d, kept, waits)
+        out.append(ParetoPoint(float(c), a.energy_J, a.energy_lab_J, tuple(d[i] for i in opt.optimizable)))
+    return out
+
+
+def with_settings(settings: CycleSettings, **changes: object) -> CycleSettings:
+    return replace(settings, **changes)  # type: ignore[arg-type]

@@ -1,0 +1,322 @@
+"""From a parsed module (or a plain cycle file) to the cycle: joint targets, speeds, zones, waits.
+
+The cycle is the body of ``main``'s ``WHILE TRUE`` loop, or ``main``'s body when there is
+no loop; calls of the module's procedures are followed (their statements join the
+cycle where the call stands). The robot starts each cycle where the previous one ended:
+at the last move's target. Robtargets are solved with the closed-form inverse
+kinematics, choosing the solution their ``confdata`` names; a tool's TCP and load
+are taken into account (targets are TCP poses, the load is carried in the dynamics).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import Robot
+from joulepath.errors import InvalidInput
+from joulepath.kinematics import quaternion_to_rotation
+from joulepath.kinematics._ik import check_layout, confdata, solve_ik
+from joulepath.program._model import (
+    Call,
+    JointTarget,
+    Module,
+    Move,
+    RapidError,
+    RobTarget,
+    SpeedData,
+    Statement,
+    ToolData,
+    Verbatim,
+    WaitTime,
+    WhileTrue,
+    ZoneData,
+)
+from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES, TOOL0
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Step:
+    """One step of the cycle.
+
+    ``kind`` is ``"move"``, ``"wait"`` or ``"fixed"`` (an instruction kept verbatim).
+    For a move: the joint target (rad), whether the TCP moves on a straight line
+    (``MoveL``), the speed, ``\\T`` (s), the zone radius (mm; None: a stop point), the
+    tool (TCP in m as a 4x4 flange-to-TCP transform) and the robot carrying its load.
+    """
+
+    kind: str
+    line: int
+    label: str
+    statement: Statement | None
+    q: FloatArray | None = None
+    linear: bool = False
+    speed: SpeedData | None = None
+    time_s: float | None = None
+    zone_mm: float | None = None
+    tcp: FloatArray | None = None
+    robot: Robot | None = None
+    seconds: float = 0.0
+    repeated: bool = False
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CycleSpec:
+    """The cycle: its steps, where it starts (rad), and where it came from."""
+
+    steps: tuple[Step, ...]
+    start: FloatArray
+    source: str
+    module: Module | None
+    fixed_lines: tuple[int, ...]
+
+
+def tool_transform(tool: ToolData) -> FloatArray:
+    """Flange (tool0) to TCP transform, m."""
+    out = np.eye(4)
+    out[:3, :3] = quaternion_to_rotation(np.asarray(tool.rotation, dtype=float))
+    out[:3, 3] = np.asarray(tool.tcp_mm) / 1000.0
+    return out
+
+
+def target_pose(target: RobTarget) -> FloatArray:
+    """The TCP pose of a robtarget in the base frame, m."""
+    out = np.eye(4)
+    out[:3, :3] = quaternion_to_rotation(np.asarray(target.quaternion, dtype=float))
+    out[:3, 3] = np.asarray(target.position_mm) / 1000.0
+    return out
+
+
+def _flatten(module: Module, body: tuple[Statement, ...]) -> list[Statement]:
+    out: list[Statement] = []
+    for s in body:
+        if isinstance(s, Call):
+            proc = module.procedure(s.name)
+            assert proc is not None
+            out.extend(_flatten(module, proc.body))
+        elif isinstance(s, WhileTrue):
+            out.extend(_flatten(module, s.body))
+        else:
+            out.append(s)
+    return out
+
+
+def _lookup(module: Module, name: str, type_: str, line: int) -> object:
+    d = module.declaration(name)
+    if d is None:
+        if type_ == "speeddata" and name.lower() in PREDEFINED_SPEEDS:
+            return PREDEFINED_SPEEDS[name.lower()]
+        if type_ == "zonedata" and name.lower() in PREDEFINED_ZONES:
+            return PREDEFINED_ZONES[name.lower()]
+        if type_ == "tooldata" and name.lower() == "tool0":
+            return TOOL0
+        if type_ in ("robtarget", "jointtarget"):
+            raise module.error(line, f"unknown target {name!r}: declare it (CONST {type_} {name} := [...])")
+        raise module.error(line, f"unknown {type_} {name!r}: declare it or use a predefined one")
+    if d.type != type_:
+        raise module.error(line, f"{name} is a {d.type} (line {d.line}), but a {type_} is needed here")
+    return d.value
+
+
+def resolve_module(module: Module, robot: Robot) -> CycleSpec:
+    """The cycle of a parsed module on ``robot``; ``RapidError`` naming the line otherwise."""
+    main = module.procedure("main")
+    assert main is not None
+    loop = next((s for s in main.body if isinstance(s, WhileTrue)), None)
+    body = loop.body if loop is not None else main.body
+    flat = _flatten(module, body)
+    lo, hi = robot.joint_ranges()
+    counts: dict[int, int] = {}
+    for s in flat:
+        counts[s.line] = counts.get(s.line, 0) + 1
+    robots: dict[str, Robot] = {}
+    steps: list[Step] = []
+    fixed: list[int] = []
+    for s in flat:
+        if isinstance(s, WaitTime):
+            steps.append(Step("wait", s.line, f"WaitTime {s.seconds:g}", s, seconds=s.seconds))
+        elif isinstance(s, Verbatim):
+            steps.append(Step("fixed", s.line, s.text, s))
+            fixed.append(s.line)
+        elif isinstance(s, Move):
+            steps.append(_move_step(module, robot, s, lo, hi, robots, counts[s.line] > 1))
+    moves = [st for st in steps if st.kind == "move"]
+    if not moves:
+        where = "main's WHILE TRUE loop" if loop is not None else "main"
+        raise module.error(loop.line if loop is not None else main.line, f"{where} holds no move; nothing to optimize")
+    assert moves[-1].q is not None
+    return CycleSpec(tuple(steps), moves[-1].q.copy(), module.path, module, tuple(fixed))
+
+
+def _move_step(
+    module: Module,
+    robot: Robot,
+    s: Move,
+    lo: FloatArray,
+    hi: FloatArray,
+    robots: dict[str, Robot],
+    repeated: bool,
+) -> Step:
+    speed = _lookup(module, s.speed, "speeddata", s.line)
+    zone = _lookup(module, s.zone, "zonedata", s.line)
+    tool = _lookup(module, s.tool, "tooldata", s.line)
+    assert isinstance(speed, SpeedData) and isinstance(zone, ZoneData) and isinstance(tool, ToolData)
+    if s.v_tcp is not None:
+        speed = SpeedData(s.v_tcp, speed.v_ori, speed.v_leax, speed.v_reax)
+    zone_mm = None if zone.finep else zone.pzone_tcp
+    if s.z_tcp is not None and zone_mm is not None:
+        zone_mm = s.z_tcp
+    tcp = tool_transform(tool)
+    key = s.tool.lower()
+    if key not in robots:
+        robots[key] = robot.with_payload(tool.mass_kg, com=np.asarray(tool.cog_mm) / 1000.0) if tool.mass_kg > 0 else robot
+    if s.instruction == "MoveAbsJ":
+        jt = _lookup(module, s.target, "jointtarget", s.line)
+        assert isinstance(jt, JointTarget)
+        q = np.radians(np.asarray(jt.joints_deg[: robot.n_joints], dtype=float))
+        bad = np.nonzero((q < lo - 1e-9) | (q > hi + 1e-9))[0]
+        if bad.size:
+            j = int(bad[0])
+            raise module.error(
+                s.line,
+                f"{s.target}: joint {j + 1} = {np.degrees(q[j]):.2f} deg is outside its range "
+                f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg",
+            )
+    else:
+        rt = _lookup(module, s.target, "robtarget", s.line)
+        assert isinstance(rt, RobTarget)
+        q = robtarget_joints(module, robot, rt, tcp, s)
+    return Step(
+        "move",
+        s.line,
+        f"{s.instruction} {s.target}",
+        s,
+        q=q,
+        linear=s.instruction == "MoveL",
+        speed=speed,
+        time_s=s.time_s,
+        zone_mm=zone_mm,
+        tcp=tcp,
+        robot=robots[key],
+        repeated=repeated,
+    )
+
+
+def robtarget_joints(module: Module, robot: Robot, rt: RobTarget, tcp: FloatArray, s: Move) -> FloatArray:
+    """Joint values of a robtarget with its confdata; ``RapidError`` when unreachable or the conf fits no solution."""
+    try:
+        check_layout(robot.chain)
+    except InvalidInput as err:
+        raise module.error(s.line, str(err)) from err
+    lo, hi = robot.joint_ranges()
+    flange = target_pose(rt) @ np.linalg.inv(tcp)
+    q = solve_ik(robot.chain, flange, rt.conf, lower=lo, upper=hi)
+    if q is not None:
+        return q
+    anyq = solve_ik(robot.chain, flange, None, lower=lo, upper=hi, near=np.zeros(robot.n_joints))
+    if anyq is None:
+        raise module.error(
+            s.line,
+            f"{s.target} at {list(rt.position_mm)} mm is out of the robot's reach with this orientation "
+            "and tool (no joint solution within the ranges); move the target",
+        )
+    from joulepath.kinematics._ik import ik_branches
+
+    qs, valid = ik_branches(robot.chain, flange)
+    confs = sorted(
+        {tuple(int(v) for v in confdata(robot.chain, c)) for c, ok in zip(qs, valid, strict=True) if ok and np.all(c >= lo - 1e-9) and np.all(c <= hi + 1e-9)}
+    )
+    raise module.error(
+        s.line,
+        f"{s.target}: no joint solution matches its confdata {list(rt.conf)}; reachable ones: "
+        + ", ".join(str(list(c)) for c in confs),
+    )
+
+
+# ---------------------------------------------------------------- plain cycle file
+def read_cycle_toml(path: str | Path, robot: Robot) -> CycleSpec:
+    """A plain cycle file for arms without RAPID (TOML), e.g.::
+
+        start_deg = [0, 0, 0, 0, 30, 0]      # optional: default the last waypoint
+        [[step]]
+        joints_deg = [60, 20, 10, 0, 40, 0]
+        duration_s = 0.9                      # the move's time as the arm runs it
+        [[step]]
+        wait_s = 0.3
+
+    Every move is a joint move that stops at its waypoint; its default is the
+    controller's jerk-limited profile stretched to ``duration_s``.
+    """
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as err:
+        raise InvalidInput(f"{p}: cannot be read ({err}); give a TOML cycle file") from err
+    except tomllib.TOMLDecodeError as err:
+        raise InvalidInput(f"{p}: not valid TOML ({err})") from err
+    unknown = set(data) - {"start_deg", "step"}
+    if unknown:
+        raise InvalidInput(f"{p}: unknown key(s) {sorted(unknown)}; use start_deg and [[step]]")
+    raw = data.get("step")
+    if not isinstance(raw, list) or not raw:
+        raise InvalidInput(f"{p}: no [[step]] tables; add moves (joints_deg, duration_s) and waits (wait_s)")
+    n = robot.n_joints
+    lo, hi = robot.joint_ranges()
+    steps: list[Step] = []
+    for k, st in enumerate(raw, start=1):
+        where = f"{p}: step {k}"
+        if not isinstance(st, dict):
+            raise InvalidInput(f"{where}: must be a table")
+        if set(st) == {"wait_s"}:
+            w = st["wait_s"]
+            if not isinstance(w, int | float) or not 0 <= w <= 3600:
+                raise InvalidInput(f"{where}: wait_s must be a number of seconds in [0, 3600]")
+            steps.append(Step("wait", k, f"wait {w:g}", None, seconds=float(w)))
+            continue
+        if set(st) != {"joints_deg", "duration_s"}:
+            raise InvalidInput(f"{where}: a step is either wait_s or joints_deg + duration_s, got {sorted(st)}")
+        q = _joints(st["joints_deg"], n, where)
+        T = st["duration_s"]
+        if not isinstance(T, int | float) or not 0 < T <= 60:
+            raise InvalidInput(f"{where}: duration_s must be a number of seconds in (0, 60]")
+        bad = np.nonzero((q < lo - 1e-9) | (q > hi + 1e-9))[0]
+        if bad.size:
+            j = int(bad[0])
+            raise InvalidInput(f"{where}: joint {j + 1} = {np.degrees(q[j]):.2f} deg is outside its range")
+        steps.append(
+            Step(
+                "move",
+                k,
+                f"step {k}",
+                None,
+                q=q,
+                speed=SpeedData(7000.0, 500.0, 5000.0, 1000.0),
+                time_s=float(T),
+                zone_mm=None,
+                tcp=np.eye(4),
+                robot=robot,
+            )
+        )
+    moves = [s for s in steps if s.kind == "move"]
+    if not moves:
+        raise InvalidInput(f"{p}: no move step; add [[step]] tables with joints_deg and duration_s")
+    start = _joints(data["start_deg"], n, f"{p}: start_deg") if "start_deg" in data else moves[-1].q
+    assert start is not None
+    return CycleSpec(tuple(steps), np.asarray(start, float), str(p), None, ())
+
+
+def _joints(value: object, n: int, where: str) -> FloatArray:
+    if (
+        not isinstance(value, list)
+        or len(value) != n
+        or not all(isinstance(v, int | float) and np.isfinite(v) for v in value)
+    ):
+        raise InvalidInput(f"{where}: needs a list of {n} joint values in degrees")
+    return np.radians(np.asarray(value, dtype=float))
+
+
+__all__ = ["CycleSpec", "RapidError", "Step", "read_cycle_toml", "resolve_module"]
