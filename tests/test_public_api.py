@@ -20,6 +20,7 @@ PACKAGES = [
     "joulepath.sim",
     "joulepath.experiment",
     "joulepath.report",
+    "joulepath.program",
 ]
 
 
@@ -65,6 +66,7 @@ ALLOWED = {
         "sim",
         "energy",
     },
+    "program": {"kinematics", "dynamics", "trajectory", "optimize", "sim", "energy"},
     "energy": set(),
     "units": set(),
     "abb": set(),

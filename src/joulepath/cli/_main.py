@@ -7,6 +7,7 @@ from collections.abc import Sequence
 
 import typer
 
+from joulepath.cli._cycle import cycle
 from joulepath.cli._data import ingest, rapid_app, simulate
 from joulepath.cli._experiment import demo, run
 from joulepath.cli._learn import importance, train
@@ -32,6 +33,7 @@ app.command("synth")(synth)
 app.command("compare")(compare)
 app.command("optimize")(optimize)
 app.command("bench-optimizers")(bench_optimizers)
+app.command("cycle")(cycle)
 app.command("run")(run)
 app.command("demo")(demo)
 

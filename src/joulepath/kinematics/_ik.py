@@ -234,8 +234,12 @@ def _turns(q: FloatArray, lower: FloatArray, upper: FloatArray) -> list[FloatArr
     """``q`` with whole turns added to any joint, every combination within the ranges."""
     options = []
     for j in range(q.size):
-        ks = range(int(np.floor((lower[j] - q[j]) / (2 * np.pi))), int(np.ceil((upper[j] - q[j]) / (2 * np.pi))) + 1)
-        vals = [q[j] + 2 * np.pi * k for k in ks if lower[j] - 1e-9 <= q[j] + 2 * np.pi * k <= upper[j] + 1e-9]
+        ks = range(
+            int(np.floor((lower[j] - q[j]) / (2 * np.pi))), int(np.ceil((upper[j] - q[j]) / (2 * np.pi))) + 1
+        )
+        vals = [
+            q[j] + 2 * np.pi * k for k in ks if lower[j] - 1e-9 <= q[j] + 2 * np.pi * k <= upper[j] + 1e-9
+        ]
         if not vals:
             return []
         options.append(vals)
@@ -250,6 +254,9 @@ def pose_error(chain: Chain, q: FloatArray, pose: FloatArray) -> tuple[FloatArra
     rel = np.swapaxes(got.rotation, -1, -2) @ pose[..., :3, :3]
     tr = np.clip((np.trace(rel, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
     # arccos is ill-conditioned near 0: use the skew part for small angles
-    skew = np.stack([rel[..., 2, 1] - rel[..., 1, 2], rel[..., 0, 2] - rel[..., 2, 0], rel[..., 1, 0] - rel[..., 0, 1]], -1)
+    skew = np.stack(
+        [rel[..., 2, 1] - rel[..., 1, 2], rel[..., 0, 2] - rel[..., 2, 0], rel[..., 1, 0] - rel[..., 0, 1]],
+        -1,
+    )
     angle = np.arctan2(0.5 * np.linalg.norm(skew, axis=-1), tr)
     return dp, angle

@@ -1,1 +1,43 @@
-"""Robot programs: read a RAPID module (or a plain cycle file), run its cycle as the controller does, optimize it."""
+"""Robot programs: read a RAPID module (or a plain cycle file), run its cycle as the
+controller does, optimize it."""
+
+from joulepath.program._cycle import (
+    Breakdown,
+    CycleOptimizer,
+    CycleResult,
+    CycleSettings,
+    MoveOutcome,
+    ParetoPoint,
+    optimize_cycle,
+    pareto,
+)
+from joulepath.program._model import Module, RapidError
+from joulepath.program._output import CYCLE_FILES, optimized_module, write_cycle_run
+from joulepath.program._parse import parse_module, read_module
+from joulepath.program._resolve import CycleSpec, read_cycle_toml, resolve_module
+from joulepath.program._timing import plan_cycle
+from joulepath.program._write import format_move, write_module
+
+__all__ = [
+    "CYCLE_FILES",
+    "Breakdown",
+    "CycleOptimizer",
+    "CycleResult",
+    "CycleSettings",
+    "CycleSpec",
+    "Module",
+    "MoveOutcome",
+    "ParetoPoint",
+    "RapidError",
+    "format_move",
+    "optimize_cycle",
+    "optimized_module",
+    "parse_module",
+    "pareto",
+    "plan_cycle",
+    "read_cycle_toml",
+    "read_module",
+    "resolve_module",
+    "write_cycle_run",
+    "write_module",
+]

@@ -239,7 +239,9 @@ class CycleOptimizer:
                 acceleration_limit=self._amax(robot),
             )
             if shortest is None:
-                raise LimitViolation(f"{spec.source}:{m.step.line}: {m.step.label}: no feasible duration found")
+                raise LimitViolation(
+                    f"{spec.source}:{m.step.line}: {m.step.label}: no feasible duration found"
+                )
             self.t_lo[i] = shortest
         self.shortest_cycle = self.fixed_time + sum(self.t_lo.values())
 
@@ -283,7 +285,15 @@ class CycleOptimizer:
         fine = problem.path(x, fine=True)
         report = check_limits(robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax)
         e, e_lab = _energy(robot, self.plant(robot), fine)
-        out = Solved(T, e, e_lab, report.ok and res.feasible, tuple(w.describe() for w in report.worst), problem.path(x), fine)
+        out = Solved(
+            T,
+            e,
+            e_lab,
+            report.ok and res.feasible,
+            tuple(w.describe() for w in report.worst),
+            problem.path(x),
+            fine,
+        )
         self.cache[key] = out
         return out
 
@@ -326,7 +336,7 @@ class CycleOptimizer:
         return cycle_time - self.fixed_time - (0.0 if use_waits else self.wait_total)
 
     def table(self, extra: float) -> dict[int, list[Solved]]:
-        """Each optimized move solved at ``table_points`` durations from its shortest to shortest + ``extra``."""
+        """Each optimized move solved at ``table_points`` durations, shortest to shortest + ``extra``."""
         k = self.settings.table_points
         shares = np.concatenate([[0.0], np.geomspace(0.06, 1.0, k - 1)])
         out: dict[int, list[Solved]] = {}
@@ -402,7 +412,9 @@ class CycleOptimizer:
             jac=True,
             method="SLSQP",
             bounds=list(zip(lo, hi, strict=True)),
-            constraints=[{"type": "ineq", "fun": lambda T: budget - T.sum(), "jac": lambda T: -np.ones_like(T)}],
+            constraints=[
+                {"type": "ineq", "fun": lambda T: budget - T.sum(), "jac": lambda T: -np.ones_like(T)}
+            ],
             options={"maxiter": 200, "ftol": 1e-10},
         )
         T = np.clip(np.asarray(res.x, dtype=float), lo, hi)
@@ -415,7 +427,9 @@ class CycleOptimizer:
             spare -= 1
         return {i: float(u * STEP) for i, u in zip(idx, units, strict=True)}
 
-    def evaluate(self, durations: dict[int, float], kept: dict[int, tuple[float, float]], waits: float) -> Allocation:
+    def evaluate(
+        self, durations: dict[int, float], kept: dict[int, tuple[float, float]], waits: float
+    ) -> Allocation:
         """Verified cycle energies for given durations of the optimized moves."""
         e = e_lab = 0.0
         for i, T in durations.items():
@@ -439,9 +453,21 @@ class CycleOptimizer:
         for _ in range(80):
             mid = 0.5 * (lo + hi)
             lo, hi = (mid, hi) if total(mid) <= budget else (lo, mid)
-        return {i: max(STEP * np.ceil(self.t_lo[i] / STEP - 1e-9), STEP * np.floor(max(self.t_lo[i], lo * base[i]) / STEP + 1e-9)) for i in base}
+        return {
+            i: max(
+                STEP * np.ceil(self.t_lo[i] / STEP - 1e-9),
+                STEP * np.floor(max(self.t_lo[i], lo * base[i]) / STEP + 1e-9),
+            )
+            for i in base
+        }
 
-    def best(self, table: dict[int, list[Solved]], budget: float, kept: dict[int, tuple[float, float]], waits: float) -> Allocation:
+    def best(
+        self,
+        table: dict[int, list[Solved]],
+        budget: float,
+        kept: dict[int, tuple[float, float]],
+        waits: float,
+    ) -> Allocation:
         candidates = []
         d = self.dp(table, budget)
         if d is not None:
@@ -452,7 +478,8 @@ class CycleOptimizer:
             candidates.append(alloc)
         if not candidates:
             raise LimitViolation(
-                f"{self.spec.source}: no allocation of the durations keeps every optimized move within its limits"
+                f"{self.spec.source}: no allocation of the durations keeps every optimized move "
+                "within its limits"
             )
         return min(candidates, key=lambda a: a.energy_J)
 
@@ -468,13 +495,13 @@ def optimize_cycle(
     opt = CycleOptimizer(spec, settings, progress=progress)
     plan = opt.plan
     target = plan.cycle_time if settings.cycle_time is None else settings.cycle_time
-    wait_budget = opt.wait_total if settings.use_waits else 0.0
     if not opt.optimizable:
         raise InvalidInput(f"{spec.source}: the cycle has no MoveJ or MoveAbsJ that can be optimized")
     shortest = opt.shortest_cycle + (0.0 if settings.use_waits else opt.wait_total)
     if target < shortest - 1e-9:
         raise LimitViolation(
-            f"{spec.source}: cycle time {target:.3f} s is shorter than the shortest this program reaches with "
+            f"{spec.source}: cycle time {target:.3f} s is shorter than the shortest this program "
+            "reaches with "
             f"moves that stop at every target ({shortest:.3f} s; the default runs {plan.cycle_time:.3f} s); "
             f"give --cycle-time {np.ceil(shortest * 1000) / 1000:.3f} or more"
             + ("" if settings.use_waits else ", or allow --use-waits")
@@ -516,8 +543,21 @@ def optimize_cycle(
             ok = ok and s.limits_ok
             outcomes.append(
                 MoveOutcome(
-                    m.step.line, m.step.label, True, "reshaped and re-timed", d_T, s.duration, d_e,
-                    s.energy_J, d_lab, s.energy_lab_J, s.limits_ok, s.limit_excess, n_via, dev_q, dev_mm,
+                    m.step.line,
+                    m.step.label,
+                    True,
+                    "reshaped and re-timed",
+                    d_T,
+                    s.duration,
+                    d_e,
+                    s.energy_J,
+                    d_lab,
+                    s.energy_lab_J,
+                    s.limits_ok,
+                    s.limit_excess,
+                    n_via,
+                    dev_q,
+                    dev_mm,
                 )
             )
         else:
@@ -530,11 +570,25 @@ def optimize_cycle(
             )
             a, b = kept[m.index]
             outcomes.append(
-                MoveOutcome(m.step.line, m.step.label, False, note, d_T, m.profile.duration, d_e, a, d_lab, b, True, (), 0, 0.0, 0.0)
+                MoveOutcome(
+                    m.step.line,
+                    m.step.label,
+                    False,
+                    note,
+                    d_T,
+                    m.profile.duration,
+                    d_e,
+                    a,
+                    d_lab,
+                    b,
+                    True,
+                    (),
+                    0,
+                    0.0,
+                    0.0,
+                )
             )
-    waits = tuple(
-        (spec.steps[i].line, sec, 0.0 if settings.use_waits else sec) for i, _, sec in plan.waits
-    )
+    waits = tuple((spec.steps[i].line, sec, 0.0 if settings.use_waits else sec) for i, _, sec in plan.waits)
     result = CycleResult(
         moves=tuple(outcomes),
         default_cycle_s=plan.cycle_time,
@@ -581,7 +635,9 @@ def via_deviation(step: Step, solved: Solved, every: int) -> tuple[int, float, f
     return len(idx) - 1, dev_q, float(1000 * np.linalg.norm(pa - pb, axis=1).max())
 
 
-def pareto(opt: CycleOptimizer, *, points: int = 10, span: float = 0.3, use_waits: bool = False) -> list[ParetoPoint]:
+def pareto(
+    opt: CycleOptimizer, *, points: int = 10, span: float = 0.3, use_waits: bool = False
+) -> list[ParetoPoint]:
     """Energy against cycle time from the shortest feasible cycle to ``(1 + span)`` times it.
 
     One table of solved, verified moves covers the whole range; each point is the

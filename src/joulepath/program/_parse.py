@@ -107,7 +107,18 @@ def _opens_block_line(text: str) -> bool:
     up = text.rstrip().upper()
     if head in ("MODULE", "ENDMODULE", "PROC", "ENDPROC", "FUNC", "ENDFUNC", "TRAP", "ENDTRAP"):
         return True
-    if head in ("ENDIF", "ENDFOR", "ENDWHILE", "ENDTEST", "ELSE", "DEFAULT:", "DEFAULT", "BACKWARD", "ERROR", "UNDO"):
+    if head in (
+        "ENDIF",
+        "ENDFOR",
+        "ENDWHILE",
+        "ENDTEST",
+        "ELSE",
+        "DEFAULT:",
+        "DEFAULT",
+        "BACKWARD",
+        "ERROR",
+        "UNDO",
+    ):
         return True
     if head in ("IF", "ELSEIF") and up.endswith("THEN"):
         return True
@@ -139,7 +150,7 @@ def split_units(path: str, text: str) -> list[Unit]:
                 else:
                     in_string = False
             elif ch == "\n":
-                raise RapidError(f"{path}:{line}: a string is not closed on its line; add the closing \"")
+                raise RapidError(f'{path}:{line}: a string is not closed on its line; add the closing "')
             i += 1
             continue
         if ch == "!":
@@ -244,7 +255,7 @@ def _aggregate(path: str, line: int, text: str) -> object:
 def _nums(path: str, line: int, item: object, size: int, what: str) -> tuple[float, ...]:
     if not isinstance(item, list) or len(item) != size or not all(isinstance(v, float) for v in item):
         raise RapidError(f"{path}:{line}: {what} needs [{size} numbers]")
-    return tuple(float(v) for v in item)  # type: ignore[arg-type]
+    return tuple(float(v) for v in item)
 
 
 def _value(path: str, line: int, type_: str, text: str) -> Value:
@@ -262,7 +273,8 @@ def _value(path: str, line: int, type_: str, text: str) -> Value:
     if type_ == "robtarget":
         if len(agg) != 4:
             raise RapidError(
-                f"{path}:{line}: robtarget needs [[x,y,z], [q1,q2,q3,q4], [cf1,cf4,cf6,cfx], [6 external axes]]"
+                f"{path}:{line}: robtarget needs [[x,y,z], [q1,q2,q3,q4], [cf1,cf4,cf6,cfx], "
+                "[6 external axes]]"
             )
         pos = _nums(path, line, agg[0], 3, "trans")
         quat = _nums(path, line, agg[1], 4, "rot")
@@ -276,7 +288,9 @@ def _value(path: str, line: int, type_: str, text: str) -> Value:
             )
         ext = _nums(path, line, agg[3], 6, "extax")
         c = tuple(int(round(v)) for v in conf)
-        return RobTarget(pos, quat, (c[0], c[1], c[2], c[3]), ext)
+        return RobTarget(
+            (pos[0], pos[1], pos[2]), (quat[0], quat[1], quat[2], quat[3]), (c[0], c[1], c[2], c[3]), ext
+        )
     if type_ == "speeddata":
         v = _nums(path, line, agg, 4, "speeddata")
         if v[0] <= 0 or v[1] <= 0:
@@ -293,19 +307,36 @@ def _value(path: str, line: int, type_: str, text: str) -> Value:
             raise RapidError(f"{path}:{line}: zonedata pzone_tcp must be ≥ 0, got {rest[0]:g}")
         return ZoneData(bool(agg[0]), rest[0])
     # tooldata
-    if len(agg) != 3 or not isinstance(agg[0], bool) or not isinstance(agg[1], list) or not isinstance(agg[2], list):
-        raise RapidError(f"{path}:{line}: tooldata needs [robhold, [[x,y,z],[q1..q4]], [mass, [cog], [aom], ix, iy, iz]]")
+    if (
+        len(agg) != 3
+        or not isinstance(agg[0], bool)
+        or not isinstance(agg[1], list)
+        or not isinstance(agg[2], list)
+    ):
+        raise RapidError(
+            f"{path}:{line}: tooldata needs [robhold, [[x,y,z],[q1..q4]], [mass, [cog], [aom], ix, iy, iz]]"
+        )
     frame, load = agg[1], agg[2]
     if len(frame) != 2 or len(load) != 6:
-        raise RapidError(f"{path}:{line}: tooldata needs [robhold, [[x,y,z],[q1..q4]], [mass, [cog], [aom], ix, iy, iz]]")
+        raise RapidError(
+            f"{path}:{line}: tooldata needs [robhold, [[x,y,z],[q1..q4]], [mass, [cog], [aom], ix, iy, iz]]"
+        )
     tcp = _nums(path, line, frame[0], 3, "tframe.trans")
     rot = _nums(path, line, frame[1], 4, "tframe.rot")
     if not isinstance(load[0], float) or load[0] < 0:
         raise RapidError(f"{path}:{line}: tooldata load mass must be a number ≥ 0")
     cog = _nums(path, line, load[1], 3, "tload.cog")
     if not agg[0]:
-        raise RapidError(f"{path}:{line}: a stationary tool (robhold FALSE) is not supported; use a tool the robot holds")
-    return ToolData(True, (tcp[0], tcp[1], tcp[2]), (rot[0], rot[1], rot[2], rot[3]), float(load[0]), (cog[0], cog[1], cog[2]))
+        raise RapidError(
+            f"{path}:{line}: a stationary tool (robhold FALSE) is not supported; use a tool the robot holds"
+        )
+    return ToolData(
+        True,
+        (tcp[0], tcp[1], tcp[2]),
+        (rot[0], rot[1], rot[2], rot[3]),
+        float(load[0]),
+        (cog[0], cog[1], cog[2]),
+    )
 
 
 _DECL = re.compile(
@@ -325,7 +356,9 @@ def _declaration(path: str, unit: Unit) -> Declaration | None:
     if dims:
         if type_l == "num":
             return None
-        raise RapidError(f"{path}:{unit.line}: arrays of {type_l} are not supported; declare each {type_l} by name")
+        raise RapidError(
+            f"{path}:{unit.line}: arrays of {type_l} are not supported; declare each {type_l} by name"
+        )
     if value is None:
         if type_l == "num":
             return None
@@ -341,7 +374,9 @@ def _declaration(path: str, unit: Unit) -> Declaration | None:
 
 # ---------------------------------------------------------------- instructions
 def _split_args(path: str, line: int, text: str) -> list[str]:
-    out, depth, cur = [], 0, []
+    out: list[str] = []
+    cur: list[str] = []
+    depth = 0
     for ch in text:
         if ch in "[(":
             depth += 1
@@ -385,9 +420,7 @@ def _number(path: str, line: int, text: str, nums: dict[str, float], what: str) 
         return float(text)
     if _IDENT.match(text) and text.lower() in nums:
         return nums[text.lower()]
-    raise RapidError(
-        f"{path}:{line}: {what} must be a number or a num constant of the module, got {text!r}"
-    )
+    raise RapidError(f"{path}:{line}: {what} must be a number or a num constant of the module, got {text!r}")
 
 
 def _move(path: str, unit: Unit, nums: dict[str, float]) -> Move:
@@ -419,7 +452,9 @@ def _move(path: str, unit: Unit, nums: dict[str, float]) -> Move:
     (target, _), (speed, sp), (zone, zs), (tool, ts) = parsed
     wobj = ts.get("WObj")
     if "WObj" in ts and (wobj is None or wobj.strip().lower() != "wobj0"):
-        raise RapidError(f"{path}:{unit.line}: work object {wobj!r} is not supported; only wobj0 (the base frame)")
+        raise RapidError(
+            f"{path}:{unit.line}: work object {wobj!r} is not supported; only wobj0 (the base frame)"
+        )
     for key, sws in (("V", sp), ("T", sp), ("Z", zs)):
         if key in sws and sws[key] is None:
             raise RapidError(f"{path}:{unit.line}: \\{key} needs a value (\\{key}:=...)")
@@ -477,7 +512,9 @@ class _Reader:
             if u.head.upper() == close:
                 return body, self.take()
             if u.head.upper() in ("ENDPROC", "ENDMODULE", "ENDFUNC", "ENDTRAP") and close != u.head.upper():
-                raise self.fail(u.line, f"{u.head} before {close} (opened at line {opener.line}); add {close}")
+                raise self.fail(
+                    u.line, f"{u.head} before {close} (opened at line {opener.line}); add {close}"
+                )
             body.append(self.statement(inside))
 
     def skip_block(self, opener: Unit, close: str) -> Unit:
@@ -585,7 +622,8 @@ def parse_module(text: str, *, path: str = "<program>") -> Module:
     nums: dict[str, float] = {}
     procedures: list[Procedure] = []
     reader = _Reader(path, units[1:-1], procs, nums)
-    while (u := reader.peek()) is not None:
+    while (cur := reader.peek()) is not None:
+        u = cur
         head = u.head.upper()
         if head in ("CONST", "PERS", "VAR"):
             reader.take()
@@ -647,7 +685,9 @@ def _check_calls(module: Module) -> None:
         for s in _statements(proc.body):
             if isinstance(s, Call):
                 if s.name.lower() in stack:
-                    raise module.error(s.line, f"{s.name} calls itself (through {' -> '.join(stack)}); not supported")
+                    raise module.error(
+                        s.line, f"{s.name} calls itself (through {' -> '.join(stack)}); not supported"
+                    )
                 callee = module.procedure(s.name)
                 assert callee is not None
                 visit(callee, (*stack, callee.name.lower()))

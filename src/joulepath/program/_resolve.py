@@ -147,7 +147,9 @@ def resolve_module(module: Module, robot: Robot) -> CycleSpec:
     moves = [st for st in steps if st.kind == "move"]
     if not moves:
         where = "main's WHILE TRUE loop" if loop is not None else "main"
-        raise module.error(loop.line if loop is not None else main.line, f"{where} holds no move; nothing to optimize")
+        raise module.error(
+            loop.line if loop is not None else main.line, f"{where} holds no move; nothing to optimize"
+        )
     assert moves[-1].q is not None
     return CycleSpec(tuple(steps), moves[-1].q.copy(), module.path, module, tuple(fixed))
 
@@ -173,7 +175,11 @@ def _move_step(
     tcp = tool_transform(tool)
     key = s.tool.lower()
     if key not in robots:
-        robots[key] = robot.with_payload(tool.mass_kg, com=np.asarray(tool.cog_mm) / 1000.0) if tool.mass_kg > 0 else robot
+        robots[key] = (
+            robot.with_payload(tool.mass_kg, com=np.asarray(tool.cog_mm) / 1000.0)
+            if tool.mass_kg > 0
+            else robot
+        )
     if s.instruction == "MoveAbsJ":
         jt = _lookup(module, s.target, "jointtarget", s.line)
         assert isinstance(jt, JointTarget)
@@ -207,7 +213,7 @@ def _move_step(
 
 
 def robtarget_joints(module: Module, robot: Robot, rt: RobTarget, tcp: FloatArray, s: Move) -> FloatArray:
-    """Joint values of a robtarget with its confdata; ``RapidError`` when unreachable or the conf fits no solution."""
+    """Joint values of a robtarget with its confdata; ``RapidError`` if unreachable or no solution fits."""
     try:
         check_layout(robot.chain)
     except InvalidInput as err:
@@ -228,7 +234,11 @@ def robtarget_joints(module: Module, robot: Robot, rt: RobTarget, tcp: FloatArra
 
     qs, valid = ik_branches(robot.chain, flange)
     confs = sorted(
-        {tuple(int(v) for v in confdata(robot.chain, c)) for c, ok in zip(qs, valid, strict=True) if ok and np.all(c >= lo - 1e-9) and np.all(c <= hi + 1e-9)}
+        {
+            tuple(int(v) for v in confdata(robot.chain, c))
+            for c, ok in zip(qs, valid, strict=True)
+            if ok and np.all(c >= lo - 1e-9) and np.all(c <= hi + 1e-9)
+        }
     )
     raise module.error(
         s.line,
@@ -278,7 +288,9 @@ def read_cycle_toml(path: str | Path, robot: Robot) -> CycleSpec:
             steps.append(Step("wait", k, f"wait {w:g}", None, seconds=float(w)))
             continue
         if set(st) != {"joints_deg", "duration_s"}:
-            raise InvalidInput(f"{where}: a step is either wait_s or joints_deg + duration_s, got {sorted(st)}")
+            raise InvalidInput(
+                f"{where}: a step is either wait_s or joints_deg + duration_s, got {sorted(st)}"
+            )
         q = _joints(st["joints_deg"], n, where)
         T = st["duration_s"]
         if not isinstance(T, int | float) or not 0 < T <= 60:
@@ -316,7 +328,8 @@ def _joints(value: object, n: int, where: str) -> FloatArray:
         or not all(isinstance(v, int | float) and np.isfinite(v) for v in value)
     ):
         raise InvalidInput(f"{where}: needs a list of {n} joint values in degrees")
-    return np.radians(np.asarray(value, dtype=float))
+    out: FloatArray = np.radians(np.asarray(value, dtype=float))
+    return out
 
 
 __all__ = ["CycleSpec", "RapidError", "Step", "read_cycle_toml", "resolve_module"]

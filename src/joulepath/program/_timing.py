@@ -52,7 +52,11 @@ class SegmentPath:
         s = np.asarray(s, dtype=float)
         if self.spline is None:
             dq = self.q1 - self.q0
-            return self.q0 + s[:, None] * dq, np.broadcast_to(dq, (s.size, dq.size)), np.zeros((s.size, dq.size))
+            return (
+                self.q0 + s[:, None] * dq,
+                np.broadcast_to(dq, (s.size, dq.size)),
+                np.zeros((s.size, dq.size)),
+            )
         return self.spline(s), self.spline(s, 1), self.spline(s, 2)
 
 
@@ -71,7 +75,8 @@ def _angle_deg(r0: FloatArray, r1: FloatArray) -> float:
 def _slerp(r0: FloatArray, r1: FloatArray, s: FloatArray) -> FloatArray:
     from scipy.spatial.transform import Rotation, Slerp
 
-    return Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([r0, r1])))(s).as_matrix()
+    out: FloatArray = Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([r0, r1])))(s).as_matrix()
+    return out
 
 
 def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from joulepath.errors import InvalidInput
-from joulepath.program._model import Module, Move
+from joulepath.program._model import Module, Move, Statement
 
 
 def _num(value: float) -> str:
@@ -64,10 +64,10 @@ def write_module(
     return "\n".join(out) + "\n"
 
 
-def _all_statements(module: Module) -> list[Move | object]:
+def _all_statements(module: Module) -> list[Statement]:
     from joulepath.program._parse import _statements
 
-    out: list[Move | object] = []
+    out: list[Statement] = []
     for p in module.procedures:
         out.extend(_statements(p.body))
     return out

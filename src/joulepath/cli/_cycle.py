@@ -1,0 +1,92 @@
+"""``joulepath cycle``: optimize a robot program's whole cycle."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from joulepath.cli._common import check_out_folder, console
+from joulepath.cli._robot import load_robot_for_cli, unchecked_option
+
+
+def _cycle_time(text: str) -> float | None:
+    if text.strip().lower() == "same":
+        return None
+    try:
+        value = float(text)
+    except ValueError as err:
+        raise typer.BadParameter(
+            f"{text!r} is neither 'same' nor a number of seconds", param_hint="--cycle-time"
+        ) from err
+    if not (value > 0 and value < 3600):
+        raise typer.BadParameter(f"{text!r}: give a positive number of seconds", param_hint="--cycle-time")
+    return value
+
+
+def cycle(
+    program: Path = typer.Argument(..., help="RAPID module (.mod) or plain cycle file (.toml)."),
+    robot: str = typer.Option("irb120", help="Robot name or .irml/.urdf path."),
+    out: Path = typer.Option(..., "--out", help="Run folder."),
+    cycle_time: str = typer.Option("same", "--cycle-time", help="'same' (the default program's) or seconds."),
+    use_waits: bool = typer.Option(
+        False, "--use-waits", help="Spend WaitTime slack on the moves (waits set to 0)."
+    ),
+    pareto: bool = typer.Option(False, "--pareto", help="Also energy against cycle time (CSV + plot)."),
+    points: int = typer.Option(10, "--points", min=3, max=30, help="Points of --pareto."),
+    seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
+    unchecked: bool = unchecked_option(),
+) -> int:
+    """Optimize a program's cycle for energy at the same (or a given) cycle time; verify; write RAPID.
+
+    Exit code 0: written within every limit; 1: a result breaks a limit, no program
+    written; 2: bad input (unreadable program, unreachable target, infeasible cycle time).
+    """
+    from joulepath.program import (
+        CYCLE_FILES,
+        CycleSettings,
+        optimize_cycle,
+        read_cycle_toml,
+        read_module,
+        resolve_module,
+        write_cycle_run,
+    )
+    from joulepath.program import pareto as run_pareto
+
+    target = _cycle_time(cycle_time)
+    check_out_folder(out, files=CYCLE_FILES, inputs=[program])
+    if not program.is_file():
+        raise typer.BadParameter(f"{program}: no such file", param_hint="PROGRAM")
+    r = load_robot_for_cli(robot, unchecked=unchecked)
+    rapid = program.suffix.lower() != ".toml"
+    spec = resolve_module(read_module(program), r) if rapid else read_cycle_toml(program, r)
+    settings = CycleSettings(cycle_time=target, use_waits=use_waits, seed=seed)
+    with console.status("optimizing the cycle...") as status:
+        result, opt = optimize_cycle(spec, settings, progress=lambda msg: status.update(msg))
+        front = None
+        if pareto:
+            status.update("energy against cycle time...")
+            front = run_pareto(opt, points=points, use_waits=use_waits)
+    files = write_cycle_run(out, result, via_every=settings.via_every, pareto=front, write_rapid=rapid)
+    b = result.breakdown
+    console.print(
+        f"cycle {result.default_cycle_s:.3f} s -> {result.optimized_cycle_s:.3f} s; energy on physics "
+        f"{result.default_energy_J:.2f} -> {result.optimized_energy_J:.2f} J "
+        f"({result.saved_pct:.1f} % saved), "
+        f"on the lab robot {result.saved_lab_pct:.1f} % saved"
+    )
+    waits = "" if b.by_waits_pct is None else f", waits {b.by_waits_pct:.1f} %"
+    console.print(
+        f"breakdown: shape {b.by_shape_pct:.1f} %, time allocation {b.by_allocation_pct:.1f} %{waits}"
+    )
+    if result.fixed_lines:
+        console.print(
+            f"kept verbatim, run time treated as fixed: line(s) {', '.join(map(str, result.fixed_lines))}"
+        )
+    console.print(f"wrote {', '.join(sorted(files))} in {out}")
+    if rapid and "optimized.mod" not in files:
+        console.print(
+            "REFUSED: the optimized cycle breaks a limit; optimized.mod was NOT written (see cycle.json)"
+        )
+        return 1
+    return 0

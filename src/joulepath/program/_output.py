@@ -1,0 +1,218 @@
+"""What ``joulepath cycle`` writes: the optimized module, cycle.json, the trade-off (CSV + plot)."""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from joulepath import __version__
+from joulepath._io import atomic_write_text
+from joulepath.abb import EXTERNAL_AXES_UNUSED
+from joulepath.errors import LimitViolation
+from joulepath.program._cycle import CycleResult, ParetoPoint, Solved, via_points
+from joulepath.program._model import Move, WaitTime
+from joulepath.program._write import _num, format_move, write_module
+
+CYCLE_FILES = ("cycle.json", "optimized.mod", "pareto.csv", "pareto.png", "optimized_cycle.csv")
+"""Files ``joulepath cycle`` may write in its run folder (``optimized.mod`` only within every limit)."""
+
+ASSUMPTIONS = (
+    "energy: sum over joints and 2.5 ms samples of |tau * qd| * dt, physics = nominal rigid body with the "
+    "tool's load and NOMINAL_FRICTION; lab = the emulated lab robot's drive torque on the same motion",
+    "default: the emulated controller (jerk-limited profile, speeddata, joint limits, accel = vmax/0.25 s, "
+    "zones blended by superposition, 48 ms dwell at stop points; a move before WaitTime stops)",
+    "optimized MoveJ/MoveAbsJ: rest to rest (the single-move gradient optimizer), written as MoveAbsJ via "
+    "points with \\T and z1 zones; the last via point keeps the original move's stop (fine) or ends in z1",
+    "MoveL: kept unchanged (straight line, controller timing); moves that occur more than once: kept",
+    "instructions kept verbatim (I/O, assignments, ...): their run time is not modelled (treated as fixed)",
+)
+
+
+def _jt(q_deg: np.ndarray) -> str:
+    ext = ", ".join([EXTERNAL_AXES_UNUSED] * 6)
+    return "[[" + ", ".join(_num(float(v)) for v in q_deg) + f"], [{ext}]]"
+
+
+def optimized_module(result: CycleResult, *, via_every: int) -> str:
+    """The module with each optimized move replaced by its via points; refused outside a limit."""
+    spec = result.spec
+    module = spec.module
+    assert module is not None
+    if not result.limits_ok:
+        bad = "; ".join(e for m in result.moves for e in m.limit_excess)
+        raise LimitViolation(f"the optimized cycle breaks a limit ({bad}); the program is not written")
+    replace: dict[int, list[str]] = {}
+    decls: list[str] = []
+    for i, solved in result.paths.items():
+        step = spec.steps[i]
+        move = step.statement
+        assert isinstance(move, Move) and step.robot is not None
+        lines, names = _via_lines(move, solved, via_every, step.zone_mm is None, step.robot)
+        replace[move.line] = lines
+        decls.extend(names)
+    for wline, before, after in result.waits:
+        if after != before:
+            replace[wline] = [
+                f"! joulepath: WaitTime {_num(before)} s spent on the moves (--use-waits)",
+                f"WaitTime {_num(after)};",
+            ]
+    for i, step in enumerate(spec.steps):  # kept moves keep their zone; nothing to change
+        del i, step
+    header = [
+        f"! Optimized by joulepath {__version__} for energy at cycle time {result.optimized_cycle_s:.3f} s "
+        f"(default {result.default_cycle_s:.3f} s): physics {result.default_energy_J:.2f} -> "
+        f"{result.optimized_energy_J:.2f} J ({result.saved_pct:.1f} % saved). See cycle.json.",
+    ]
+    # every replaced statement must be a move or WaitTime of the module (never a verbatim one)
+    for line in replace:
+        stmt = next(
+            (s.statement for s in spec.steps if s.statement is not None and s.statement.line == line), None
+        )
+        assert isinstance(stmt, Move | WaitTime)
+    return write_module(module, replace=replace, declarations=decls, header=header)
+
+
+def _via_lines(move: Move, solved: Solved, every: int, fine: bool, robot: Any) -> tuple[list[str], list[str]]:
+    samples = solved.samples
+    idx = via_points(samples, every)
+    lo, hi = robot.joint_ranges()
+    q = samples.q[idx]
+    if np.any(q < lo - 1e-9) or np.any(q > hi + 1e-9):
+        raise LimitViolation(
+            f"line {move.line}: a via point leaves a joint range; the program is not written"
+        )
+    times = np.diff([0.0, *samples.t[idx]])
+    prev = np.vstack([samples.q[0], q[:-1]])
+    speed = np.abs(q - prev) / times[:, None]
+    if np.any(speed > robot.velocity_limit * (1 + 1e-9)):
+        raise LimitViolation(f"line {move.line}: a via segment exceeds a joint speed limit; not written")
+    names = []
+    lines = [f"! joulepath: {format_move(move)} reshaped: {len(idx)} via points in {solved.duration:.3f} s"]
+    for k, (qk, tk) in enumerate(zip(q, times, strict=True), start=1):
+        name = f"jpL{move.line}_{k}"
+        names.append(f"CONST jointtarget {name} := {_jt(np.degrees(qk))};")
+        zone = "fine" if (k == len(idx) and fine) else "z1"
+        lines.append(f"MoveAbsJ {name}, v7000 \\T:={_num(float(tk))}, {zone}, {move.tool};")
+    return lines, names
+
+
+def cycle_json(
+    result: CycleResult, pareto: list[ParetoPoint] | None, rapid: str | None, refused: str | None
+) -> dict[str, Any]:
+    b = result.breakdown
+    return {
+        "source": result.spec.source,
+        "default_cycle_s": result.default_cycle_s,
+        "target_cycle_s": result.target_cycle_s,
+        "optimized_cycle_s": result.optimized_cycle_s,
+        "shortest_cycle_s": result.shortest_cycle_s,
+        "energy_default_J": result.default_energy_J,
+        "energy_optimized_J": result.optimized_energy_J,
+        "saved_pct": result.saved_pct,
+        "energy_default_lab_J": result.default_lab_J,
+        "energy_optimized_lab_J": result.optimized_lab_J,
+        "saved_lab_pct": result.saved_lab_pct,
+        "breakdown": {
+            "default_J": b.default_J,
+            "shapes_at_default_proportions_J": b.shape_J,
+            "reallocated_durations_J": b.allocation_J,
+            "waits_spent_J": b.waits_J,
+            "saved_by_shape_pct": b.by_shape_pct,
+            "saved_by_time_allocation_pct": b.by_allocation_pct,
+            "saved_by_waits_pct": b.by_waits_pct,
+        },
+        "limits_ok": result.limits_ok,
+        "moves": [asdict(m) for m in result.moves],
+        "waits": [{"line": w[0], "default_s": w[1], "optimized_s": w[2]} for w in result.waits],
+        "kept_verbatim_lines": list(result.fixed_lines),
+        "kept_verbatim_note": "run time not modelled (treated as fixed); not part of the cycle times above",
+        "assumptions": list(ASSUMPTIONS),
+        "solves": result.n_solves,
+        "wall_s": result.wall_s,
+        "pareto": None if pareto is None else [asdict(p) for p in pareto],
+        "rapid": rapid,
+        "rapid_refused": refused,
+    }
+
+
+def optimized_cycle_csv(result: CycleResult) -> str:
+    """The optimized moves' sampled paths (25 ms), one block per move."""
+    rows = ["line,t,q1,q2,q3,q4,q5,q6".replace(",q6", "".join(f",q{j}" for j in range(6, 7)))]
+    for i, s in result.paths.items():
+        line = result.spec.steps[i].line
+        for t, q in zip(s.samples.t, s.samples.q, strict=True):
+            rows.append(f"{line},{t:.4f}," + ",".join(f"{v:.8f}" for v in q))
+    return "\n".join(rows) + "\n"
+
+
+def pareto_csv(points: list[ParetoPoint], default: tuple[float, float, float]) -> str:
+    rows = ["cycle_time_s,energy_J,energy_lab_J,kind"]
+    rows += [f"{p.cycle_time_s:.4f},{p.energy_J:.6f},{p.energy_lab_J:.6f},optimized" for p in points]
+    rows.append(f"{default[0]:.4f},{default[1]:.6f},{default[2]:.6f},default program")
+    return "\n".join(rows) + "\n"
+
+
+def pareto_plot(points: list[ParetoPoint], default: tuple[float, float, float], path: Path) -> Path:
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6, 4))
+    ax = fig.subplots()
+    ax.plot([p.cycle_time_s for p in points], [p.energy_J for p in points], "o-", label="optimized (physics)")
+    ax.plot(
+        [p.cycle_time_s for p in points], [p.energy_lab_J for p in points], "s--", label="optimized (lab)"
+    )
+    ax.plot([default[0]], [default[1]], "k*", ms=12, label="default program (physics)")
+    ax.set_xlabel("cycle time [s]")
+    ax.set_ylabel("energy per cycle [J]")
+    ax.legend()
+    fig.tight_layout()
+    tmp = path.with_name(f".{path.name}.tmp.png")
+    fig.savefig(tmp, dpi=100)
+    os.replace(tmp, path)
+    return path
+
+
+def write_cycle_run(
+    out: Path, result: CycleResult, *, via_every: int, pareto: list[ParetoPoint] | None, write_rapid: bool
+) -> dict[str, Path]:
+    """Write the run folder; the module only when every limit holds (else cycle.json says why)."""
+    files: dict[str, Path] = {}
+    text = refused = None
+    if write_rapid:
+        try:
+            text = optimized_module(result, via_every=via_every)
+        except LimitViolation as err:
+            refused = str(err)
+    out.mkdir(parents=True, exist_ok=True)
+    stale = out / "optimized.mod"
+    if text is not None:
+        files["optimized.mod"] = atomic_write_text(stale, text)
+    elif stale.is_file() and not stale.is_symlink():
+        stale.unlink()
+    files["optimized_cycle.csv"] = atomic_write_text(out / "optimized_cycle.csv", optimized_cycle_csv(result))
+    if pareto is not None:
+        default = (result.default_cycle_s, result.default_energy_J, result.default_lab_J)
+        files["pareto.csv"] = atomic_write_text(out / "pareto.csv", pareto_csv(pareto, default))
+        files["pareto.png"] = pareto_plot(pareto, default, out / "pareto.png")
+    data = cycle_json(result, pareto, "optimized.mod" if text is not None else None, refused)
+    files["cycle.json"] = atomic_write_text(
+        out / "cycle.json", json.dumps(_finite(data), indent=2, allow_nan=False)
+    )
+    return files
+
+
+def _finite(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    if isinstance(value, float | np.floating):
+        return float(value) if np.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value

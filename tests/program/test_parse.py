@@ -1,0 +1,133 @@
+"""The RAPID reader: the example, round trips, and a corpus of malformed programs (exit 2, line number)."""
+
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from joulepath.cli._main import main
+from joulepath.program import format_move, parse_module, read_module, write_module
+from joulepath.program._model import Call, Move, WaitTime, WhileTrue
+
+EXAMPLE = Path(__file__).parents[2] / "examples" / "pick_and_place.mod"
+
+
+def test_example_structure():
+    m = read_module(EXAMPLE)
+    main_proc = m.procedure("main")
+    loop = next(s for s in main_proc.body if isinstance(s, WhileTrue))
+    kinds = [type(s).__name__ for s in loop.body]
+    assert kinds == ["Move", "Move", "WaitTime", "Move", "Move", "Call", "Move", "Verbatim"]
+    first = loop.body[0]
+    assert isinstance(first, Move) and (first.instruction, first.target, first.zone) == ("MoveJ", "pAbovePick", "z50")
+    assert isinstance(loop.body[2], WaitTime) and loop.body[2].seconds == pytest.approx(0.3)
+    assert isinstance(loop.body[5], Call) and loop.body[5].name == "Place"
+
+
+def test_round_trip_is_exact():
+    text = EXAMPLE.read_text()
+    m = parse_module(text, path="x.mod")
+    written = write_module(m)
+    assert written == text
+    assert parse_module(written, path="x.mod") == m
+
+
+def test_canonical_move_round_trips():
+    m = read_module(EXAMPLE)
+    moves = [s for p in m.procedures for s in p.body if isinstance(s, Move)]
+    moves.append(replace(moves[0], time_s=1.25, zone="z10", z_tcp=3.0))
+    moves.append(replace(moves[0], v_tcp=450.0))
+    for mv in moves:
+        text = f"MODULE T\n    PROC main()\n        {format_move(mv)}\n    ENDPROC\nENDMODULE\n"
+        again = parse_module(text, path="t.mod").procedure("main").body[0]
+        assert replace(again, line=mv.line, end_line=mv.end_line) == mv
+
+
+def test_replacing_a_statement_keeps_the_rest():
+    text = EXAMPLE.read_text()
+    m = parse_module(text, path="x.mod")
+    out = write_module(m, replace={19: ["MoveJ pVia, v500, fine, tGripper;"]}, declarations=["VAR num k := 1;"])
+    again = parse_module(out, path="x.mod")
+    old = {(s.line, type(s)) for p in m.procedures for s in p.body}
+    assert len(out.splitlines()) == len(text.splitlines()) + 1
+    assert again.procedure("Place").body == tuple(
+        replace(s, line=s.line + 1, end_line=s.end_line + 1) for s in m.procedure("Place").body
+    )
+    assert old
+
+
+HEAD = """MODULE Bad
+    CONST jointtarget jA := [[0, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pA := [[375, 0, 540], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+"""
+TAIL = "ENDMODULE\n"
+
+
+def _prog(*body: str, decl: str = "") -> str:
+    lines = [f"        {b}" for b in body]
+    return HEAD + decl + "    PROC main()\n" + "\n".join(lines) + "\n    ENDPROC\n" + TAIL
+
+
+# (name, program text, line of the error)
+CORPUS = [
+    ("unknown target", _prog("MoveJ pB, v100, fine, tool0;"), 5),
+    ("missing semicolon", _prog("MoveJ pA, v100, fine, tool0", "WaitTime 1;"), 5),
+    ("conc argument", _prog("MoveJ \\Conc, pA, v100, fine, tool0;"), 5),
+    ("inpos argument", _prog("MoveJ pA, v100, fine \\Inpos:=inpos50, tool0;"), 5),
+    (
+        "unreachable pose",
+        _prog("MoveJ pFar, v100, fine, tool0;", decl="    CONST robtarget pFar := [[1500, 0, 500], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n"),
+        6,
+    ),
+    (
+        "wrong confdata",
+        _prog("MoveJ pConf, v100, fine, tool0;", decl="    CONST robtarget pConf := [[375, 0, 540], [0, 0, 1, 0], [0, 0, 0, 5], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n"),
+        6,
+    ),
+    ("MoveC", _prog("MoveC pA, pA, v100, fine, tool0;"), 5),
+    ("VelSet", _prog("VelSet 50, 800;", "MoveJ pA, v100, fine, tool0;"), 5),
+    ("no ENDMODULE", (HEAD + "    PROC main()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n"), 6),
+    ("no main", HEAD + "    PROC other()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n" + TAIL, 1),
+    (
+        "quaternion norm",
+        _prog("MoveJ pQ, v100, fine, tool0;", decl="    CONST robtarget pQ := [[375, 0, 540], [0, 0, 2, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n"),
+        4,
+    ),
+    (
+        "joint out of range",
+        _prog("MoveAbsJ jB, v100, fine, tool0;", decl="    CONST jointtarget jB := [[0, 0, 0, 0, 150, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n"),
+        6,
+    ),
+    ("unknown speeddata", _prog("MoveAbsJ jA, v123, fine, tool0;"), 5),
+    ("move inside IF", _prog("IF nParts > 3 THEN", "    MoveJ pA, v100, fine, tool0;", "ENDIF"), 6),
+    ("other work object", _prog("MoveJ pA, v100, fine, tool0 \\WObj:=wobjTable;"), 5),
+    ("WaitTime InPos", _prog("MoveJ pA, v100, fine, tool0;", "WaitTime \\InPos, 0.5;"), 6),
+    ("declared twice", HEAD + "    CONST robtarget pA := [[375, 0, 540], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n" + "    PROC main()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n" + TAIL, 4),
+    ("robtarget without value", _prog("MoveJ pA, v100, fine, tool0;", decl="    VAR robtarget pNone;\n"), 4),
+    (
+        "recursion",
+        HEAD + "    PROC main()\n        Loop;\n    ENDPROC\n    PROC Loop()\n        MoveJ pA, v100, fine, tool0;\n        Loop;\n    ENDPROC\n" + TAIL,
+        9,
+    ),
+    ("jointtarget in MoveJ", _prog("MoveJ jA, v100, fine, tool0;"), 5),
+    ("unclosed string", _prog('TPWrite "hello;', "MoveJ pA, v100, fine, tool0;"), 5),
+    ("unbalanced bracket", _prog("MoveJ pA, v100, fine, tool0];"), 5),
+    ("no move in the cycle", _prog("WaitTime 1;"), 4),
+]
+
+
+@pytest.mark.parametrize(("name", "text", "line"), CORPUS, ids=[c[0] for c in CORPUS])
+def test_malformed_program_exit_2_with_line(tmp_path, capsys, name, text, line):
+    prog = tmp_path / "bad.mod"
+    prog.write_text(text)
+    out = tmp_path / "run"
+    rc = main(["cycle", str(prog), "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2, name
+    assert len(err.splitlines()) == 1, err
+    assert f"bad.mod:{line}:" in err, err
+    assert not out.exists()
+
+
+def test_corpus_is_large_enough():
+    assert len(CORPUS) >= 15
