@@ -58,7 +58,8 @@ def test_confdata_hand_checked(robot, q_deg, conf):
 
 
 def test_wrist_behind_axis_1_and_elbow(robot):
-    # lower arm tilted far back, upper arm forward of it: wrist centre behind axis 1, in front of the lower arm
+    # lower arm tilted far back, upper arm forward of it:
+    # wrist centre behind axis 1, in front of the lower arm
     q = np.radians([0, -100, 40, 0, 30, 0])
     assert _wrist_centre(robot, q)[0] < 0
     assert confdata(robot.chain, q)[3] == 4

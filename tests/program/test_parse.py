@@ -19,7 +19,11 @@ def test_example_structure():
     kinds = [type(s).__name__ for s in loop.body]
     assert kinds == ["Move", "Move", "WaitTime", "Move", "Move", "Call", "Move", "Verbatim"]
     first = loop.body[0]
-    assert isinstance(first, Move) and (first.instruction, first.target, first.zone) == ("MoveJ", "pAbovePick", "z50")
+    assert isinstance(first, Move) and (first.instruction, first.target, first.zone) == (
+        "MoveJ",
+        "pAbovePick",
+        "z50",
+    )
     assert isinstance(loop.body[2], WaitTime) and loop.body[2].seconds == pytest.approx(0.3)
     assert isinstance(loop.body[5], Call) and loop.body[5].name == "Place"
 
@@ -46,7 +50,9 @@ def test_canonical_move_round_trips():
 def test_replacing_a_statement_keeps_the_rest():
     text = EXAMPLE.read_text()
     m = parse_module(text, path="x.mod")
-    out = write_module(m, replace={19: ["MoveJ pVia, v500, fine, tGripper;"]}, declarations=["VAR num k := 1;"])
+    out = write_module(
+        m, replace={19: ["MoveJ pVia, v500, fine, tGripper;"]}, declarations=["VAR num k := 1;"]
+    )
     again = parse_module(out, path="x.mod")
     old = {(s.line, type(s)) for p in m.procedures for s in p.body}
     assert len(out.splitlines()) == len(text.splitlines()) + 1
@@ -63,6 +69,13 @@ HEAD = """MODULE Bad
 TAIL = "ENDMODULE\n"
 
 
+EXT = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
+
+
+def _rt(name: str, pos: str, quat: str = "0, 0, 1, 0", conf: str = "0, 0, 0, 0") -> str:
+    return f"    CONST robtarget {name} := [[{pos}], [{quat}], [{conf}], {EXT}];\n"
+
+
 def _prog(*body: str, decl: str = "") -> str:
     lines = [f"        {b}" for b in body]
     return HEAD + decl + "    PROC main()\n" + "\n".join(lines) + "\n    ENDPROC\n" + TAIL
@@ -76,12 +89,18 @@ CORPUS = [
     ("inpos argument", _prog("MoveJ pA, v100, fine \\Inpos:=inpos50, tool0;"), 5),
     (
         "unreachable pose",
-        _prog("MoveJ pFar, v100, fine, tool0;", decl="    CONST robtarget pFar := [[1500, 0, 500], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n"),
+        _prog(
+            "MoveJ pFar, v100, fine, tool0;",
+            decl=_rt("pFar", "1500, 0, 500"),
+        ),
         6,
     ),
     (
         "wrong confdata",
-        _prog("MoveJ pConf, v100, fine, tool0;", decl="    CONST robtarget pConf := [[375, 0, 540], [0, 0, 1, 0], [0, 0, 0, 5], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n"),
+        _prog(
+            "MoveJ pConf, v100, fine, tool0;",
+            decl=_rt("pConf", "375, 0, 540", conf="0, 0, 0, 5"),
+        ),
         6,
     ),
     ("MoveC", _prog("MoveC pA, pA, v100, fine, tool0;"), 5),
@@ -90,23 +109,39 @@ CORPUS = [
     ("no main", HEAD + "    PROC other()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n" + TAIL, 1),
     (
         "quaternion norm",
-        _prog("MoveJ pQ, v100, fine, tool0;", decl="    CONST robtarget pQ := [[375, 0, 540], [0, 0, 2, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n"),
+        _prog(
+            "MoveJ pQ, v100, fine, tool0;",
+            decl=_rt("pQ", "375, 0, 540", quat="0, 0, 2, 0"),
+        ),
         4,
     ),
     (
         "joint out of range",
-        _prog("MoveAbsJ jB, v100, fine, tool0;", decl="    CONST jointtarget jB := [[0, 0, 0, 0, 150, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n"),
+        _prog(
+            "MoveAbsJ jB, v100, fine, tool0;",
+            decl=f"    CONST jointtarget jB := [[0, 0, 0, 0, 150, 0], {EXT}];\n",
+        ),
         6,
     ),
     ("unknown speeddata", _prog("MoveAbsJ jA, v123, fine, tool0;"), 5),
     ("move inside IF", _prog("IF nParts > 3 THEN", "    MoveJ pA, v100, fine, tool0;", "ENDIF"), 6),
     ("other work object", _prog("MoveJ pA, v100, fine, tool0 \\WObj:=wobjTable;"), 5),
     ("WaitTime InPos", _prog("MoveJ pA, v100, fine, tool0;", "WaitTime \\InPos, 0.5;"), 6),
-    ("declared twice", HEAD + "    CONST robtarget pA := [[375, 0, 540], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n" + "    PROC main()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n" + TAIL, 4),
+    (
+        "declared twice",
+        HEAD
+        + _rt("pA", "375, 0, 540")
+        + "    PROC main()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n"
+        + TAIL,
+        4,
+    ),
     ("robtarget without value", _prog("MoveJ pA, v100, fine, tool0;", decl="    VAR robtarget pNone;\n"), 4),
     (
         "recursion",
-        HEAD + "    PROC main()\n        Loop;\n    ENDPROC\n    PROC Loop()\n        MoveJ pA, v100, fine, tool0;\n        Loop;\n    ENDPROC\n" + TAIL,
+        HEAD
+        + "    PROC main()\n        Loop;\n    ENDPROC\n"
+        + "    PROC Loop()\n        MoveJ pA, v100, fine, tool0;\n        Loop;\n    ENDPROC\n"
+        + TAIL,
         9,
     ),
     ("jointtarget in MoveJ", _prog("MoveJ jA, v100, fine, tool0;"), 5),

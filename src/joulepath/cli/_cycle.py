@@ -34,6 +34,12 @@ def cycle(
     ),
     pareto: bool = typer.Option(False, "--pareto", help="Also energy against cycle time (CSV + plot)."),
     points: int = typer.Option(10, "--points", min=3, max=30, help="Points of --pareto."),
+    knot_spacing: float = typer.Option(
+        0.05, "--knot-spacing", min=0.02, max=1.0, help="s between B-spline knots of the optimized moves."
+    ),
+    table_points: int = typer.Option(
+        4, "--table-points", min=2, max=20, help="Durations solved per move before sharing the time."
+    ),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     unchecked: bool = unchecked_option(),
 ) -> int:
@@ -42,6 +48,7 @@ def cycle(
     Exit code 0: written within every limit; 1: a result breaks a limit, no program
     written; 2: bad input (unreadable program, unreachable target, infeasible cycle time).
     """
+    from joulepath.optimize import GradientSettings
     from joulepath.program import (
         CYCLE_FILES,
         CycleSettings,
@@ -60,7 +67,13 @@ def cycle(
     r = load_robot_for_cli(robot, unchecked=unchecked)
     rapid = program.suffix.lower() != ".toml"
     spec = resolve_module(read_module(program), r) if rapid else read_cycle_toml(program, r)
-    settings = CycleSettings(cycle_time=target, use_waits=use_waits, seed=seed)
+    settings = CycleSettings(
+        cycle_time=target,
+        use_waits=use_waits,
+        seed=seed,
+        table_points=table_points,
+        gradient=GradientSettings(knot_spacing=knot_spacing),
+    )
     with console.status("optimizing the cycle...") as status:
         result, opt = optimize_cycle(spec, settings, progress=lambda msg: status.update(msg))
         front = None

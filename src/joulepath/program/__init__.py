@@ -19,8 +19,8 @@ from joulepath.program._timing import plan_cycle
 from joulepath.program._write import format_move, write_module
 
 __all__ = [
-    "CYCLE_FILES",
     "Breakdown",
+    "CYCLE_FILES",
     "CycleOptimizer",
     "CycleResult",
     "CycleSettings",
@@ -32,8 +32,8 @@ __all__ = [
     "format_move",
     "optimize_cycle",
     "optimized_module",
-    "parse_module",
     "pareto",
+    "parse_module",
     "plan_cycle",
     "read_cycle_toml",
     "read_module",

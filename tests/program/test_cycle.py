@@ -1,0 +1,166 @@
+"""The cycle: the controller emulation against independent evaluations, and the optimization's invariants."""
+
+import json
+
+import numpy as np
+import pytest
+
+import joulepath
+from joulepath.cli._main import main
+from joulepath.dynamics import NOMINAL_FRICTION
+from joulepath.energy import path_energy
+from joulepath.optimize import GradientSettings
+from joulepath.program import (
+    CycleSettings,
+    optimize_cycle,
+    pareto,
+    parse_module,
+    plan_cycle,
+    read_cycle_toml,
+    read_module,
+    resolve_module,
+)
+from joulepath.program._cycle import CycleOptimizer
+from joulepath.program._timing import FINE_DT, evaluate_cycle, standalone
+from joulepath.sim import ControllerConfig
+
+SMALL = """MODULE Small
+    CONST jointtarget jA := [[-30, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST jointtarget jB := [[40, 25, -5, 20, 50, 30], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pDown := [[350, 0, 300], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pUp := [[350, 0, 420], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    PROC main()
+        WHILE TRUE DO
+            MoveAbsJ jA, v1000, z20, tool0;
+            MoveJ pUp, v1000, fine, tool0;
+            MoveL pDown, v200, fine, tool0;
+            WaitTime 0.2;
+            MoveL pUp, v200, z10, tool0;
+            MoveAbsJ jB, v800, fine, tool0;
+            SetDO doGrip, 1;
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+FAST = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), max_iter=60, coarse_factor=1)
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return joulepath.load_robot("irb120")
+
+
+@pytest.fixture(scope="module")
+def spec(robot):
+    return resolve_module(parse_module(SMALL, path="small.mod"), robot)
+
+
+def test_fine_moves_superposed_equal_standalone(spec, robot):
+    """With stop points only, the superposed cycle is the standalone moves one after another."""
+    plan = plan_cycle(spec, ControllerConfig())
+    checked = 0
+    for prev, m in zip((None, *plan.moves[:-1]), plan.moves, strict=True):
+        if not m.stops or m.profile.duration == 0 or (prev is not None and not prev.stops):
+            continue
+        checked += 1
+        alone = standalone(m)
+        t = m.t0 + alone.t
+        joint = evaluate_cycle(plan, t)
+        assert np.allclose(joint.q, alone.q, atol=1e-9)
+        assert np.allclose(joint.qd, alone.qd, atol=1e-9)
+    assert checked >= 1
+
+
+def test_movel_keeps_the_tcp_on_the_line(spec, robot):
+    plan = plan_cycle(spec, ControllerConfig())
+    m = next(m for m in plan.moves if m.step.linear)
+    traj = standalone(m)
+    tcp = robot.fk(traj.q).position_m
+    a, b = tcp[0], tcp[-1]
+    u = (b - a) / np.linalg.norm(b - a)
+    off = (tcp - a) - ((tcp - a) @ u)[:, None] * u
+    assert np.linalg.norm(off, axis=1).max() < 1e-4  # 0.1 mm (cubic spline between 64 IK points)
+    speed = np.linalg.norm(np.gradient(tcp, traj.t, axis=0), axis=1)
+    assert speed.max() <= 0.2 * 1.02  # v200
+
+
+def test_zone_shortens_the_cycle(robot):
+    fine = SMALL.replace("z20", "fine").replace("z10", "fine")
+    a = plan_cycle(resolve_module(parse_module(SMALL, path="a.mod"), robot), ControllerConfig())
+    b = plan_cycle(resolve_module(parse_module(fine, path="b.mod"), robot), ControllerConfig())
+    assert a.cycle_time < b.cycle_time
+
+
+def test_optimized_cycle_invariants(spec, robot):
+    settings = CycleSettings(gradient=FAST, table_points=3, use_waits=True)
+    result, opt = optimize_cycle(spec, settings)
+    assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
+    assert result.limits_ok
+    assert {m.label for m in result.moves if m.optimized} == {"MoveAbsJ jA", "MoveJ pUp", "MoveAbsJ jB"}
+    # the reported total is the sum over the moves, on both plants
+    assert result.optimized_energy_J == pytest.approx(sum(m.optimized_energy_J for m in result.moves))
+    assert result.default_energy_J == pytest.approx(sum(m.default_energy_J for m in result.moves))
+    # an optimized move's energy recomputed independently from its path
+    i, s = next(iter(result.paths.items()))
+    r = spec.steps[i].robot
+    tau = r.inverse_dynamics(s.fine.q, s.fine.qd, s.fine.qdd, friction=NOMINAL_FRICTION)
+    assert s.energy_J == pytest.approx(float(path_energy(tau, s.fine.qd, s.fine.dt).total))
+    assert s.fine.dt == pytest.approx(FINE_DT)
+    # more cycle time never costs energy (each point: best combination within a larger budget)
+    front = pareto(opt, points=4)
+    e = [p.energy_J for p in front]
+    assert all(b <= a + 1e-9 for a, b in zip(e, e[1:], strict=False))
+    assert front[0].cycle_time_s == pytest.approx(opt.shortest_cycle + opt.wait_total)
+
+
+def test_cycle_time_too_short_refused(spec):
+    from joulepath.errors import LimitViolation
+
+    opt = CycleOptimizer(spec, CycleSettings(gradient=FAST))
+    with pytest.raises(LimitViolation, match="shorter than the shortest"):
+        optimize_cycle(spec, CycleSettings(gradient=FAST, cycle_time=0.5 * opt.shortest_cycle))
+
+
+def test_cli_writes_a_program_that_reads_back(tmp_path, robot):
+    prog = tmp_path / "small.mod"
+    prog.write_text(SMALL.replace("MoveAbsJ jB, v800", "MoveAbsJ jB, v300"))
+    out = tmp_path / "run"
+    args = ["--use-waits", "--knot-spacing", "0.1", "--table-points", "2", "--pareto", "--points", "3"]
+    assert main(["cycle", str(prog), "--out", str(out), *args]) == 0
+    data = json.loads((out / "cycle.json").read_text())
+    assert data["limits_ok"] and data["optimized_cycle_s"] <= data["target_cycle_s"] + 1e-9
+    assert data["waits"] == [{"line": 11, "default_s": 0.2, "optimized_s": 0.0}]
+    assert data["kept_verbatim_lines"] == [14]
+    assert (out / "pareto.csv").read_text().count("\n") == 3 + 2
+    written = read_module(out / "optimized.mod")
+    again = resolve_module(written, robot)
+    moves = [s for s in again.steps if s.kind == "move"]
+    original = [s for s in resolve_module(parse_module(SMALL, path="s.mod"), robot).steps if s.kind == "move"]
+    # the targets the original program stops at are reached by the optimized program too
+    ends = {tuple(np.round(s.q, 6)) for s in moves}
+    for s in original:
+        assert tuple(np.round(s.q, 6)) in ends
+    # every written joint target within its range
+    lo, hi = robot.joint_ranges()
+    assert all(np.all(s.q >= lo - 1e-9) and np.all(s.q <= hi + 1e-9) for s in moves)
+    # untouched statements are unchanged
+    assert "MoveL pDown, v200, fine, tool0;" in (out / "optimized.mod").read_text()
+    assert "SetDO doGrip, 1;" in (out / "optimized.mod").read_text()
+
+
+def test_plain_cycle_file(tmp_path, robot):
+    f = tmp_path / "cycle.toml"
+    f.write_text(
+        "[[step]]\njoints_deg = [-30, 10, 10, 0, 40, 0]\nduration_s = 1.2\n"
+        "[[step]]\nwait_s = 0.2\n"
+        "[[step]]\njoints_deg = [40, 25, -5, 20, 50, 30]\nduration_s = 1.0\n"
+    )
+    spec = read_cycle_toml(f, robot)
+    plan = plan_cycle(spec, ControllerConfig())
+    assert [round(m.profile.duration, 9) for m in plan.moves] == [1.2, 1.0]
+    result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
+    assert result.limits_ok and result.optimized_cycle_s <= result.target_cycle_s + 1e-9
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[[step]]\njoints_deg = [0, 0, 0]\nduration_s = 1\n")
+    with pytest.raises(joulepath.errors.InvalidInput, match="step 1"):
+        read_cycle_toml(bad, robot)
