@@ -97,6 +97,9 @@ def test_optimized_cycle_invariants(spec, robot):
     assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
     assert result.limits_ok
     assert {m.label for m in result.moves if m.optimized} == {"MoveAbsJ jA", "MoveJ pUp", "MoveAbsJ jB"}
+    # the default corridor holds: tool0 within 100 mm of the joint-interpolated taught move
+    assert result.corridor_mm == 100.0
+    assert all(m.corridor_dev_mm <= 100.0 + 1e-6 for m in result.moves if m.optimized)
     # the reported total is the sum over the moves, on both plants
     assert result.optimized_energy_J == pytest.approx(sum(m.optimized_energy_J for m in result.moves))
     assert result.default_energy_J == pytest.approx(sum(m.default_energy_J for m in result.moves))

@@ -40,6 +40,12 @@ def cycle(
     table_points: int = typer.Option(
         4, "--table-points", min=2, max=20, help="Durations solved per move before sharing the time."
     ),
+    corridor: float = typer.Option(
+        100.0,
+        "--corridor",
+        min=0.0,
+        help="mm: keep tool0 this close to the taught move's path (joint-interpolated); 0: no corridor.",
+    ),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     unchecked: bool = unchecked_option(),
 ) -> int:
@@ -72,6 +78,7 @@ def cycle(
         use_waits=use_waits,
         seed=seed,
         table_points=table_points,
+        corridor_mm=corridor or None,
         gradient=GradientSettings(knot_spacing=knot_spacing),
     )
     with console.status("optimizing the cycle...") as status:

@@ -36,7 +36,7 @@ from joulepath.energy import path_energy
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize import ACCEL_TIME, GradientSettings, acceleration_limit, check_limits
 from joulepath.optimize._gradient import solve_move
-from joulepath.optimize._verify import shortest_feasible_duration
+from joulepath.optimize._verify import shortest_feasible_duration, tcp_deviation_mm
 from joulepath.program._resolve import CycleSpec, Step
 from joulepath.program._timing import (
     FINE_DT,
@@ -47,7 +47,7 @@ from joulepath.program._timing import (
     standalone,
 )
 from joulepath.sim import ControllerConfig, Plant, make_plant
-from joulepath.trajectory import Trajectory
+from joulepath.trajectory import Trajectory, minimum_jerk
 from joulepath.units import SAMPLE_PERIOD
 
 STEP = SAMPLE_PERIOD
@@ -69,6 +69,7 @@ class CycleSettings:
     table_points: int = 4
     via_every: int = 2
     accel_time: float = ACCEL_TIME
+    corridor_mm: float | None = 100.0
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     seed: int = 0
@@ -80,6 +81,8 @@ class CycleSettings:
             raise InvalidInput(f"table_points must be 2..20, got {self.table_points}")
         if not 1 <= self.via_every <= 40:
             raise InvalidInput(f"via_every must be 1..40, got {self.via_every}")
+        if self.corridor_mm is not None and not (np.isfinite(self.corridor_mm) and self.corridor_mm > 0):
+            raise InvalidInput(f"corridor must be a positive number of mm, got {self.corridor_mm}")
         if not 0 < self.accel_time <= 10:
             raise InvalidInput(f"accel_time must be in (0, 10] s, got {self.accel_time}")
 
@@ -95,6 +98,7 @@ class Solved:
     limit_excess: tuple[str, ...]
     samples: Trajectory  # 25 ms
     fine: Trajectory  # 2.5 ms
+    corridor_dev_mm: float  # tool0 from the joint-interpolated taught move, largest
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,6 +120,7 @@ class MoveOutcome:
     via_points: int
     via_max_joint_dev_deg: float
     via_max_tcp_dev_mm: float
+    corridor_dev_mm: float
 
 
 @dataclass(frozen=True, slots=True)
@@ -167,6 +172,7 @@ class CycleResult:
     waits: tuple[tuple[int, float, float], ...]  # (line, default s, optimized s)
     fixed_lines: tuple[int, ...]
     limits_ok: bool
+    corridor_mm: float | None
     shortest_cycle_s: float
     wall_s: float
     n_solves: int
@@ -279,20 +285,25 @@ class CycleOptimizer:
             settings=self.settings.gradient,
             rng=np.random.default_rng(seq),
             acceleration_limit=amax,
+            max_deviation_m=None if self.settings.corridor_mm is None else self.settings.corridor_mm / 1000,
         )
         self.n_solves += 1
         x = res.coefficients.ravel()
         fine = problem.path(x, fine=True)
         report = check_limits(robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax)
         e, e_lab = _energy(robot, self.plant(robot), fine)
+        taught = minimum_jerk(m.path.q0, m.path.q1, T, dt=STEP)
+        samples = problem.path(x)
+        taught = minimum_jerk(m.path.q0, m.path.q1, T, dt=STEP)
         out = Solved(
             T,
             e,
             e_lab,
             report.ok and res.feasible,
             tuple(w.describe() for w in report.worst),
-            problem.path(x),
+            samples,
             fine,
+            tcp_deviation_mm(robot, samples, taught),
         )
         self.cache[key] = out
         return out
@@ -558,13 +569,14 @@ def optimize_cycle(
                     n_via,
                     dev_q,
                     dev_mm,
+                    s.corridor_dev_mm,
                 )
             )
         else:
             note = (
-                "MoveL: kept (straight line, controller timing), stops at its target"
+                "MoveL: kept unchanged (straight line, controller timing)"
                 if m.step.linear
-                else "occurs more than once in the cycle: kept, stops at its target"
+                else "occurs more than once in the cycle: kept unchanged"
                 if m.step.repeated
                 else "no motion"
             )
@@ -586,6 +598,7 @@ def optimize_cycle(
                     0,
                     0.0,
                     0.0,
+                    0.0,
                 )
             )
     waits = tuple((spec.steps[i].line, sec, 0.0 if settings.use_waits else sec) for i, _, sec in plan.waits)
@@ -602,6 +615,7 @@ def optimize_cycle(
         waits=waits,
         fixed_lines=spec.fixed_lines,
         limits_ok=ok,
+        corridor_mm=settings.corridor_mm,
         shortest_cycle_s=shortest,
         wall_s=time.perf_counter() - t_start,
         n_solves=opt.n_solves,

@@ -29,6 +29,8 @@ ASSUMPTIONS = (
     "optimized MoveJ/MoveAbsJ: rest to rest (the single-move gradient optimizer), written as MoveAbsJ via "
     "points with \\T and z1 zones; the last via point keeps the original move's stop (fine) or ends in z1",
     "MoveL: kept unchanged (straight line, controller timing); moves that occur more than once: kept",
+    "corridor: tool0 (the flange) stays within corridor_mm of the joint-interpolated taught move at every "
+    "25 ms sample of an optimized move (corridor_dev_mm per move)",
     "instructions kept verbatim (I/O, assignments, ...): their run time is not modelled (treated as fixed)",
 )
 
@@ -127,6 +129,7 @@ def cycle_json(
             "saved_by_waits_pct": b.by_waits_pct,
         },
         "limits_ok": result.limits_ok,
+        "corridor_mm": result.corridor_mm,
         "moves": [asdict(m) for m in result.moves],
         "waits": [{"line": w[0], "default_s": w[1], "optimized_s": w[2]} for w in result.waits],
         "kept_verbatim_lines": list(result.fixed_lines),

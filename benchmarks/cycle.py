@@ -1,0 +1,130 @@
+"""Whole-cycle optimization of the bundled RAPID example (issue 12).
+
+Measures, on ``examples/pick_and_place.mod`` (IRB 120), one core:
+
+* the program as the emulated controller runs it against the optimized cycle at the
+  same cycle time, on physics and on the emulated lab robot, with the breakdown
+  (shapes at the default's proportions of time, re-allocated durations, waits spent);
+* the same with ``--use-waits``;
+* the share of written moves within every limit;
+* the wall time of ``--pareto`` (10 points, from a fresh start: the table of solves
+  included) against the wall time of one optimization in the same run;
+* the closed-form IK on 5,000 poses, vectorized, against a per-pose loop.
+
+Usage: python benchmarks/cycle.py
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _report import ROOT, machine, single_core, write_section  # noqa: E402
+
+single_core()
+
+import numpy as np  # noqa: E402
+
+import joulepath  # noqa: E402
+from joulepath.kinematics._ik import ik_branches  # noqa: E402
+from joulepath.program import (  # noqa: E402
+    CycleSettings,
+    optimize_cycle,
+    optimized_module,
+    pareto,
+    read_module,
+    resolve_module,
+)
+from joulepath.program._cycle import CycleOptimizer  # noqa: E402
+
+EXAMPLE = ROOT / "examples" / "pick_and_place.mod"
+
+
+def _row(label: str, r) -> str:  # noqa: ANN001
+    b = r.breakdown
+    waits = "–" if b.by_waits_pct is None else f"{b.by_waits_pct:.1f} %"
+    return (
+        f"| {label} | {r.default_cycle_s:.3f} → {r.optimized_cycle_s:.3f} | {r.default_energy_J:.2f} → "
+        f"{r.optimized_energy_J:.2f} | **{r.saved_pct:.1f} %** | {r.default_lab_J:.2f} → {r.optimized_lab_J:.2f} | "
+        f"{r.saved_lab_pct:.1f} % | {b.by_shape_pct:.1f} % | {b.by_allocation_pct:.1f} % | {waits} | "
+        f"{r.n_solves} | {r.wall_s:.1f} s |"
+    )
+
+
+def main() -> None:
+    robot = joulepath.load_robot("irb120")
+    spec = resolve_module(read_module(EXAMPLE), robot)
+    rows, results = [], []
+    for label, waits in (("same cycle time", False), ("same cycle time, --use-waits", True)):
+        r, _ = optimize_cycle(spec, CycleSettings(use_waits=waits))
+        optimized_module(r, via_every=CycleSettings().via_every)  # raises if any written move breaks a limit
+        rows.append(_row(label, r))
+        results.append(r)
+        print(rows[-1], flush=True)
+    moves = [m for r in results for m in r.moves if m.optimized]
+    within = sum(m.limits_ok for m in moves)
+    t0 = time.perf_counter()
+    opt = CycleOptimizer(spec, CycleSettings())
+    front = pareto(opt, points=10)
+    pareto_wall = time.perf_counter() - t0
+    lo, hi = robot.joint_ranges()
+    q = lo + np.random.default_rng(0).random((5000, 6)) * (hi - lo)
+    pose = robot.fk(q).homogeneous
+    t0 = time.perf_counter()
+    ik_branches(robot.chain, pose)
+    ik_vec = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    for k in range(200):
+        ik_branches(robot.chain, pose[k])
+    ik_loop = (time.perf_counter() - t0) * 5000 / 200
+    r0 = results[0]
+    dev = max(m.via_max_tcp_dev_mm for m in moves)
+    body = [
+        "## Whole-cycle optimization of a RAPID program (benchmarks/cycle.py, issue 12)",
+        "",
+        f"Machine: {machine()}; one core (`OMP_NUM_THREADS=1`).",
+        "",
+        "`examples/pick_and_place.mod` (IRB 120, gripper 0.6 kg): 8 moves per cycle (6 MoveJ/MoveAbsJ, 2 MoveL),",
+        "2 × `WaitTime 0.3`, one assignment kept verbatim. Default = the program as the emulated controller runs",
+        "it (speeddata, zones blended, 48 ms dwell at stop points). Energy = Σ |τ·q̇|·dt on a 2.5 ms grid.",
+        "Optimized = the MoveJ/MoveAbsJ moves reshaped (rest to rest) and re-timed, MoveL kept, every result",
+        "verified (limits on the 2.5 ms grid; physics; lab robot).",
+        "",
+        "| run | cycle [s] | physics [J] | saved | lab [J] | saved (lab) | by shape | by time allocation | by waits | solves | wall |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+        *rows,
+        "",
+        f"Written moves within every limit: **{within}/{len(moves)}** ({100 * within / len(moves):.0f} %).",
+        f"Via points every 50 ms; their joint-linear interpolation departs from the optimized path by at most "
+        f"{dev:.1f} mm at the TCP (before the controller's z1 zones round them).",
+        "",
+        f"**Issue target: ≥ 25 % saved at the same cycle time. Measured: {r0.saved_pct:.1f} % on physics "
+        f"({r0.saved_lab_pct:.1f} % on the lab robot, {abs(r0.saved_pct - r0.saved_lab_pct):.1f} points apart); "
+        f"with the waits spent {results[1].saved_pct:.1f} %. Not reached.** Why: the default already runs at its "
+        "speed limits with zones, so at the same cycle time the optimized moves (which stop at every target) get "
+        f"only {r0.default_cycle_s - r0.shortest_cycle_s:.2f} s of slack beyond their shortest feasible "
+        "durations; the MoveL moves (kept) are ~20 % of the energy.",
+        "",
+        f"Energy against cycle time (`--pareto`, 10 points, {front[0].cycle_time_s:.2f}–{front[-1].cycle_time_s:.2f} s):",
+        "",
+        "| cycle [s] | physics [J] | lab [J] |",
+        "|---|---|---|",
+        *(f"| {p.cycle_time_s:.3f} | {p.energy_J:.2f} | {p.energy_lab_J:.2f} |" for p in front),
+        f"| {r0.default_cycle_s:.3f} (default program) | {r0.default_energy_J:.2f} | {r0.default_lab_J:.2f} |",
+        "",
+        f"`--pareto` wall time from a fresh start (table of {opt.n_solves} solves included): **{pareto_wall:.1f} s** "
+        f"on one core (issue target ≤ 60 s); one same-cycle-time optimization in this run: {r0.wall_s:.1f} s "
+        f"(ratio {pareto_wall / r0.wall_s:.2f}).",
+        "",
+        f"Closed-form IK, all 8 branches of 5,000 poses: {1000 * ik_vec:.0f} ms vectorized, "
+        f"{1000 * ik_loop:.0f} ms as a per-pose loop (extrapolated from 200), {ik_loop / ik_vec:.0f}× faster.",
+    ]
+    text = "\n".join(body)
+    print(text)
+    write_section("cycle", text)
+
+
+if __name__ == "__main__":
+    main()
