@@ -46,6 +46,9 @@ def cycle(
         min=0.0,
         help="mm: keep tool0 this close to the taught move's path (joint-interpolated); 0: no corridor.",
     ),
+    cell: Path = typer.Option(
+        None, "--cell", help="Cell file (TOML: boxes, cylinders, margin): every move must clear it."
+    ),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     unchecked: bool = unchecked_option(),
 ) -> int:
@@ -67,13 +70,17 @@ def cycle(
     from joulepath.program import pareto as run_pareto
 
     target = _cycle_time(cycle_time)
-    check_out_folder(out, files=CYCLE_FILES, inputs=[program])
+    check_out_folder(out, files=CYCLE_FILES, inputs=[program, *([cell] if cell else [])])
     if not program.is_file():
         raise typer.BadParameter(f"{program}: no such file", param_hint="PROGRAM")
     r = load_robot_for_cli(robot, unchecked=unchecked)
     rapid = program.suffix.lower() != ".toml"
     spec = resolve_module(read_module(program), r) if rapid else read_cycle_toml(program, r)
+    from joulepath.program._cell import read_cell
+
+    cell_data = read_cell(cell) if cell is not None else None
     settings = CycleSettings(
+        cell=cell_data,
         cycle_time=target,
         use_waits=use_waits,
         seed=seed,
@@ -99,6 +106,12 @@ def cycle(
     console.print(
         f"breakdown: shape {b.by_shape_pct:.1f} %, time allocation {b.by_allocation_pct:.1f} %{waits}"
     )
+    if cell_data is not None:
+        near = [m for m in result.moves if m.default_clearance_mm is not None and m.default_clearance_mm < 0]
+        for m in near:
+            console.print(
+                f"line {m.line}: {m.label}: the default move comes within the cell's margin; not optimized"
+            )
     if result.fixed_lines:
         console.print(
             f"kept verbatim, run time treated as fixed: line(s) {', '.join(map(str, result.fixed_lines))}"

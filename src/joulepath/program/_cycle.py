@@ -37,6 +37,7 @@ from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize import ACCEL_TIME, GradientSettings, acceleration_limit, check_limits
 from joulepath.optimize._gradient import solve_move
 from joulepath.optimize._verify import shortest_feasible_duration, tcp_deviation_mm
+from joulepath.program._cell import Cell, clearance
 from joulepath.program._resolve import CycleSpec, Step
 from joulepath.program._timing import (
     FINE_DT,
@@ -70,6 +71,7 @@ class CycleSettings:
     via_every: int = 2
     accel_time: float = ACCEL_TIME
     corridor_mm: float | None = 100.0
+    cell: Cell | None = None
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     seed: int = 0
@@ -99,6 +101,12 @@ class Solved:
     samples: Trajectory  # 25 ms
     fine: Trajectory  # 2.5 ms
     corridor_dev_mm: float  # tool0 from the joint-interpolated taught move, largest
+    clearance_mm: float | None = None  # smallest distance to the cell's obstacles (None: no cell)
+    corridor_used_mm: float | None = None
+
+    @property
+    def usable(self) -> bool:
+        return self.limits_ok and (self.clearance_mm is None or self.clearance_mm >= 0.0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,6 +129,8 @@ class MoveOutcome:
     via_max_joint_dev_deg: float
     via_max_tcp_dev_mm: float
     corridor_dev_mm: float
+    default_clearance_mm: float | None = None
+    optimized_clearance_mm: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -173,6 +183,7 @@ class CycleResult:
     fixed_lines: tuple[int, ...]
     limits_ok: bool
     corridor_mm: float | None
+    cell: dict[str, object] | None
     shortest_cycle_s: float
     wall_s: float
     n_solves: int
@@ -223,8 +234,16 @@ class CycleOptimizer:
         self.n_solves = 0
         moves = self.plan.moves
         self.by_index = {m.index: m for m in moves}
+        self.default_clearance: dict[int, float] = {}
+        if settings.cell is not None:
+            self._default_clearance()
         self.optimizable = [
-            m.index for m in moves if not m.step.linear and not m.step.repeated and m.profile.duration > 0
+            m.index
+            for m in moves
+            if not m.step.linear
+            and not m.step.repeated
+            and m.profile.duration > 0
+            and self.default_clearance.get(m.index, np.inf) >= 0.0
         ]
         self.kept = [m.index for m in moves if m.index not in self.optimizable]
         self.dwell = settings.controller.fine_dwell
@@ -252,6 +271,21 @@ class CycleOptimizer:
         self.shortest_cycle = self.fixed_time + sum(self.t_lo.values())
 
     # ------------------------------------------------------------ helpers
+    def _clearance_mm(self, m: PlannedMove, q: FloatArray) -> float:
+        """Smallest distance (mm) beyond the margin to the cell along ``q``; negative: too close."""
+        cell = self.settings.cell
+        assert cell is not None and m.step.tcp is not None
+        c = clearance(cell, self._robot(m), q, m.step.tcp)
+        return 1000.0 * (c.distance - cell.margin)
+
+    def _default_clearance(self) -> None:
+        plan = self.plan
+        for m in plan.moves:
+            if m.profile.duration == 0:
+                continue
+            t = np.linspace(m.t0, m.t_end, max(2, int(np.ceil(m.profile.duration / FINE_DT)) + 1))
+            self.default_clearance[m.index] = self._clearance_mm(m, evaluate_cycle(plan, t).q)
+
     def _robot(self, m: PlannedMove) -> Robot:
         assert m.step.robot is not None
         return m.step.robot
@@ -272,10 +306,24 @@ class CycleOptimizer:
         if key in self.cache:
             return self.cache[key]
         m = self.by_index[i]
-        robot = self._robot(m)
         T = units * STEP
+        corridors: list[float | None] = [self.settings.corridor_mm]
+        if self.settings.cell is not None:  # tighter corridors around the (clear) taught move
+            first = self.settings.corridor_mm or 100.0
+            corridors += [first / 2, first / 4, first / 8]
+        out: Solved | None = None
+        for corridor in corridors:
+            out = self._solve_once(m, T, units, corridor)
+            if out.usable or not out.limits_ok:
+                break
+        assert out is not None
+        self.cache[key] = out
+        return out
+
+    def _solve_once(self, m: PlannedMove, T: float, units: int, corridor: float | None) -> Solved:
+        robot = self._robot(m)
         amax = self._amax(robot)
-        seq = np.random.SeedSequence([self.settings.seed, i, units])
+        seq = np.random.SeedSequence([self.settings.seed, m.index, units])
         res, problem = solve_move(
             robot,
             m.path.q0,
@@ -285,17 +333,16 @@ class CycleOptimizer:
             settings=self.settings.gradient,
             rng=np.random.default_rng(seq),
             acceleration_limit=amax,
-            max_deviation_m=None if self.settings.corridor_mm is None else self.settings.corridor_mm / 1000,
+            max_deviation_m=None if corridor is None else corridor / 1000,
         )
         self.n_solves += 1
         x = res.coefficients.ravel()
         fine = problem.path(x, fine=True)
         report = check_limits(robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax)
         e, e_lab = _energy(robot, self.plant(robot), fine)
-        taught = minimum_jerk(m.path.q0, m.path.q1, T, dt=STEP)
         samples = problem.path(x)
         taught = minimum_jerk(m.path.q0, m.path.q1, T, dt=STEP)
-        out = Solved(
+        return Solved(
             T,
             e,
             e_lab,
@@ -304,9 +351,9 @@ class CycleOptimizer:
             samples,
             fine,
             tcp_deviation_mm(robot, samples, taught),
+            None if self.settings.cell is None else self._clearance_mm(m, fine.q),
+            corridor,
         )
-        self.cache[key] = out
-        return out
 
     # ------------------------------------------------------------ default
     def default_energies(self) -> dict[int, tuple[float, float, float]]:
@@ -370,7 +417,7 @@ class CycleOptimizer:
             new = np.full(cap + 1, np.inf)
             pick = np.full(cap + 1, -1)
             for k, s in enumerate(table[i]):
-                if not s.limits_ok:
+                if not s.usable:
                     continue
                 u = int(round(s.duration / STEP))
                 if u > cap:
@@ -400,7 +447,7 @@ class CycleOptimizer:
         idx = self.optimizable
         coef = []
         for i in idx:
-            pts = [(s.duration, s.energy_J) for s in table[i] if s.limits_ok]
+            pts = [(s.duration, s.energy_J) for s in table[i] if s.usable]
             T = np.array([p[0] for p in pts])
             E = np.array([p[1] for p in pts])
             A = np.column_stack([np.ones_like(T), 1 / T, 1 / T**2])
@@ -485,7 +532,7 @@ class CycleOptimizer:
             candidates.append(self.evaluate(d, kept, waits))
         c = self.continuous(table, budget)
         alloc = self.evaluate(c, kept, waits)
-        if all(self.solve(i, T).limits_ok for i, T in c.items()):
+        if all(self.solve(i, T).usable for i, T in c.items()):
             candidates.append(alloc)
         if not candidates:
             raise LimitViolation(
@@ -551,7 +598,7 @@ def optimize_cycle(
             s = opt.solve(m.index, final.durations[m.index])
             paths[m.index] = s
             n_via, dev_q, dev_mm = via_deviation(m.step, s, settings.via_every)
-            ok = ok and s.limits_ok
+            ok = ok and s.usable
             outcomes.append(
                 MoveOutcome(
                     m.step.line,
@@ -570,6 +617,8 @@ def optimize_cycle(
                     dev_q,
                     dev_mm,
                     s.corridor_dev_mm,
+                    opt.default_clearance.get(m.index),
+                    s.clearance_mm,
                 )
             )
         else:
@@ -580,6 +629,11 @@ def optimize_cycle(
                 if m.step.repeated
                 else "no motion"
             )
+            if opt.default_clearance.get(m.index, np.inf) < 0.0:
+                note = "the default move comes closer to the cell than the margin: reported, not optimized"
+            kept_clear = None
+            if settings.cell is not None and m.profile.duration > 0:
+                kept_clear = opt._clearance_mm(m, standalone(m).q)
             a, b = kept[m.index]
             outcomes.append(
                 MoveOutcome(
@@ -599,6 +653,8 @@ def optimize_cycle(
                     0.0,
                     0.0,
                     0.0,
+                    opt.default_clearance.get(m.index),
+                    kept_clear,
                 )
             )
     waits = tuple((spec.steps[i].line, sec, 0.0 if settings.use_waits else sec) for i, _, sec in plan.waits)
@@ -616,6 +672,9 @@ def optimize_cycle(
         fixed_lines=spec.fixed_lines,
         limits_ok=ok,
         corridor_mm=settings.corridor_mm,
+        cell=None
+        if settings.cell is None
+        else {"source": settings.cell.source, "margin_mm": 1000 * settings.cell.margin},
         shortest_cycle_s=shortest,
         wall_s=time.perf_counter() - t_start,
         n_solves=opt.n_solves,

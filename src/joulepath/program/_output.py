@@ -47,7 +47,10 @@ def optimized_module(result: CycleResult, *, via_every: int) -> str:
     assert module is not None
     if not result.limits_ok:
         bad = "; ".join(e for m in result.moves for e in m.limit_excess)
-        raise LimitViolation(f"the optimized cycle breaks a limit ({bad}); the program is not written")
+        raise LimitViolation(
+            f"the optimized cycle breaks a limit or the cell's margin ({bad or 'clearance'}); "
+            "the program is not written"
+        )
     replace: dict[int, list[str]] = {}
     decls: list[str] = []
     for i, solved in result.paths.items():
@@ -130,6 +133,12 @@ def cycle_json(
         },
         "limits_ok": result.limits_ok,
         "corridor_mm": result.corridor_mm,
+        "cell": result.cell,
+        "cell_note": None
+        if result.cell is None
+        else "clearance_mm per move = smallest distance beyond the margin between the robot's capsules "
+        "(lower arm, upper arm, wrist, tool) and the obstacles, coal distance queries on the 2.5 ms grid; "
+        "an optimized move too close is solved again in a tighter corridor (down to 1/8), else not used",
         "moves": [asdict(m) for m in result.moves],
         "waits": [{"line": w[0], "default_s": w[1], "optimized_s": w[2]} for w in result.waits],
         "kept_verbatim_lines": list(result.fixed_lines),
