@@ -5,11 +5,10 @@ import pytest
 
 import joulepath
 from joulepath.errors import InvalidInput
+from joulepath.optimize import GradientSettings
 from joulepath.program import CycleSettings, optimize_cycle, parse_module, resolve_module
 from joulepath.program._cell import Cell, Obstacle, clearance, read_cell
 from joulepath.program._cycle import CycleOptimizer
-
-from joulepath.optimize import GradientSettings
 
 pytest.importorskip("coal")
 
