@@ -116,6 +116,15 @@ def cycle(
         console.print(
             f"kept verbatim, run time treated as fixed: line(s) {', '.join(map(str, result.fixed_lines))}"
         )
+    import json
+
+    emulated = json.loads(files["cycle.json"].read_text()).get("written_program_emulated_cycle_s")
+    if emulated is not None and emulated > 1.01 * result.optimized_cycle_s:
+        console.print(
+            f"note: the controller emulation runs the written via points in a {emulated:.3f} s cycle "
+            f"(planned {result.optimized_cycle_s:.3f} s): it starts each via-point instruction on its own "
+            "profile; measure the written program on the robot (see cycle.json)"
+        )
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
     if rapid and "optimized.mod" not in files:
         console.print(

@@ -73,6 +73,7 @@ class CycleSpec:
     source: str
     module: Module | None
     fixed_lines: tuple[int, ...]
+    robot: Robot
 
 
 def tool_transform(tool: ToolData) -> FloatArray:
@@ -151,7 +152,7 @@ def resolve_module(module: Module, robot: Robot) -> CycleSpec:
             loop.line if loop is not None else main.line, f"{where} holds no move; nothing to optimize"
         )
     assert moves[-1].q is not None
-    return CycleSpec(tuple(steps), moves[-1].q.copy(), module.path, module, tuple(fixed))
+    return CycleSpec(tuple(steps), moves[-1].q.copy(), module.path, module, tuple(fixed), robot)
 
 
 def _move_step(
@@ -318,7 +319,7 @@ def read_cycle_toml(path: str | Path, robot: Robot) -> CycleSpec:
         raise InvalidInput(f"{p}: no move step; add [[step]] tables with joints_deg and duration_s")
     start = _joints(data["start_deg"], n, f"{p}: start_deg") if "start_deg" in data else moves[-1].q
     assert start is not None
-    return CycleSpec(tuple(steps), np.asarray(start, float), str(p), None, ())
+    return CycleSpec(tuple(steps), np.asarray(start, float), str(p), None, (), robot)
 
 
 def _joints(value: object, n: int, where: str) -> FloatArray:
