@@ -91,7 +91,7 @@ def test_zone_shortens_the_cycle(robot):
     assert a.cycle_time < b.cycle_time
 
 
-def test_optimized_cycle_invariants(spec, robot):
+def test_optimized_cycle_invariants(spec, robot, tmp_path):
     settings = CycleSettings(gradient=FAST, table_points=3, use_waits=True)
     result, opt = optimize_cycle(spec, settings)
     assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
@@ -109,6 +109,19 @@ def test_optimized_cycle_invariants(spec, robot):
     tau = r.inverse_dynamics(s.fine.q, s.fine.qd, s.fine.qdd, friction=NOMINAL_FRICTION)
     assert s.energy_J == pytest.approx(float(path_energy(tau, s.fine.qd, s.fine.dt).total))
     assert s.fine.dt == pytest.approx(FINE_DT)
+    # a result outside a limit is refused: no module, the reason in cycle.json, a stale module removed
+    from dataclasses import replace
+
+    from joulepath.errors import LimitViolation
+    from joulepath.program import optimized_module, write_cycle_run
+
+    bad = replace(result, limits_ok=False)
+    with pytest.raises(LimitViolation, match="not written"):
+        optimized_module(bad, via_every=2)
+    (tmp_path / "optimized.mod").write_text("old")
+    files = write_cycle_run(tmp_path, bad, via_every=2, pareto=None, write_rapid=True)
+    assert "optimized.mod" not in files and not (tmp_path / "optimized.mod").exists()
+    assert json.loads((tmp_path / "cycle.json").read_text())["rapid_refused"]
     # more cycle time never costs energy (each point: best combination within a larger budget)
     front = pareto(opt, points=4)
     e = [p.energy_J for p in front]
@@ -167,3 +180,13 @@ def test_plain_cycle_file(tmp_path, robot):
     bad.write_text("[[step]]\njoints_deg = [0, 0, 0]\nduration_s = 1\n")
     with pytest.raises(joulepath.errors.InvalidInput, match="step 1"):
         read_cycle_toml(bad, robot)
+
+
+def test_warm_start_solves_within_limits(spec):
+    opt = CycleOptimizer(spec, CycleSettings(gradient=FAST, warm_start=True))
+    i = opt.optimizable[0]
+    first = opt.solve(i, opt.t_lo[i] + 0.2)
+    assert opt._neighbour(i, opt.t_lo[i]) is first
+    second = opt.solve(i, opt.t_lo[i])  # warm-started from the first
+    assert second.usable and second.corridor_dev_mm <= 100.0 + 1e-6
+    assert opt.n_solves == 2

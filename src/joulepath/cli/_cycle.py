@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import typer
@@ -95,6 +96,13 @@ def cycle(
             status.update("energy against cycle time...")
             front = run_pareto(opt, points=points, use_waits=use_waits)
     files = write_cycle_run(out, result, via_every=settings.via_every, pareto=front, write_rapid=rapid)
+    if not result.limits_ok or (rapid and "optimized.mod" not in files):
+        console.print(
+            "REFUSED: the optimized cycle breaks a limit or the cell's margin; no program was written "
+            f"and no saving is claimed (default {result.default_energy_J:.2f} J; see cycle.json)"
+        )
+        console.print(f"wrote {', '.join(sorted(files))} in {out}")
+        return 1
     b = result.breakdown
     console.print(
         f"cycle {result.default_cycle_s:.3f} s -> {result.optimized_cycle_s:.3f} s; energy on physics "
@@ -116,8 +124,6 @@ def cycle(
         console.print(
             f"kept verbatim, run time treated as fixed: line(s) {', '.join(map(str, result.fixed_lines))}"
         )
-    import json
-
     emulated = json.loads(files["cycle.json"].read_text()).get("written_program_emulated_cycle_s")
     if emulated is not None and emulated > 1.01 * result.optimized_cycle_s:
         console.print(
@@ -126,9 +132,4 @@ def cycle(
             "profile; measure the written program on the robot (see cycle.json)"
         )
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
-    if rapid and "optimized.mod" not in files:
-        console.print(
-            "REFUSED: the optimized cycle breaks a limit; optimized.mod was NOT written (see cycle.json)"
-        )
-        return 1
     return 0

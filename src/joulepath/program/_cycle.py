@@ -27,6 +27,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -35,7 +36,7 @@ from joulepath.dynamics import NOMINAL_FRICTION, Robot
 from joulepath.energy import path_energy
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize import ACCEL_TIME, GradientSettings, acceleration_limit, check_limits
-from joulepath.optimize._gradient import solve_move
+from joulepath.optimize._gradient import SplineProblem, optimize_spline, solve_move
 from joulepath.optimize._verify import shortest_feasible_duration, tcp_deviation_mm
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._resolve import CycleSpec, Step
@@ -48,7 +49,7 @@ from joulepath.program._timing import (
     standalone,
 )
 from joulepath.sim import ControllerConfig, Plant, make_plant
-from joulepath.trajectory import Trajectory, minimum_jerk
+from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk
 from joulepath.units import SAMPLE_PERIOD
 
 STEP = SAMPLE_PERIOD
@@ -62,7 +63,13 @@ class CycleSettings:
     ``cycle_time``: s, or None for the default program's cycle time. ``use_waits``:
     spend ``WaitTime`` slack on the moves. ``table_points``: durations solved per
     move; ``via_every``: samples (25 ms) between the via points written per optimized
-    move.
+    move. ``corridor_mm``: tool0 stays within this distance of the joint-interpolated
+    taught move (the path ``MoveJ`` itself follows) at every sample (None: none).
+    ``cell``: obstacles every optimized move must clear (a move too close is solved
+    again in corridors of 1/2, 1/4, 1/8 of ``corridor_mm``, else not used).
+    ``warm_start``: start each solve of a move from its nearest solved duration
+    (time-scaled) and run only the last continuation stages; measured not faster and
+    slightly worse (BENCHMARKS.md), so off by default.
     """
 
     cycle_time: float | None = None
@@ -72,6 +79,7 @@ class CycleSettings:
     accel_time: float = ACCEL_TIME
     corridor_mm: float | None = 100.0
     cell: Cell | None = None
+    warm_start: bool = False
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     seed: int = 0
@@ -311,30 +319,70 @@ class CycleOptimizer:
         if self.settings.cell is not None:  # tighter corridors around the (clear) taught move
             first = self.settings.corridor_mm or 100.0
             corridors += [first / 2, first / 4, first / 8]
+        warm = self._neighbour(i, T) if self.settings.warm_start else None
         out: Solved | None = None
         for corridor in corridors:
-            out = self._solve_once(m, T, units, corridor)
+            out = self._solve_once(m, T, units, corridor, warm)
             if out.usable or not out.limits_ok:
                 break
         assert out is not None
         self.cache[key] = out
         return out
 
-    def _solve_once(self, m: PlannedMove, T: float, units: int, corridor: float | None) -> Solved:
+    def _neighbour(self, i: int, T: float) -> Solved | None:
+        """The usable solve of move ``i`` at the nearest other duration (a warm start), if any."""
+        near = [s for (j, _), s in self.cache.items() if j == i and s.usable]
+        return min(near, key=lambda s: abs(s.duration - T)) if near else None
+
+    def _warm_problem(
+        self, m: PlannedMove, T: float, corridor: float | None, warm: Solved
+    ) -> tuple[Any, Any]:
+        """The fine-knot problem at ``T`` and the warm path in its coefficients (time-scaled, lstsq)."""
+        g = self.settings.gradient
         robot = self._robot(m)
-        amax = self._amax(robot)
-        seq = np.random.SeedSequence([self.settings.seed, m.index, units])
-        res, problem = solve_move(
+        basis = SplineBasis(T, knot_spacing=g.knot_spacing, degree=g.degree, dt=STEP)
+        problem = SplineProblem(
             robot,
             m.path.q0,
             m.path.q1,
             T,
-            friction=NOMINAL_FRICTION,
-            settings=self.settings.gradient,
-            rng=np.random.default_rng(seq),
-            acceleration_limit=amax,
+            NOMINAL_FRICTION,
+            basis,
+            check_factor=g.check_factor,
             max_deviation_m=None if corridor is None else corridor / 1000,
+            acceleration_limit=self._amax(robot),
         )
+        t_old = problem.fine.t * (warm.duration / T)
+        q_old = np.column_stack(
+            [np.interp(t_old, warm.fine.t, warm.fine.q[:, j]) for j in range(robot.n_joints)]
+        )
+        c = np.linalg.lstsq(problem.fine.B, q_old - problem.default_fine.q, rcond=None)[0]
+        return problem, c
+
+    def _solve_once(
+        self, m: PlannedMove, T: float, units: int, corridor: float | None, warm: Solved | None = None
+    ) -> Solved:
+        robot = self._robot(m)
+        amax = self._amax(robot)
+        seq = np.random.SeedSequence([self.settings.seed, m.index, units])
+        rng = np.random.default_rng(seq)
+        if warm is not None:  # from the nearest solved duration: the last continuation stages only
+            problem, start = self._warm_problem(m, T, corridor, warm)
+            g = self.settings.gradient
+            refine = replace(g, n_starts=1, continuation=g.continuation[-g.refine_stages :])
+            res = optimize_spline(problem, refine, rng=rng, initial=start)
+        else:
+            res, problem = solve_move(
+                robot,
+                m.path.q0,
+                m.path.q1,
+                T,
+                friction=NOMINAL_FRICTION,
+                settings=self.settings.gradient,
+                rng=rng,
+                acceleration_limit=amax,
+                max_deviation_m=None if corridor is None else corridor / 1000,
+            )
         self.n_solves += 1
         x = res.coefficients.ravel()
         fine = problem.path(x, fine=True)
