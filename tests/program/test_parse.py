@@ -148,6 +148,15 @@ CORPUS = [
     ("unclosed string", _prog('TPWrite "hello;', "MoveJ pA, v100, fine, tool0;"), 5),
     ("unbalanced bracket", _prog("MoveJ pA, v100, fine, tool0];"), 5),
     ("no move in the cycle", _prog("WaitTime 1;"), 4),
+    (
+        "MoveL that turns joint 6 a whole turn",
+        _prog(
+            "MoveJ pA, v100, fine, tool0;",
+            "MoveL pTurned, v100, fine, tool0;",
+            decl=_rt("pTurned", "375, 0, 540", conf="0, 0, 4, 0"),
+        ),
+        7,
+    ),
 ]
 
 

@@ -7,10 +7,12 @@
   the next move's start; waits are at rest and cost nothing).
 * Optimized: every ``MoveAbsJ`` / ``MoveJ`` that occurs once in the cycle is
   reshaped by the single-move gradient optimizer (:func:`joulepath.optimize.solve_move`,
-  rest to rest, fixed duration, limits as constraints). ``MoveL`` moves and moves
-  that occur more than once are kept: same path, same controller profile. Every move
-  of the optimized program stops at its target (the optimizer is rest to rest:
-  zones are replaced by ``fine``) and dwells as the controller does.
+  rest to rest, fixed duration, limits as constraints, tool0 within a corridor of
+  the taught joint move). ``MoveL`` moves and moves that occur more than once are
+  kept: same path, same controller profile, run on their own. An optimized move
+  comes to rest at its target; where the original stopped (``fine``, before a wait)
+  it dwells as the controller does, where it had a zone the next move starts at once.
+  What is lost against the default is the overlap of blended moves.
 * Time: the optimized moves share ``budget = cycle time - kept moves - dwells - waits``
   (with ``use_waits`` the waits are set to 0 and their time joins the budget). Each
   optimized move is solved at a few durations from the shortest one whose
@@ -19,7 +21,8 @@
   are solved again at the shared durations (25 ms steps), and the better of that and
   the best combination of the solved table (dynamic programming) is kept.
 * Verified: every optimized move's path on a 2.5 ms grid against the joint ranges,
-  speed and acceleration limits; its energy on physics and on the lab plant.
+  speed and acceleration limits (and the cell's obstacles, with ``cell``); its energy
+  on physics and on the lab plant.
 """
 
 from __future__ import annotations
@@ -779,7 +782,3 @@ def pareto(
         a = opt.evaluate(d, kept, waits)
         out.append(ParetoPoint(float(c), a.energy_J, a.energy_lab_J, tuple(d[i] for i in opt.optimizable)))
     return out
-
-
-def with_settings(settings: CycleSettings, **changes: object) -> CycleSettings:
-    return replace(settings, **changes)  # type: ignore[arg-type]

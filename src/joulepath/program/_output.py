@@ -66,8 +66,6 @@ def optimized_module(result: CycleResult, *, via_every: int) -> str:
                 f"! joulepath: WaitTime {_num(before)} s spent on the moves (--use-waits)",
                 f"WaitTime {_num(after)};",
             ]
-    for i, step in enumerate(spec.steps):  # kept moves keep their zone; nothing to change
-        del i, step
     header = [
         f"! Optimized by joulepath {__version__} for energy at cycle time {result.optimized_cycle_s:.3f} s "
         f"(default {result.default_cycle_s:.3f} s): physics {result.default_energy_J:.2f} -> "
@@ -180,8 +178,9 @@ def cycle_json(
 
 
 def optimized_cycle_csv(result: CycleResult) -> str:
-    """The optimized moves' sampled paths (25 ms), one block per move."""
-    rows = ["line,t,q1,q2,q3,q4,q5,q6".replace(",q6", "".join(f",q{j}" for j in range(6, 7)))]
+    """The optimized moves' sampled paths (25 ms, rad), one block of rows per move (its first line)."""
+    n = result.spec.robot.n_joints
+    rows = ["line,t," + ",".join(f"q{j}" for j in range(1, n + 1))]
     for i, s in result.paths.items():
         line = result.spec.steps[i].line
         for t, q in zip(s.samples.t, s.samples.q, strict=True):

@@ -102,13 +102,13 @@ def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:
         q = solve_ik(robot.chain, pose @ inv_tcp, None, lower=lo, upper=hi, near=qs[-1])
         if q is None or np.abs(q - qs[-1]).max() > 0.5:
             raise InvalidInput(
-                f"{where}: {step.label}: the straight line leaves the reachable space or passes a "
+                f"{where}:{step.line}: {step.label}: the straight line leaves the reachable space or passes a "
                 f"singularity at {100 * s[k]:.0f} % of the way; use MoveJ or move the target"
             )
         qs.append(q)
     if np.abs(qs[-1] - q1).max() > 1e-6:
         raise InvalidInput(
-            f"{where}: {step.label}: the straight line ends in another configuration than the "
+            f"{where}:{step.line}: {step.label}: the straight line ends in another configuration than the "
             "target's confdata; use MoveJ or fix the confdata"
         )
     spline = CubicSpline(s, np.stack(qs), axis=0)
