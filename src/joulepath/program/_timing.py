@@ -102,8 +102,8 @@ def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:
         q = solve_ik(robot.chain, pose @ inv_tcp, None, lower=lo, upper=hi, near=qs[-1])
         if q is None or np.abs(q - qs[-1]).max() > 0.5:
             raise InvalidInput(
-                f"{where}:{step.line}: {step.label}: the straight line leaves the reachable space or passes a "
-                f"singularity at {100 * s[k]:.0f} % of the way; use MoveJ or move the target"
+                f"{where}:{step.line}: {step.label}: the straight line leaves the reachable space or "
+                f"passes a singularity at {100 * s[k]:.0f} % of the way; use MoveJ or move the target"
             )
         qs.append(q)
     if np.abs(qs[-1] - q1).max() > 1e-6:
