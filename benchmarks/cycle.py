@@ -112,7 +112,8 @@ def main() -> None:
     body = [
         "## Whole-cycle optimization of a RAPID program (benchmarks/cycle.py, issue 12)",
         "",
-        f"Machine: {machine()}; one core (`OMP_NUM_THREADS=1`).",
+        f"Machine: {machine()}; one core (`OMP_NUM_THREADS=1`); the machine is shared, so wall times vary "
+        "between runs (up to 2x seen).",
         "",
         "`examples/pick_and_place.mod` (IRB 120, gripper 0.6 kg): 8 moves per cycle (6 MoveJ/MoveAbsJ, 2 MoveL),",
         "2 × `WaitTime 0.3`, one assignment kept verbatim. Default = the program as the emulated controller runs",
@@ -143,12 +144,12 @@ def main() -> None:
         f"**Issue target: ≥ 25 % saved at the same cycle time. Measured: {r0.saved_pct:.1f} % on physics "
         f"({r0.saved_lab_pct:.1f} % on the lab robot, {abs(r0.saved_pct - r0.saved_lab_pct):.1f} points apart); "
         f"with the waits spent {results[1].saved_pct:.1f} %. Not reached.** Why: the default already runs at its "
-        "speed limits with zones, so at the same cycle time the optimized moves (which stop at every target) get "
+        "speed limits with zones, so at the same cycle time the optimized moves (which come to rest at every target and lose the blends' overlap) get "
         f"only {r0.default_cycle_s - r0.shortest_cycle_s:.2f} s of slack beyond their shortest feasible "
         "durations; the MoveL moves (kept; their energy hardly changes with their duration, measured) are ~20 % "
         f"of the energy; and even at +30 % cycle time the saving is {100 * (1 - front[-1].energy_J / r0.default_energy_J):.1f} % "
-        "(the table below): most of the rest is the work against gravity of lifting and lowering the load "
-        "(|τ·q̇| counts both).",
+        "(the table below): "
+        "that is the part of this cycle's energy that shaping and timing reach.",
         "",
         f"Energy against cycle time (`--pareto`, 10 points, {front[0].cycle_time_s:.2f}–{front[-1].cycle_time_s:.2f} s):",
         "",
