@@ -98,6 +98,8 @@ class GradientResult:
     n_iterations: int
     wall_s: float
     starts: tuple[float, ...]
+    active: dict[str, np.ndarray] = field(default_factory=dict)
+    """The fine-grid constraints the search ended with (flat indices per kind), to warm-start another."""
 
 
 def _smooth_abs(p: FloatArray, eps: float) -> tuple[FloatArray, FloatArray]:
@@ -346,13 +348,19 @@ def _solve_from(
     scale: float,
     eps_unit: float,
     history: list[float],
-) -> tuple[FloatArray, int]:
-    """Continuation stages from ``x0``; each stage regenerates constraints until none is violated."""
+    known: dict[str, np.ndarray] | None = None,
+) -> tuple[FloatArray, int, dict[str, np.ndarray]]:
+    """Continuation stages from ``x0``; each stage regenerates constraints until none is violated.
+
+    ``known`` adds constraints found active by an earlier search on the same fine grid.
+    """
     from scipy.optimize import minimize
 
     x = x0.copy()
     n_iter = 0
     active = problem.screen(x, SCREEN_BAND)
+    if known:
+        active = _merge(active, known)
     for share in settings.continuation:
         eps = share * eps_unit
 
@@ -377,7 +385,7 @@ def _solve_from(
             active = _merge(active, problem.screen(x, SCREEN_BAND))
             if problem.violation(x) == 0.0:
                 break
-    return x, n_iter
+    return x, n_iter, active
 
 
 def optimize_spline(
@@ -387,6 +395,7 @@ def optimize_spline(
     rng: np.random.Generator,
     progress: Callable[[int, int], None] | None = None,
     initial: FloatArray | None = None,
+    known: dict[str, np.ndarray] | None = None,
 ) -> GradientResult:
     """Multi-start continuation SLSQP on ``problem``; returns the best feasible start.
 
@@ -401,7 +410,7 @@ def optimize_spline(
     # the solver's small dense linear algebra runs many times faster on one BLAS
     # thread than on a pool that competes with other work for the same cores
     with threadpool_limits(limits=1, user_api="blas"):
-        return _optimize_spline(problem, settings, rng=rng, progress=progress, initial=initial)
+        return _optimize_spline(problem, settings, rng=rng, progress=progress, initial=initial, known=known)
 
 
 def _optimize_spline(
@@ -411,6 +420,7 @@ def _optimize_spline(
     rng: np.random.Generator,
     progress: Callable[[int, int], None] | None,
     initial: FloatArray | None,
+    known: dict[str, np.ndarray] | None = None,
 ) -> GradientResult:
     t0 = time.perf_counter()
     zero = np.zeros(problem.n_var)
@@ -426,16 +436,17 @@ def _optimize_spline(
         starts.append(bump.ravel())
     history: list[float] = [e_default]
     best_x, best_e, best_ok = zero, e_default, problem.violation(zero) == 0.0
+    best_active: dict[str, np.ndarray] = {}
     finals: list[float] = []
     n_iter = 0
     for s, x0 in enumerate(starts):
-        x, it = _solve_from(problem, x0, settings, scale, eps_unit, history)
+        x, it, active = _solve_from(problem, x0, settings, scale, eps_unit, history, known)
         n_iter += it
         e = problem.true_energy(x)
         ok = problem.violation(x) == 0.0
         finals.append(e if ok else float("inf"))
         if ok and (not best_ok or e < best_e):
-            best_x, best_e, best_ok = x, e, True
+            best_x, best_e, best_ok, best_active = x, e, True, active
         if progress is not None:
             progress(s + 1, len(starts))
     return GradientResult(
@@ -448,6 +459,7 @@ def _optimize_spline(
         n_iterations=n_iter,
         wall_s=time.perf_counter() - t0,
         starts=tuple(finals),
+        active=best_active,
     )
 
 
@@ -490,7 +502,10 @@ def solve_move(
     target = coarse.fine.B @ first.coefficients
     start: FloatArray = np.asarray(np.linalg.lstsq(fine.fine.B, target, rcond=None)[0], dtype=float)
     refine = replace(settings, n_starts=1, continuation=settings.continuation[-settings.refine_stages :])
-    second = optimize_spline(fine, refine, rng=rng, initial=start)
+    # the limit grids (accelerations, efforts, corridor) are the same in both bases;
+    # the control-point (hull) rows are not
+    known = {kind: rows for kind, rows in first.active.items() if kind != "hull"}
+    second = optimize_spline(fine, refine, rng=rng, initial=start, known=known)
     merged_history = np.minimum.accumulate(np.concatenate([first.history, second.history]))
     best, problem = (
         (second, fine) if second.feasible and second.energy_J <= first.energy_J else (first, coarse)
