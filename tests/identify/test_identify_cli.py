@@ -76,3 +76,16 @@ def test_identify_refuses_without_writing(twin, lab_log, tmp_path, capsys):
     assert main(["identify", str(lab_log), "--max-condition", "2", "--out", str(out)]) == 2
     assert "least excited" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_simulate_on_the_twin_plant_gives_data_that_identify_the_twin_again(twin, tmp_path):
+    log = tmp_path / "twin.csv"
+    assert main(["simulate", "--plant", str(twin), "--moves", "15", "--seed", "4", "--out", str(log)]) == 0
+    again = tmp_path / "again"
+    assert main(["identify", str(log), "--out", str(again)]) == 0
+    first = json.loads((twin / TWIN_FRICTION_FILE).read_text())
+    second = json.loads((again / TWIN_FRICTION_FILE).read_text())
+    # the twin's own data are noise-free: the gear efficiency comes back (accelerations are differenced)
+    assert second["gear_efficiency"] == pytest.approx(first["gear_efficiency"], abs=5e-3)
+    card = json.loads((again / TWIN_CARD_FILE).read_text())
+    assert min(card["fit"]["torque_r2"]) > 0.99

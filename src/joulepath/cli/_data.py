@@ -56,7 +56,9 @@ def rapid_collect(
 
 def simulate(
     out: Path = typer.Option(..., "--out", help="Log file (.csv) for one run, or a folder for --plan."),
-    plant: str = typer.Option("lab", help="sim (nominal twin) or lab (emulated real robot)."),
+    plant: str = typer.Option(
+        "lab", help="sim (nominal twin), lab (emulated real robot) or a twin folder (`joulepath identify`)."
+    ),
     moves: int = typer.Option(1000, min=1, help="Number of random moves."),
     seed: int = typer.Option(
         0, min=0, max=2**32 - 1, help="Seed of the random moves and of the plant's noise."
@@ -77,7 +79,7 @@ def simulate(
     elif plan:
         check_out_folder(out, inputs=inputs)
     else:
-        name = f"{plant}-{seed}.csv"
+        name = f"{Path(plant).name if Path(plant).is_dir() else plant}-{seed}.csv"
         check_out_folder(out, files=(name, sidecar_path(Path(name)).name), inputs=inputs)
     if plan:
         if plan != "thesis":
@@ -95,7 +97,7 @@ def simulate(
             )
         console.print(f"wrote {len(results)} logs under {out / 'logs'} and tables {out}/<name>.parquet")
         return 0
-    target = out if out.suffix == ".csv" else out / f"{plant}-{seed}.csv"
+    target = out if out.suffix == ".csv" else out / name
     with console.status(f"simulating {moves} moves on the {plant} plant..."):
         res = run(target, plant=plant, n_moves=moves, seed=seed, robot=robot)
     console.print(

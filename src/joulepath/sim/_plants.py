@@ -19,6 +19,7 @@ public); they are of the size reported for robots of this class.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 from scipy import signal
@@ -88,8 +89,30 @@ def perturbed_robot(robot: Robot, rng: np.random.Generator) -> Robot:
     return Robot(new, description=None, source=f"{robot.source} (perturbed)")
 
 
+def twin_plant(folder: str, robot: Robot) -> Plant:
+    """A twin folder (``joulepath identify --out``) as a plant: its identified physics, no noise.
+
+    The twin's identified rigid body, friction and gear efficiency turn the motion of
+    ``robot`` (the planned kinematics) into motor torque; nothing else is added.
+    """
+    from joulepath.dynamics import load_robot
+
+    twin = load_robot(folder)
+    if twin.calibration is None or twin.n_joints != robot.n_joints:
+        raise InvalidInput(f"{folder}: not a twin of a {robot.n_joints}-joint robot; give a twin folder")
+    return Plant(
+        name="twin",
+        robot=twin,
+        friction=twin.friction,
+        gear_efficiency=twin.calibration.gear_efficiency,
+        torque_noise=(0.0,) * robot.n_joints,
+    )
+
+
 def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
-    """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot)."""
+    """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot), or a twin folder."""
+    if name not in PLANTS and Path(name).is_dir():
+        return twin_plant(name, robot)
     if name == "sim":
         return Plant(name="sim", robot=robot, friction=NOMINAL_FRICTION)
     if name == "lab":
@@ -109,7 +132,9 @@ def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
             speed_noise_deg_s=0.05,
             tracking_hz=12.0,
         )
-    raise InvalidInput(f"unknown plant {name!r}; use one of {', '.join(PLANTS)}")
+    raise InvalidInput(
+        f"unknown plant {name!r}; use one of {', '.join(PLANTS)}, or a twin folder (`joulepath identify`)"
+    )
 
 
 def _track(plan: MotionPlan, t: FloatArray, hz: float) -> tuple[FloatArray, FloatArray, FloatArray]:
