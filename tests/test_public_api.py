@@ -52,7 +52,7 @@ ALLOWED = {
     "export": {"description", "kinematics", "dynamics", "trajectory", "data"},
     "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb"},
     "learn": {"data", "dynamics", "energy"},
-    "identify": {"data", "description", "dynamics", "energy"},
+    "identify": {"data", "description", "dynamics", "energy", "trajectory", "sim"},
     "synth": {"data", "description", "kinematics", "dynamics"},
     "evolve": set(),
     "optimize": {

@@ -15,6 +15,12 @@ from joulepath.identify._consistency import (
     triangle_margins,
 )
 from joulepath.identify._data import IdentificationData, data_from_logs
+from joulepath.identify._excitation import (
+    ExcitationDesign,
+    FourierExcitation,
+    design_excitation,
+    simulate_excitation,
+)
 from joulepath.identify._fit import (
     MAX_CONDITION,
     FitScores,
@@ -36,7 +42,9 @@ from joulepath.identify._twin import CARD_FORMAT, link_inertials, twin_descripti
 __all__ = [
     "BaseParameters",
     "CARD_FORMAT",
+    "ExcitationDesign",
     "FitScores",
+    "FourierExcitation",
     "Identification",
     "IdentificationData",
     "IdentifyOptions",
@@ -44,6 +52,7 @@ __all__ = [
     "RANK_TOLERANCE",
     "base_parameters",
     "data_from_logs",
+    "design_excitation",
     "friction_regressor",
     "from_log_cholesky",
     "identify",
@@ -52,6 +61,7 @@ __all__ = [
     "link_inertials",
     "min_eigenvalues",
     "pseudo_inertia",
+    "simulate_excitation",
     "to_log_cholesky",
     "triangle_margins",
     "true_parameters",

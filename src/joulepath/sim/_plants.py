@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 from scipy import signal
@@ -137,11 +138,25 @@ def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
     )
 
 
-def _track(plan: MotionPlan, t: FloatArray, hz: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+class Commanded(Protocol):
+    """Any commanded motion besides a :class:`MotionPlan`: ``q, qd, qdd`` at times ``t`` (s)."""
+
+    def evaluate(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]: ...
+
+
+def _commanded(plan: MotionPlan | Commanded, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    if isinstance(plan, MotionPlan):
+        return evaluate_plan(plan, t)
+    return plan.evaluate(t)
+
+
+def _track(
+    plan: MotionPlan | Commanded, t: FloatArray, hz: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Actual motion: the command through ``w²/(s² + 2ws + w²)``, sampled at ``t``."""
     step = 0.002
     grid = np.arange(0.0, t[-1] + 2 * step, step)
-    q_c, qd_c, qdd_c = evaluate_plan(plan, grid)
+    q_c, qd_c, qdd_c = _commanded(plan, grid)
     w = 2 * np.pi * hz
     b, a, _ = signal.cont2discrete(([w * w], [1.0, 2 * w, w * w]), step, method="bilinear")
     b = np.ravel(b)
@@ -167,10 +182,12 @@ class Measured:
     tau: FloatArray
 
 
-def run_plant(plant: Plant, plan: MotionPlan, t: FloatArray, *, rng: np.random.Generator) -> Measured:
-    """Drive the plant along a plan and measure at times ``t``."""
+def run_plant(
+    plant: Plant, plan: MotionPlan | Commanded, t: FloatArray, *, rng: np.random.Generator
+) -> Measured:
+    """Drive the plant along a plan (or any :class:`Commanded` motion) and measure at times ``t``."""
     if plant.tracking_hz is None:
-        q, qd, qdd = evaluate_plan(plan, t)
+        q, qd, qdd = _commanded(plan, t)
     else:
         q, qd, qdd = _track(plan, t, plant.tracking_hz)
     tau = plant.drive_torque(q, qd, qdd)
