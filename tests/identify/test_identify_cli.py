@@ -89,3 +89,19 @@ def test_simulate_on_the_twin_plant_gives_data_that_identify_the_twin_again(twin
     assert second["gear_efficiency"] == pytest.approx(first["gear_efficiency"], abs=5e-3)
     card = json.loads((again / TWIN_CARD_FILE).read_text())
     assert min(card["fit"]["torque_r2"]) > 0.99
+
+
+def test_a_twins_plants_are_its_own_physics_and_the_lab_robot_it_twins(twin, rng):
+    from joulepath.dynamics import motor_torque
+    from joulepath.sim import make_plant
+
+    robot = joulepath.load_robot(twin)
+    nominal = joulepath.load_robot("irb120")
+    q, qd, qdd = rng.normal(scale=0.5, size=(3, 20, 6))
+    lab_of_twin = make_plant("lab", robot).drive_torque(q, qd, qdd)
+    np.testing.assert_array_equal(lab_of_twin, make_plant("lab", nominal).drive_torque(q, qd, qdd))
+    own = motor_torque(
+        robot.inverse_dynamics(q, qd, qdd, friction=robot.friction), qd, robot.calibration.gear_efficiency
+    )
+    np.testing.assert_allclose(make_plant("sim", robot).drive_torque(q, qd, qdd), own, rtol=1e-12)
+    np.testing.assert_allclose(make_plant(str(twin), nominal).drive_torque(q, qd, qdd), own, rtol=1e-12)

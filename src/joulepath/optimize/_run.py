@@ -190,16 +190,6 @@ def rank_joints_by_energy(robot: Robot, path: Trajectory) -> tuple[int, ...]:
     return tuple(int(j) + 1 for j in np.argsort(-per_joint))
 
 
-def _lab_robot(robot: Robot) -> Robot:
-    """The robot the lab plant emulates: a twin is verified on the lab robot it is a twin of."""
-    twin_of = robot.calibration.twin_of if robot.calibration is not None else None
-    if twin_of is None:
-        return robot
-    from joulepath.dynamics import load_robot
-
-    return load_robot(twin_of)
-
-
 def _plant_energy(plant: Any, traj: Trajectory) -> float:
     tau = plant.drive_torque(traj.q, traj.qd, traj.qdd)
     return float(path_energy(tau, traj.qd, traj.dt).total)
@@ -356,7 +346,7 @@ def verify_move(
         e_sur_def, e_sur_opt = float(e_sur[0]), float(e_sur[1])
     from joulepath.sim import make_plant
 
-    lab = make_plant("lab", _lab_robot(robot))
+    lab = make_plant("lab", robot)  # a twin: the lab robot it twins
     e_lab_def, e_lab_opt = _plant_energy(lab, default), _plant_energy(lab, optimized)
     summary = MoveSummary(
         robot=robot.name,

@@ -111,9 +111,23 @@ def twin_plant(folder: str, robot: Robot) -> Plant:
 
 
 def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
-    """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot), or a twin folder."""
+    """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot), or a twin folder.
+
+    For a twin (``robot.calibration``), ``sim`` is the twin's own identified physics and
+    ``lab`` the lab plant of the robot it is a twin of.
+    """
     if name not in PLANTS and Path(name).is_dir():
         return twin_plant(name, robot)
+    calibration = robot.calibration
+    if calibration is not None and name == "sim":  # a twin's nominal physics are its identified ones
+        return Plant(
+            name="sim", robot=robot, friction=robot.friction, gear_efficiency=calibration.gear_efficiency
+        )
+    if calibration is not None and calibration.twin_of is not None:
+        # a twin is measured on the lab robot it is a twin of, never on a perturbed copy of itself
+        from joulepath.dynamics import load_robot
+
+        robot = load_robot(calibration.twin_of)
     if name == "sim":
         return Plant(name="sim", robot=robot, friction=NOMINAL_FRICTION)
     if name == "lab":
