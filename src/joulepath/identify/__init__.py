@@ -28,6 +28,7 @@ from joulepath.identify._fit import (
     IdentifyOptions,
     identify,
     joint_side,
+    score_prediction,
 )
 from joulepath.identify._regressor import (
     RANK_TOLERANCE,
@@ -61,6 +62,7 @@ __all__ = [
     "link_inertials",
     "min_eigenvalues",
     "pseudo_inertia",
+    "score_prediction",
     "simulate_excitation",
     "to_log_cholesky",
     "triangle_margins",

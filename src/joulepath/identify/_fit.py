@@ -241,7 +241,8 @@ def _excitation(A: FloatArray, names: tuple[str, ...]) -> tuple[float, str]:
     return cond, names[int(np.argmax(np.abs(vt[-1])))]
 
 
-def _scores(pred: FloatArray, data: IdentificationData) -> FitScores:
+def score_prediction(pred: FloatArray, data: IdentificationData) -> FitScores:
+    """Scores of predicted (motor-side) torques ``pred`` ``(N, n)`` against the data's."""
     tau = data.tau
     res = pred - tau
     sst = ((tau - tau.mean(axis=0)) ** 2).sum(axis=0)
@@ -449,8 +450,10 @@ def identify(
         condition_number=cond,
         weakest=weakest,
         weights=w,
-        fit=_scores(motor_torque(Y @ phi + friction.torque(fit_data.qd), fit_data.qd, eta), fit_data),
-        held_out=None if held is None else _scores(predict(held), held),
+        fit=score_prediction(
+            motor_torque(Y @ phi + friction.torque(fit_data.qd), fit_data.qd, eta), fit_data
+        ),
+        held_out=None if held is None else score_prediction(predict(held), held),
         min_pseudo_inertia_eig=eig,
         consistent=bool(np.all(eig > 0)),
         options=options,
@@ -468,4 +471,5 @@ __all__ = [
     "REST_SPEED",
     "identify",
     "joint_side",
+    "score_prediction",
 ]
