@@ -186,3 +186,25 @@ def test_too_few_samples_and_bad_arrays_are_refused(irb120):
 def test_load_robot_refuses_a_folder_that_is_not_a_twin(tmp_path):
     with pytest.raises(joulepath.errors.InvalidRobotDescription, match="not a twin"):
         joulepath.load_robot(tmp_path)
+
+
+def test_generic_log_with_accelerations_recovers_the_sim_plant_exactly(irb120, tmp_path):
+    """The file route: a generic CSV (rad, with ddq columns) read by data_from_logs."""
+    from joulepath.identify import data_from_logs
+
+    sim = Plant(name="sim", robot=irb120, friction=NOMINAL_FRICTION)
+    d = _exact_data(irb120, sim, 10, seed=21)
+    t = np.cumsum(np.r_[0.0, d.dt[:-1]])
+    cols = {"t": t}
+    for i in range(6):
+        for name, arr in (("q", d.q), ("dq", d.qd), ("ddq", d.qdd), ("tau", d.tau)):
+            cols[f"{name}{i + 1}"] = arr[:, i]
+    header = ",".join(cols)
+    rows = np.column_stack(list(cols.values()))
+    path = tmp_path / "generic.csv"
+    path.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in r) for r in rows) + "\n")
+    data = data_from_logs([path], irb120)
+    assert data.n_samples == d.n_samples and len(data.data_hash) == 64
+    result = identify(data, irb120, IdentifyOptions(gear_efficiency=1.0))
+    truth = base_parameters(irb120).project(true_parameters(irb120))
+    assert _relative_error(result.beta_ls, truth) < 1e-9
