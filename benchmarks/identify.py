@@ -215,6 +215,13 @@ def main(n_tasks: int, n_loop: int) -> None:
                 f"| {name} | {np.median(arr[:, 0]):.2f} | {np.median(arr[:, 1]):.2f} | {np.median(gap):.2f} | "
                 f"{gap.max():.2f} |"
             )
+    lines += [
+        "",
+        "Not in this section: models trained on SDV rows (the synthetic-data section measures them on their "
+        "own data), the grey-box models' torque R² (they predict energy only; the twin's torque R² on held-out "
+        "samples is on its card.json), and lab runs with the plant's tracking lag and noise for the optimized "
+        "paths (their lab energy is the lab drives' torque on the planned motion, as `optimize` verifies it).",
+    ]
     text = "\n".join(lines)
     print(text)
     write_section("identify", text)
