@@ -755,7 +755,6 @@ def _optimum(robot: Any, res: Any) -> dict[str, Any]:
     reference starts from the minimum-jerk move (``benchmarks/optimizer_peers.py`` also
     starts it from the optimized path and keeps the better of the two).
     """
-    from joulepath.dynamics import NOMINAL_FRICTION
     from joulepath.optimize import acceleration_limit
     from joulepath.optimize._reference import reference_optimum
 
@@ -763,7 +762,7 @@ def _optimum(robot: Any, res: Any) -> dict[str, Any]:
     amax = acceleration_limit(robot, s.config["accel_time"])
     q0, qf = np.asarray(s.start_rad), np.asarray(s.end_rad)
     solves = [
-        reference_optimum(robot, q0, qf, s.duration_s, friction=NOMINAL_FRICTION, acceleration_limit=amax)
+        reference_optimum(robot, q0, qf, s.duration_s, friction=robot.friction, acceleration_limit=amax)
     ]
     ok = [r for r in solves if r.max_violation < 1e-6]
     best = min(ok or solves, key=lambda r: r.energy_fine_J)
