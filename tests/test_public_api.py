@@ -14,6 +14,7 @@ PACKAGES = [
     "joulepath.description",
     "joulepath.kinematics",
     "joulepath.dynamics",
+    "joulepath.identify",
     "joulepath.trajectory",
     "joulepath.data",
     "joulepath.export",
@@ -52,6 +53,7 @@ ALLOWED = {
     "export": {"description", "kinematics", "dynamics", "trajectory", "data"},
     "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb"},
     "learn": {"data", "dynamics", "energy"},
+    "identify": {"data", "description", "dynamics", "energy", "trajectory", "sim"},
     "synth": {"data", "description", "kinematics", "dynamics"},
     "evolve": set(),
     "optimize": {

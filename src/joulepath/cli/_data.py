@@ -3,12 +3,36 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from joulepath.cli._common import check_out_file, check_out_folder, console, robot_inputs
 
+if TYPE_CHECKING:
+    from joulepath.dynamics import Robot
+
 COLLECT_FILES = ("JPCollect.mod", "JPMeasure.mod")
+EXCITE_FILES = ("JPExcite.mod", "JPMeasure.mod")
+
+
+def _excitation_programs(robot: Robot, *, range_set: str, seed: int) -> dict[str, str]:
+    """JPExcite.mod (an optimised exciting trajectory, one period) and the measurement module."""
+    from joulepath.export import excitation_module, measurement_module
+    from joulepath.identify import design_excitation
+
+    with console.status("designing an exciting trajectory (condition number of the regressor)..."):
+        design = design_excitation(robot, range_set=range_set, seed=seed)
+    path = design.trajectory.sample(0.025)
+    console.print(
+        f"exciting trajectory: {design.trajectory.end_time:g} s, condition number "
+        f"{design.condition_number:.1f} (random start {design.condition_number_start:.1f})"
+    )
+    return {
+        "JPExcite.mod": excitation_module(robot, path.q, path.qd, design.trajectory.end_time),
+        "JPMeasure.mod": measurement_module(),
+    }
+
 
 rapid_app = typer.Typer(help="Write RAPID programs for the ABB controller.", no_args_is_help=True)
 
@@ -19,7 +43,11 @@ def rapid_collect(
     robot: str = typer.Option("irb120", help="Robot name or .irml/.urdf path."),
     moves: int = typer.Option(1000, min=1, help="Number of random moves."),
     range_set: str = typer.Option("collection", help="Joint bounds: collection (App. D.1), lab, nominal."),
-    mode: str = typer.Option("rand", help="rand: draw on the controller; table: embed the moves of --seed."),
+    mode: str = typer.Option(
+        "rand",
+        help="rand: draw on the controller; table: embed the moves of --seed; excitation: an exciting "
+        "trajectory for `joulepath identify` (JPExcite.mod).",
+    ),
     seed: int = typer.Option(
         0, min=0, max=2**32 - 1, help="Seed of the moves (table) or of the controller's generator (rand)."
     ),
@@ -37,16 +65,20 @@ def rapid_collect(
     from joulepath.errors import InvalidInput
     from joulepath.export import collection_programs
 
-    check_out_folder(out, files=COLLECT_FILES, inputs=robot_inputs(robot))
-    existing = [name for name in COLLECT_FILES if (out / name).exists()]
+    files = EXCITE_FILES if mode == "excitation" else COLLECT_FILES
+    check_out_folder(out, files=files, inputs=robot_inputs(robot))
+    existing = [name for name in files if (out / name).exists()]
     if existing and not force:
         raise InvalidInput(
             f"{out}: already holds {' and '.join(existing)}; pass --force to replace "
             f"{'them' if len(existing) > 1 else 'it'}, or choose another --out"
         )
-    programs = collection_programs(
-        load_robot(robot), n_moves=moves, range_set=range_set, mode=mode, seed=seed
-    )
+    if mode == "excitation":
+        programs = _excitation_programs(load_robot(robot), range_set=range_set, seed=seed)
+    else:
+        programs = collection_programs(
+            load_robot(robot), n_moves=moves, range_set=range_set, mode=mode, seed=seed
+        )
     make_folder(out)
     for name, text in programs.items():
         atomic_write_text(out / name, text)
@@ -56,7 +88,9 @@ def rapid_collect(
 
 def simulate(
     out: Path = typer.Option(..., "--out", help="Log file (.csv) for one run, or a folder for --plan."),
-    plant: str = typer.Option("lab", help="sim (nominal twin) or lab (emulated real robot)."),
+    plant: str = typer.Option(
+        "lab", help="sim (nominal twin), lab (emulated real robot) or a twin folder (`joulepath identify`)."
+    ),
     moves: int = typer.Option(1000, min=1, help="Number of random moves."),
     seed: int = typer.Option(
         0, min=0, max=2**32 - 1, help="Seed of the random moves and of the plant's noise."
@@ -64,8 +98,19 @@ def simulate(
     plan: str = typer.Option("", help="'thesis': real, sim, micro and test datasets in one go."),
     robot: str = typer.Option("irb120", help="Robot name or .irml path."),
     workers: int = typer.Option(2, min=1, help="Processes for --plan."),
+    mode: str = typer.Option(
+        "moves", help="moves: random moves; excitation: an exciting trajectory for `joulepath identify`."
+    ),
+    periods: int = typer.Option(3, min=1, help="--mode excitation: periods of the 10 s trajectory."),
+    harmonics: int = typer.Option(5, min=1, max=20, help="--mode excitation: harmonics per joint."),
 ) -> int:
     """Simulate data collection: random moves on the sim or lab plant, logged like the controller."""
+    if mode not in ("moves", "excitation"):
+        raise typer.BadParameter(f"unknown mode {mode!r}; use moves or excitation", param_hint="--mode")
+    if mode == "excitation" and plan:
+        raise typer.BadParameter(
+            "--plan runs random moves; drop --plan for --mode excitation", param_hint="--mode"
+        )
     from joulepath.data import moves_sidecar_path as sidecar_path
     from joulepath.sim import simulate as run
     from joulepath.sim import simulate_plan
@@ -77,7 +122,7 @@ def simulate(
     elif plan:
         check_out_folder(out, inputs=inputs)
     else:
-        name = f"{plant}-{seed}.csv"
+        name = f"{Path(plant).name if Path(plant).is_dir() else plant}-{seed}.csv"
         check_out_folder(out, files=(name, sidecar_path(Path(name)).name), inputs=inputs)
     if plan:
         if plan != "thesis":
@@ -95,12 +140,34 @@ def simulate(
             )
         console.print(f"wrote {len(results)} logs under {out / 'logs'} and tables {out}/<name>.parquet")
         return 0
-    target = out if out.suffix == ".csv" else out / f"{plant}-{seed}.csv"
+    target = out if out.suffix == ".csv" else out / name
+    if mode == "excitation":
+        return _simulate_excitation(
+            target, plant=plant, robot=robot, seed=seed, periods=periods, harmonics=harmonics
+        )
     with console.status(f"simulating {moves} moves on the {plant} plant..."):
         res = run(target, plant=plant, n_moves=moves, seed=seed, robot=robot)
     console.print(
         f"wrote {res.log} ({res.n_rows:,} rows, {res.n_moves} moves: simulated {res.duration_s:.1f} s "
         f"of robot motion) and {res.moves}"
+    )
+    return 0
+
+
+def _simulate_excitation(
+    target: Path, *, plant: str, robot: str, seed: int, periods: int, harmonics: int
+) -> int:
+    from joulepath import load_robot
+    from joulepath.identify import design_excitation, simulate_excitation
+
+    r = load_robot(robot)
+    with console.status("designing an exciting trajectory (condition number of the regressor)..."):
+        design = design_excitation(r, periods=periods, harmonics=harmonics, seed=seed)
+    with console.status(f"simulating {design.trajectory.end_time:g} s of excitation on the {plant} plant..."):
+        rows, seconds = simulate_excitation(target, design, r, plant=plant, seed=seed)
+    console.print(
+        f"wrote {target} ({rows:,} rows: simulated {seconds:.1f} s of an exciting trajectory, condition "
+        f"number {design.condition_number:.1f}; random start {design.condition_number_start:.1f})"
     )
     return 0
 

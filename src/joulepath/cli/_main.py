@@ -10,6 +10,7 @@ import typer
 from joulepath.cli._cycle import cycle
 from joulepath.cli._data import ingest, rapid_app, simulate
 from joulepath.cli._experiment import demo, run
+from joulepath.cli._identify import identify
 from joulepath.cli._learn import importance, train
 from joulepath.cli._optimize import bench_optimizers, optimize
 from joulepath.cli._robot import robot_app
@@ -27,6 +28,7 @@ app.add_typer(robot_app, name="robot")
 app.add_typer(rapid_app, name="rapid")
 app.command("simulate")(simulate)
 app.command("ingest")(ingest)
+app.command("identify")(identify)
 app.command("train")(train)
 app.command("importance")(importance)
 app.command("synth")(synth)

@@ -1,5 +1,13 @@
 """Rigid-body dynamics: the :class:`Robot`, two inverse-dynamics implementations, friction."""
 
+from joulepath.dynamics._calibration import (
+    TWIN_CARD_FILE,
+    TWIN_FRICTION_FILE,
+    TWIN_ROBOT_FILE,
+    Calibration,
+    IdentifiedFriction,
+    motor_torque,
+)
 from joulepath.dynamics._derivatives import DynamicsDerivatives, inverse_dynamics_derivatives
 from joulepath.dynamics._friction import (
     NOMINAL_FRICTION,
@@ -14,18 +22,24 @@ from joulepath.dynamics._rnea import PinocchioRnea
 from joulepath.dynamics._robot import METHODS, Robot, load_robot
 
 __all__ = [
+    "Calibration",
     "CoulombViscousFriction",
     "DynamicsDerivatives",
     "ElastoPlasticFriction",
     "Friction",
     "FrictionSum",
+    "IdentifiedFriction",
     "METHODS",
     "NOMINAL_FRICTION",
     "PinocchioRnea",
     "Robot",
+    "TWIN_CARD_FILE",
+    "TWIN_FRICTION_FILE",
+    "TWIN_ROBOT_FILE",
     "friction_derivative",
     "inverse_dynamics_derivatives",
     "lagrange_euler",
     "load_robot",
     "mass_matrix_le",
+    "motor_torque",
 ]

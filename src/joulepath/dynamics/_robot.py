@@ -27,7 +27,8 @@ from joulepath.description import (
     read_irml,
 )
 from joulepath.description._check import check_chain
-from joulepath.dynamics._friction import Friction
+from joulepath.dynamics._calibration import Calibration, read_calibration, twin_paths
+from joulepath.dynamics._friction import NOMINAL_FRICTION, Friction
 from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le
 from joulepath.dynamics._rnea import PinocchioRnea
 from joulepath.errors import InvalidInput, InvalidRobotDescription
@@ -56,11 +57,18 @@ class Robot:
         description: RobotDescription | None = None,
         source: str | None = None,
         payload: Inertial | None = None,
+        calibration: Calibration | None = None,
     ) -> None:
         self.chain = chain
         self.description = description
         self.source = source
         self.payload = payload
+        self.calibration = calibration
+
+    @property
+    def friction(self) -> Friction:
+        """The joint friction of this robot's physics: identified for a twin, else ``NOMINAL_FRICTION``."""
+        return self.calibration.friction if self.calibration is not None else NOMINAL_FRICTION
 
     # ------------------------------------------------------------------ facts
     @property
@@ -260,7 +268,13 @@ class Robot:
             from dataclasses import replace
 
             chain = replace(self.chain, masses=masses, coms=coms, inertias=inertias)
-        return Robot(chain, description=self.description, source=self.source, payload=load)
+        return Robot(
+            chain,
+            description=self.description,
+            source=self.source,
+            payload=load,
+            calibration=self.calibration,
+        )
 
     # ----------------------------------------------------------------- checks
     def check_physical(self) -> list[Finding]:
@@ -298,7 +312,10 @@ class Robot:
 def load_robot(
     name_or_path: str | os.PathLike[str], *, tool_frame: str | None = None, checked: bool = True
 ) -> Robot:
-    """Load a bundled robot by name (``"irb120"``) or a robot file (``.irml`` or ``.urdf``).
+    """Load a bundled robot by name (``"irb120"``), a robot file (``.irml`` or ``.urdf``) or a twin folder.
+
+    A twin folder (written by ``joulepath identify``) gives its identified robot with
+    its identified friction and drive losses (:attr:`Robot.calibration`).
 
     The robot is checked on load (:meth:`Robot.check_physical`): a description with
     an error (a non-positive mass, an inertia that is not positive definite or breaks
@@ -329,6 +346,8 @@ def load_robot(
     6
     """
     text = os.fspath(name_or_path)
+    if text not in PRESETS and Path(text).is_dir():
+        return _load_twin(Path(text), checked=checked)
     if text in PRESETS:
         path = preset_path(text)
     else:
@@ -347,6 +366,14 @@ def load_robot(
         raise InvalidRobotDescription(f"{path}: unknown robot file type {suffix!r}; use .irml or .urdf")
     if checked:
         _refuse_unphysical(robot, text)
+    return robot
+
+
+def _load_twin(folder: Path, *, checked: bool) -> Robot:
+    """A twin folder (``joulepath identify --out``): its IRML robot with its identified friction."""
+    robot_file, friction_file = twin_paths(folder)
+    robot = load_robot(robot_file, checked=checked)
+    robot.calibration = read_calibration(friction_file, robot.n_joints)
     return robot
 
 

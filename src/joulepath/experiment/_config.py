@@ -36,9 +36,14 @@ Example (``joulepath/experiment/presets/demo.toml``, abridged)::
     tasks = 3
     generations = 30
 
-Sections left out take their defaults; ``[synth]`` and ``[bench]`` are skipped unless
-they are given (``methods`` non-empty, ``tasks`` ≥ 1). A wrong key or value stops the
-run at once with the file, the section and key, and the allowed keys or values. Every
+    [identify]            # optional: a calibrated twin from the training logs (joulepath identify)
+    enabled = true
+    loop_tasks = 3        # tasks optimized on the twin: predicted against realized saving
+
+Sections left out take their defaults; ``[synth]``, ``[bench]`` and ``[identify]`` are
+skipped unless they are given (``methods`` non-empty, ``tasks`` ≥ 1, ``enabled = true``).
+A wrong key or value stops the run at once with the file, the section and key, and the
+allowed keys or values. Every
 count, ``jobs`` and ``seed`` has a range (:data:`BOUNDS`), checked before anything runs.
 """
 
@@ -134,6 +139,20 @@ class BenchStage:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class IdentifyStage:
+    """A calibrated twin identified from the training logs (off unless ``enabled``).
+
+    Scores the twin and the nominal physics on the test logs, then optimizes
+    ``loop_tasks`` random tasks of ``range_set`` on the twin and compares the saving it
+    predicts with the one realized on the lab plant.
+    """
+
+    enabled: bool = False
+    loop_tasks: int = 3
+    range_set: str = "lab"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Experiment:
     """A whole study: data -> synthetic data -> models -> importance -> optimized moves -> benchmark."""
 
@@ -148,6 +167,7 @@ class Experiment:
     importance: ImportanceStage = field(default_factory=ImportanceStage)
     optimize: OptimizeStage = field(default_factory=OptimizeStage)
     bench: BenchStage = field(default_factory=BenchStage)
+    identify: IdentifyStage = field(default_factory=IdentifyStage)
     source: str = ""
 
 
@@ -158,6 +178,7 @@ SECTIONS: dict[str, type] = {
     "importance": ImportanceStage,
     "optimize": OptimizeStage,
     "bench": BenchStage,
+    "identify": IdentifyStage,
 }
 
 _ALLOWED: dict[str, tuple[str, ...]] = {
@@ -185,6 +206,7 @@ BOUNDS: dict[str, dict[str, tuple[int, int]]] = {
     "importance": {"max_rows": (1, 1_000_000)},
     "optimize": {"tasks": (0, 1_000), "generations": (1, 10_000), "population": (4, 10_000)},
     "bench": {"tasks": (0, 10_000), "generations": (1, 10_000), "population": (4, 10_000)},
+    "identify": {"loop_tasks": (0, 1_000)},
 }
 """Allowed range (inclusive) of every integer setting, by section (``""``: top level).
 

@@ -38,6 +38,7 @@ import numpy as np
 import pandas as pd
 
 from joulepath._io import atomic_write_text
+from joulepath.errors import InvalidInput
 from joulepath.experiment._config import Experiment, resolve_logs
 
 Progress = Callable[[str, int, int], None]
@@ -225,6 +226,10 @@ def run_experiment(
         stages["bench"] = _bench_stage(ctx, model_key, stages["importance"]["key"])
     else:
         _drop_stage(ctx, "bench", "bench")
+    if exp.identify.enabled:
+        stages["identify"] = _identify_stage(ctx, keys["data"])
+    else:
+        _drop_stage(ctx, "identify", "identify")
     tasks = pd.read_csv(root / "optimize" / "tasks.csv")
     ok = tasks[tasks["limits_ok"].astype(bool)] if len(tasks) else tasks
     summary: dict[str, Any] = {
@@ -750,7 +755,6 @@ def _optimum(robot: Any, res: Any) -> dict[str, Any]:
     reference starts from the minimum-jerk move (``benchmarks/optimizer_peers.py`` also
     starts it from the optimized path and keeps the better of the two).
     """
-    from joulepath.dynamics import NOMINAL_FRICTION
     from joulepath.optimize import acceleration_limit
     from joulepath.optimize._reference import reference_optimum
 
@@ -758,7 +762,7 @@ def _optimum(robot: Any, res: Any) -> dict[str, Any]:
     amax = acceleration_limit(robot, s.config["accel_time"])
     q0, qf = np.asarray(s.start_rad), np.asarray(s.end_rad)
     solves = [
-        reference_optimum(robot, q0, qf, s.duration_s, friction=NOMINAL_FRICTION, acceleration_limit=amax)
+        reference_optimum(robot, q0, qf, s.duration_s, friction=robot.friction, acceleration_limit=amax)
     ]
     ok = [r for r in solves if r.max_violation < 1e-6]
     best = min(ok or solves, key=lambda r: r.energy_fine_J)
@@ -848,6 +852,112 @@ def _bench_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str
         return {}
 
     return _stage(ctx, "bench", "bench", key, body)
+
+
+# ----------------------------------------------------------------------------- identify
+def _identify_stage(ctx: _Context, data_key: str) -> dict[str, Any]:
+    """A twin from the training logs; twin and nominal physics on the test logs; the loop closed."""
+    exp, st = ctx.exp, ctx.exp.identify
+    key = _hash("identify", data_key, _robot_key(exp.robot), asdict(st), exp.seed)
+
+    def logs(name: str, given: tuple[str, ...]) -> list[str]:
+        paths = resolve_logs(exp, given) or [str(ctx.root / "data" / "logs" / f"{name}.csv")]
+        missing = [p for p in paths if not Path(p).is_file()]
+        if missing:
+            raise InvalidInput(
+                f"[identify] needs the {name} logs; {missing[0]} is missing (run the data stage)"
+            )
+        return paths
+
+    def body(folder: Path) -> dict[str, Any]:
+        from joulepath.dynamics import NOMINAL_FRICTION, load_robot
+        from joulepath.energy import path_energy
+        from joulepath.identify import (
+            IdentifyOptions,
+            data_from_logs,
+            identify,
+            score_prediction,
+            twin_robot,
+            write_twin,
+        )
+        from joulepath.optimize import OptimizeConfig, optimize_move, random_tasks
+
+        robot = load_robot(exp.robot)
+        ctx.progress("identify", 0, 2 + st.loop_tasks)
+        ident = identify(data_from_logs(logs("train", exp.data.train_logs), robot), robot, IdentifyOptions())
+        write_twin(ident, robot, folder / "twin")
+        twin = twin_robot(robot, ident)
+        test = data_from_logs(logs("test", exp.data.test_logs), robot)
+        nominal = robot.inverse_dynamics(test.q, test.qd, test.qdd, friction=NOMINAL_FRICTION)
+        rows = []
+        for label, pred in (
+            ("twin", ident.motor_torque(robot, test.q, test.qd, test.qdd)),
+            ("nominal physics + nominal friction", nominal),
+        ):
+            sc = score_prediction(pred, test)
+            rows.append(
+                {
+                    "model": label,
+                    "samples": sc.n_samples,
+                    "torque_r2_worst_joint": min(sc.torque_r2),
+                    "energy_r2": sc.energy_r2,
+                    "energy_error_pct": sc.energy_error_pct,
+                }
+            )
+        atomic_write_text(folder / "scores.csv", pd.DataFrame(rows).to_csv(index=False))
+        ctx.progress("identify", 2, 2 + st.loop_tasks)
+        assert twin.calibration is not None
+        cal = twin.calibration
+
+        def predicted(path: Any) -> float:
+            tau = twin.inverse_dynamics(path.q, path.qd, path.qdd, friction=twin.friction)
+            return float(path_energy(cal.motor_torque(tau, path.qd), path.qd, path.dt).total)
+
+        seed = int(np.random.SeedSequence(exp.seed).spawn(6)[5].generate_state(1)[0])
+        loop = []
+        for k, (q0, qf, T) in enumerate(
+            random_tasks(robot, st.loop_tasks, seed=seed, range_set=st.range_set)
+        ):
+            res = optimize_move(twin, q0, qf, T, OptimizeConfig(seed=exp.seed))
+            e_def, e_opt = predicted(res.default), predicted(res.optimized)
+            s = res.summary
+            loop.append(
+                {
+                    "task": k,
+                    "duration_s": T,
+                    "limits_ok": s.limits_ok,
+                    "predicted_saved_pct": 100 * (e_def - e_opt) / e_def,
+                    "realized_saved_lab_pct": s.saved_lab_pct,
+                    "energy_default_lab_J": s.energy_default_lab_J,
+                    "energy_optimized_lab_J": s.energy_optimized_lab_J,
+                }
+            )
+            ctx.progress("identify", 3 + k, 2 + st.loop_tasks)
+        frame = pd.DataFrame(loop)
+        atomic_write_text(folder / "loop.csv", frame.to_csv(index=False))
+        gap = (
+            float((frame["predicted_saved_pct"] - frame["realized_saved_lab_pct"]).abs().median())
+            if len(frame)
+            else None
+        )
+        ctx.tell(
+            f"identify: twin energy R² {rows[0]['energy_r2']:.4f} on the test logs (nominal physics "
+            f"{rows[1]['energy_r2']:.4f}); gear efficiency {ident.gear_efficiency:.3f}"
+            + (
+                f"; predicted vs realized saving: median gap {gap:.2f} pp over {len(frame)} tasks"
+                if gap is not None
+                else ""
+            )
+        )
+        return {
+            "condition_number": ident.condition_number,
+            "gear_efficiency": ident.gear_efficiency,
+            "twin_energy_r2": rows[0]["energy_r2"],
+            "nominal_energy_r2": rows[1]["energy_r2"],
+            "loop_median_gap_pp": gap,
+        }
+
+    return _stage(ctx, "identify", "identify", key, body)
 
 
 def _plot_bench(table: pd.DataFrame, path: Path) -> None:

@@ -148,7 +148,7 @@ class TrajectoryProblem:
     def energy(self, traj: Trajectory) -> tuple[FloatArray, FloatArray | None]:
         """Unpenalized fitness energy of paths (J) and torques where computed."""
         if self.fitness == "physics":
-            return physics_energy(self.robot, traj)
+            return physics_energy(self.robot, traj, friction=self.robot.friction)
         P, n = traj.q.shape[0], traj.q.shape[1]
         total = np.zeros(P)
         cache: dict[tuple[str, ...], FloatArray] = {}

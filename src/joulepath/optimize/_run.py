@@ -12,7 +12,7 @@ import numpy as np
 
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
-from joulepath.dynamics import NOMINAL_FRICTION, Robot
+from joulepath.dynamics import Robot
 from joulepath.energy import joint_power, path_energy
 from joulepath.errors import InvalidInput, InvalidModel, LimitViolation
 from joulepath.optimize._problem import FITNESS, PARAMETRIZATIONS, TrajectoryProblem
@@ -115,7 +115,8 @@ class MoveSummary:
     """Everything measured about one optimized move (``result.json``, one key per field).
 
     Energies are ``Σ |tau qd| dt`` on the physics model (nominal rigid body and
-    ``NOMINAL_FRICTION``) at the 25 ms samples; ``*_fine_J`` is the same on a grid ten
+    ``NOMINAL_FRICTION``, or a twin's identified parameters and friction:
+    :attr:`Robot.friction`) at the 25 ms samples; ``*_fine_J`` is the same on a grid ten
     times finer (the integral the samples approximate). ``saved_pct`` compares the
     optimized path with the controller-like minimum-jerk move of the same duration.
     Limits are checked on the fine grid. ``saved_vs_initial_best_pct`` is the thesis'
@@ -243,12 +244,12 @@ def check_default_feasible(
     dt = SAMPLE_PERIOD
     amax = acceleration_limit(robot, accel_time)
     report = check_limits(
-        robot, default_fine(q0, qf, duration, dt), friction=NOMINAL_FRICTION, acceleration_limit=amax
+        robot, default_fine(q0, qf, duration, dt), friction=robot.friction, acceleration_limit=amax
     )
     if report.ok:
         return
     shortest = shortest_feasible_duration(
-        robot, q0, qf, dt=dt, friction=NOMINAL_FRICTION, acceleration_limit=amax, longest=MAX_DURATION
+        robot, q0, qf, dt=dt, friction=robot.friction, acceleration_limit=amax, longest=MAX_DURATION
     )
     hint = (
         f"the shortest duration whose default move respects every limit is {shortest:.3f} s: "
@@ -314,12 +315,12 @@ def verify_move(
     """Measure a search's result: physics energy, fine-grid limits, lab plant, TCP deviation."""
     optimized = outcome.path
     amax = None if not np.all(np.isfinite(task.acceleration_limit)) else task.acceleration_limit
-    e_def = energy_on_samples(robot, default, friction=NOMINAL_FRICTION)
-    e_opt = energy_on_samples(robot, optimized, friction=NOMINAL_FRICTION)
+    e_def = energy_on_samples(robot, default, friction=robot.friction)
+    e_opt = energy_on_samples(robot, optimized, friction=robot.friction)
     fine_def = default_fine(task.q_start, task.q_end, task.duration, task.dt)
-    e_def_fine = energy_on_samples(robot, fine_def, friction=NOMINAL_FRICTION)
-    e_opt_fine = energy_on_samples(robot, outcome.fine_path, friction=NOMINAL_FRICTION)
-    report = check_limits(robot, outcome.fine_path, friction=NOMINAL_FRICTION, acceleration_limit=amax)
+    e_def_fine = energy_on_samples(robot, fine_def, friction=robot.friction)
+    e_opt_fine = energy_on_samples(robot, outcome.fine_path, friction=robot.friction)
+    report = check_limits(robot, outcome.fine_path, friction=robot.friction, acceleration_limit=amax)
     e_sur_def = e_sur_opt = None
     if task.models:
         stack = Trajectory(
@@ -345,7 +346,7 @@ def verify_move(
         e_sur_def, e_sur_opt = float(e_sur[0]), float(e_sur[1])
     from joulepath.sim import make_plant
 
-    lab = make_plant("lab", robot)
+    lab = make_plant("lab", robot)  # a twin: the lab robot it twins
     e_lab_def, e_lab_opt = _plant_energy(lab, default), _plant_energy(lab, optimized)
     summary = MoveSummary(
         robot=robot.name,
@@ -380,7 +381,12 @@ def verify_move(
         iterations=outcome.iterations,
         evaluations=outcome.evaluations,
         wall_s=wall,
-        physics_model="nominal rigid body + NOMINAL_FRICTION; |tau*qd|*dt summed at dt = 0.025 s",
+        physics_model=(
+            "nominal rigid body + NOMINAL_FRICTION; |tau*qd|*dt summed at dt = 0.025 s"
+            if robot.calibration is None
+            else f"identified twin of {robot.calibration.twin_of} (rigid body + identified friction, "
+            "joint side); |tau*qd|*dt summed at dt = 0.025 s"
+        ),
         config=asdict(config),
     )
     return MoveResult(
@@ -427,7 +433,7 @@ def plot_run(result: MoveResult, robot: Robot, out: Path) -> list[Path]:
     fig = Figure(figsize=(8, 3.5))
     ax = fig.subplots()
     for traj, style, name in ((d, "--", "default"), (o, "-", "optimized")):
-        tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
+        tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=robot.friction)
         ax.plot(traj.t, joint_power(tau, traj.qd).sum(axis=1), style, label=name)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("Σ |τ·qd| [W]")

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from joulepath._typing import FloatArray
-from joulepath.dynamics import NOMINAL_FRICTION, Robot
+from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.evolve import DE, GA, MA, Termination, minimize
 from joulepath.optimize._gradient import GradientSettings, solve_move
@@ -90,7 +90,7 @@ def _gradient(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator
         task.q_start,
         task.q_end,
         task.duration,
-        friction=NOMINAL_FRICTION,
+        friction=task.robot.friction,
         settings=settings,
         rng=rng,
         acceleration_limit=task.acceleration_limit,

@@ -19,6 +19,8 @@ public); they are of the size reported for robots of this class.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 from scipy import signal
@@ -88,8 +90,44 @@ def perturbed_robot(robot: Robot, rng: np.random.Generator) -> Robot:
     return Robot(new, description=None, source=f"{robot.source} (perturbed)")
 
 
+def twin_plant(folder: str, robot: Robot) -> Plant:
+    """A twin folder (``joulepath identify --out``) as a plant: its identified physics, no noise.
+
+    The twin's identified rigid body, friction and gear efficiency turn the motion of
+    ``robot`` (the planned kinematics) into motor torque; nothing else is added.
+    """
+    from joulepath.dynamics import load_robot
+
+    twin = load_robot(folder)
+    if twin.calibration is None or twin.n_joints != robot.n_joints:
+        raise InvalidInput(f"{folder}: not a twin of a {robot.n_joints}-joint robot; give a twin folder")
+    return Plant(
+        name="twin",
+        robot=twin,
+        friction=twin.friction,
+        gear_efficiency=twin.calibration.gear_efficiency,
+        torque_noise=(0.0,) * robot.n_joints,
+    )
+
+
 def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
-    """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot)."""
+    """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot), or a twin folder.
+
+    For a twin (``robot.calibration``), ``sim`` is the twin's own identified physics and
+    ``lab`` the lab plant of the robot it is a twin of.
+    """
+    if name not in PLANTS and Path(name).is_dir():
+        return twin_plant(name, robot)
+    calibration = robot.calibration
+    if calibration is not None and name == "sim":  # a twin's nominal physics are its identified ones
+        return Plant(
+            name="sim", robot=robot, friction=robot.friction, gear_efficiency=calibration.gear_efficiency
+        )
+    if calibration is not None and calibration.twin_of is not None:
+        # a twin is measured on the lab robot it is a twin of, never on a perturbed copy of itself
+        from joulepath.dynamics import load_robot
+
+        robot = load_robot(calibration.twin_of)
     if name == "sim":
         return Plant(name="sim", robot=robot, friction=NOMINAL_FRICTION)
     if name == "lab":
@@ -109,14 +147,30 @@ def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
             speed_noise_deg_s=0.05,
             tracking_hz=12.0,
         )
-    raise InvalidInput(f"unknown plant {name!r}; use one of {', '.join(PLANTS)}")
+    raise InvalidInput(
+        f"unknown plant {name!r}; use one of {', '.join(PLANTS)}, or a twin folder (`joulepath identify`)"
+    )
 
 
-def _track(plan: MotionPlan, t: FloatArray, hz: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+class Commanded(Protocol):
+    """Any commanded motion besides a :class:`MotionPlan`: ``q, qd, qdd`` at times ``t`` (s)."""
+
+    def evaluate(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]: ...
+
+
+def _commanded(plan: MotionPlan | Commanded, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    if isinstance(plan, MotionPlan):
+        return evaluate_plan(plan, t)
+    return plan.evaluate(t)
+
+
+def _track(
+    plan: MotionPlan | Commanded, t: FloatArray, hz: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Actual motion: the command through ``w²/(s² + 2ws + w²)``, sampled at ``t``."""
     step = 0.002
     grid = np.arange(0.0, t[-1] + 2 * step, step)
-    q_c, qd_c, qdd_c = evaluate_plan(plan, grid)
+    q_c, qd_c, qdd_c = _commanded(plan, grid)
     w = 2 * np.pi * hz
     b, a, _ = signal.cont2discrete(([w * w], [1.0, 2 * w, w * w]), step, method="bilinear")
     b = np.ravel(b)
@@ -142,10 +196,12 @@ class Measured:
     tau: FloatArray
 
 
-def run_plant(plant: Plant, plan: MotionPlan, t: FloatArray, *, rng: np.random.Generator) -> Measured:
-    """Drive the plant along a plan and measure at times ``t``."""
+def run_plant(
+    plant: Plant, plan: MotionPlan | Commanded, t: FloatArray, *, rng: np.random.Generator
+) -> Measured:
+    """Drive the plant along a plan (or any :class:`Commanded` motion) and measure at times ``t``."""
     if plant.tracking_hz is None:
-        q, qd, qdd = evaluate_plan(plan, t)
+        q, qd, qdd = _commanded(plan, t)
     else:
         q, qd, qdd = _track(plan, t, plant.tracking_hz)
     tau = plant.drive_torque(q, qd, qdd)

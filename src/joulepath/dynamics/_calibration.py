@@ -1,0 +1,196 @@
+"""A calibrated twin: identified joint friction, drive losses, and the twin folder it lives in.
+
+A twin folder (``joulepath identify ... --out twin/``) is a contract declared here
+once, read by :func:`joulepath.load_robot` and written by :mod:`joulepath.identify`:
+
+* :data:`TWIN_ROBOT_FILE` — an IRML robot description with the identified
+  (physically consistent) link masses, centres of mass and inertias;
+* :data:`TWIN_FRICTION_FILE` — JSON: the identified :class:`IdentifiedFriction`
+  and the drives' gear efficiency;
+* :data:`TWIN_CARD_FILE` — JSON: what the twin was identified from and how well it fits.
+
+Loading a twin never executes code: the friction file is plain JSON checked field by field.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.errors import InvalidRobotDescription
+
+TWIN_ROBOT_FILE = "robot.irml"
+TWIN_FRICTION_FILE = "friction.json"
+TWIN_CARD_FILE = "card.json"
+TWIN_FILES = (TWIN_ROBOT_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE)
+FRICTION_FORMAT = "joulepath-friction/1"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class IdentifiedFriction:
+    """Per-joint friction as identified (joint side, N·m), linear in its parameters::
+
+        tau_f = coulomb * s + viscous * qd + offset * |s| + stribeck * exp(-(qd / stribeck_speed)²) * s
+
+    with ``s = tanh(qd / smoothing)``. ``offset`` is a torque that adds in both
+    directions of motion (a direction asymmetry of the Coulomb level) and vanishes at
+    rest; ``stribeck`` is the extra break-away torque at low speed (0 when not identified).
+    """
+
+    coulomb: tuple[float, ...]
+    viscous: tuple[float, ...]
+    offset: tuple[float, ...]
+    stribeck: tuple[float, ...]
+    stribeck_speed: float = 0.05
+    smoothing: float = 0.005
+    _p: FloatArray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        arr = np.array([self.coulomb, self.viscous, self.offset, self.stribeck], dtype=float)
+        if arr.ndim != 2 or not np.all(np.isfinite(arr)):
+            raise InvalidRobotDescription(
+                "friction: coulomb, viscous, offset and stribeck must be finite, one value per joint each"
+            )
+        if not (self.stribeck_speed > 0 and self.smoothing > 0):
+            raise InvalidRobotDescription("friction: stribeck_speed and smoothing must be positive (rad/s)")
+        object.__setattr__(self, "_p", arr)
+
+    @property
+    def n_joints(self) -> int:
+        return int(self._p.shape[1])
+
+    def torque(self, qd: FloatArray) -> FloatArray:
+        fc, fv, fo, fs = self._p
+        s = np.tanh(qd / self.smoothing)
+        bump = np.exp(-((qd / self.stribeck_speed) ** 2))
+        out: FloatArray = (fc + fs * bump) * s + fv * qd + fo * np.abs(s)
+        return out
+
+    def derivative(self, qd: FloatArray) -> FloatArray:
+        """``d tau_f / d qd`` per joint (analytic)."""
+        fc, fv, fo, fs = self._p
+        s = np.tanh(qd / self.smoothing)
+        ds = (1.0 - s * s) / self.smoothing
+        bump = np.exp(-((qd / self.stribeck_speed) ** 2))
+        dbump = -2.0 * qd / self.stribeck_speed**2 * bump
+        out: FloatArray = (fc + fs * bump) * ds + fs * dbump * s + fv + fo * np.sign(s) * ds
+        return out
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "coulomb": list(self.coulomb),
+            "viscous": list(self.viscous),
+            "offset": list(self.offset),
+            "stribeck": list(self.stribeck),
+            "stribeck_speed": self.stribeck_speed,
+            "smoothing": self.smoothing,
+        }
+
+
+def motor_torque(tau: FloatArray, qd: FloatArray, gear_efficiency: float) -> FloatArray:
+    """Motor-side torque of a joint torque through gears of efficiency ``eta``.
+
+    ``tau / eta`` while the motor drives (``tau * qd > 0``), ``tau * eta`` otherwise
+    (braking or at rest): the lab plant's drive-loss model.
+    """
+    if gear_efficiency == 1.0:
+        return tau
+    out: FloatArray = np.where(tau * qd > 0, tau / gear_efficiency, tau * gear_efficiency)
+    return out
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Calibration:
+    """What a twin adds to its robot description: friction, drive losses, origin."""
+
+    friction: IdentifiedFriction
+    gear_efficiency: float = 1.0
+    twin_of: str | None = None
+    folder: str | None = None
+
+    def motor_torque(self, tau: FloatArray, qd: FloatArray) -> FloatArray:
+        """Joint torque ``tau`` as the drives measure it (see :func:`motor_torque`)."""
+        return motor_torque(tau, qd, self.gear_efficiency)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "format": FRICTION_FORMAT,
+            "twin_of": self.twin_of,
+            "gear_efficiency": self.gear_efficiency,
+            "friction": self.friction.to_json(),
+        }
+
+
+def _floats(value: Any, where: str, n: int) -> tuple[float, ...]:
+    if not isinstance(value, list) or len(value) != n or not all(isinstance(v, int | float) for v in value):
+        raise InvalidRobotDescription(f"{where}: expected a list of {n} numbers (one per joint)")
+    return tuple(float(v) for v in value)
+
+
+def read_calibration(path: str | os.PathLike[str], n_joints: int) -> Calibration:
+    """Read and check a twin's friction file (plain JSON; nothing is executed)."""
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise InvalidRobotDescription(f"{p}: not a readable JSON friction file ({err})") from err
+    if not isinstance(data, dict) or data.get("format") != FRICTION_FORMAT:
+        raise InvalidRobotDescription(
+            f'{p}: not a joulepath friction file (expected "format": "{FRICTION_FORMAT}"); '
+            "write the twin again with `joulepath identify`"
+        )
+    fr = data.get("friction")
+    if not isinstance(fr, dict):
+        raise InvalidRobotDescription(f'{p}: no "friction" object')
+    eta = data.get("gear_efficiency", 1.0)
+    if not isinstance(eta, int | float) or not 0.0 < float(eta) <= 1.0:
+        raise InvalidRobotDescription(f"{p}: gear_efficiency must be a number in (0, 1], got {eta!r}")
+    twin_of = data.get("twin_of")
+    if twin_of is not None and not isinstance(twin_of, str):
+        raise InvalidRobotDescription(f"{p}: twin_of must be a robot name or null")
+    speeds = {k: fr.get(k) for k in ("stribeck_speed", "smoothing")}
+    for k, v in speeds.items():
+        if not isinstance(v, int | float):
+            raise InvalidRobotDescription(f"{p}: friction.{k} must be a number (rad/s)")
+    friction = IdentifiedFriction(
+        coulomb=_floats(fr.get("coulomb"), f"{p}: friction.coulomb", n_joints),
+        viscous=_floats(fr.get("viscous"), f"{p}: friction.viscous", n_joints),
+        offset=_floats(fr.get("offset"), f"{p}: friction.offset", n_joints),
+        stribeck=_floats(fr.get("stribeck"), f"{p}: friction.stribeck", n_joints),
+        stribeck_speed=float(speeds["stribeck_speed"]),  # type: ignore[arg-type]
+        smoothing=float(speeds["smoothing"]),  # type: ignore[arg-type]
+    )
+    return Calibration(friction=friction, gear_efficiency=float(eta), twin_of=twin_of, folder=str(p.parent))
+
+
+def twin_paths(folder: str | os.PathLike[str]) -> tuple[Path, Path]:
+    """The robot and friction files of a twin folder; InvalidRobotDescription if one is missing."""
+    f = Path(folder)
+    robot, friction = f / TWIN_ROBOT_FILE, f / TWIN_FRICTION_FILE
+    missing = [p.name for p in (robot, friction) if not p.is_file()]
+    if missing:
+        raise InvalidRobotDescription(
+            f"{f}: a folder, but not a twin: {', '.join(missing)} missing "
+            "(a twin folder is what `joulepath identify LOG... --out FOLDER` writes)"
+        )
+    return robot, friction
+
+
+__all__ = [
+    "Calibration",
+    "FRICTION_FORMAT",
+    "IdentifiedFriction",
+    "TWIN_CARD_FILE",
+    "TWIN_FILES",
+    "TWIN_FRICTION_FILE",
+    "TWIN_ROBOT_FILE",
+    "motor_torque",
+    "read_calibration",
+    "twin_paths",
+]

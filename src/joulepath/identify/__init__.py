@@ -1,0 +1,73 @@
+"""Dynamic identification: a robot's base inertial parameters, friction and drive losses from its logs.
+
+Linear in the parameters (Gautier & Khalil): Pinocchio's joint torque regressor
+reduced to the identifiable base set by a pivoted QR, friction columns per joint,
+weighted least squares, a gear efficiency found by a scalar search, and a physically
+consistent refinement (log-Cholesky). The result writes a calibrated twin folder
+that :func:`joulepath.load_robot` reads back (``--robot twin/`` on the command line).
+"""
+
+from joulepath.identify._consistency import (
+    from_log_cholesky,
+    min_eigenvalues,
+    pseudo_inertia,
+    to_log_cholesky,
+    triangle_margins,
+)
+from joulepath.identify._data import IdentificationData, data_from_logs
+from joulepath.identify._excitation import (
+    ExcitationDesign,
+    FourierExcitation,
+    design_excitation,
+    simulate_excitation,
+)
+from joulepath.identify._fit import (
+    MAX_CONDITION,
+    FitScores,
+    Identification,
+    IdentifyOptions,
+    identify,
+    joint_side,
+    score_prediction,
+)
+from joulepath.identify._regressor import (
+    RANK_TOLERANCE,
+    BaseParameters,
+    base_parameters,
+    friction_regressor,
+    inertial_regressor,
+    true_parameters,
+)
+from joulepath.identify._twin import CARD_FORMAT, link_inertials, twin_description, twin_robot, write_twin
+
+__all__ = [
+    "BaseParameters",
+    "CARD_FORMAT",
+    "ExcitationDesign",
+    "FitScores",
+    "FourierExcitation",
+    "Identification",
+    "IdentificationData",
+    "IdentifyOptions",
+    "MAX_CONDITION",
+    "RANK_TOLERANCE",
+    "base_parameters",
+    "data_from_logs",
+    "design_excitation",
+    "friction_regressor",
+    "from_log_cholesky",
+    "identify",
+    "inertial_regressor",
+    "joint_side",
+    "link_inertials",
+    "min_eigenvalues",
+    "pseudo_inertia",
+    "score_prediction",
+    "simulate_excitation",
+    "to_log_cholesky",
+    "triangle_margins",
+    "true_parameters",
+    "twin_description",
+    "twin_robot",
+    "write_twin",
+]

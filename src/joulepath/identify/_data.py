@@ -1,0 +1,182 @@
+"""Identification data: joint samples ``(q, qd, qdd, tau)`` from controller or generic logs.
+
+Accelerations: a log's own ``ddq`` columns when it has them (generic logs);
+otherwise the central difference of the logged joint speed on the log's own
+timestamps, ``qdd[k] = (qd[k+1] - qd[k-1]) / (t[k+1] - t[k-1])``, within each
+stretch between gaps in ``t`` (:func:`joulepath.data.find_gaps`). That difference is
+the mean acceleration over two sample periods: it smooths speed noise (a moving
+average of the exact derivative over ``[t[k-1], t[k+1]]``) and its error on a smooth
+motion is of order ``h² q'''' / 6``. The first and last sample of each stretch (no
+central difference) are dropped.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.data import find_gaps, is_moves_sidecar, read_log
+from joulepath.dynamics import Robot
+from joulepath.errors import InvalidInput, InvalidLog
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class IdentificationData:
+    """Joint samples for identification, SI units.
+
+    Attributes
+    ----------
+    q, qd, qdd, tau : ndarray of shape (N, n)
+        rad, rad/s, rad/s², N·m (``tau`` as logged: motor side when the drives measure it).
+    dt : ndarray of shape (N,)
+        Length of each sample, s (for energies).
+    stretch : ndarray of int, shape (N,)
+        Label of the continuous stretch (between gaps, per file) each sample belongs to.
+    sources : tuple of str
+    data_hash : str
+        SHA-256 of the logs' bytes (in the order given), or of the arrays.
+    """
+
+    q: FloatArray
+    qd: FloatArray
+    qdd: FloatArray
+    tau: FloatArray
+    dt: FloatArray
+    stretch: np.ndarray
+    sources: tuple[str, ...] = ()
+    data_hash: str = ""
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.q.shape[0])
+
+    @property
+    def n_joints(self) -> int:
+        return int(self.q.shape[1])
+
+    def subset(self, mask: np.ndarray) -> IdentificationData:
+        """The samples where ``mask`` holds."""
+        return IdentificationData(
+            q=self.q[mask],
+            qd=self.qd[mask],
+            qdd=self.qdd[mask],
+            tau=self.tau[mask],
+            dt=self.dt[mask],
+            stretch=self.stretch[mask],
+            sources=self.sources,
+            data_hash=self.data_hash,
+        )
+
+    @classmethod
+    def from_arrays(
+        cls,
+        q: FloatArray,
+        qd: FloatArray,
+        qdd: FloatArray,
+        tau: FloatArray,
+        dt: float | FloatArray,
+        *,
+        stretch: np.ndarray | None = None,
+        source: str = "<arrays>",
+    ) -> IdentificationData:
+        """Samples given directly (e.g. a plant's exact signals); checked for shape and finiteness."""
+        arrays = [np.asarray(a, dtype=float) for a in (q, qd, qdd, tau)]
+        shape = arrays[0].shape
+        if len(shape) != 2 or any(a.shape != shape for a in arrays):
+            raise InvalidInput(
+                f"q, qd, qdd and tau must all have shape (N, n); got {[a.shape for a in arrays]}"
+            )
+        if not all(np.all(np.isfinite(a)) for a in arrays):
+            raise InvalidInput("q, qd, qdd and tau must be finite (a NaN or inf was given)")
+        d = np.broadcast_to(np.asarray(dt, dtype=float), shape[:1]).copy()
+        lab = np.zeros(shape[0], dtype=np.int64) if stretch is None else np.asarray(stretch, dtype=np.int64)
+        h = hashlib.sha256()
+        for a in arrays:
+            h.update(np.ascontiguousarray(a).tobytes())
+        return cls(
+            q=arrays[0],
+            qd=arrays[1],
+            qdd=arrays[2],
+            tau=arrays[3],
+            dt=d,
+            stretch=lab,
+            sources=(source,),
+            data_hash=h.hexdigest(),
+        )
+
+
+def _central(qd: FloatArray, t: FloatArray) -> FloatArray:
+    out = np.full_like(qd, np.nan)
+    out[1:-1] = (qd[2:] - qd[:-2]) / (t[2:] - t[:-2])[:, None]
+    return out
+
+
+def data_from_logs(paths: Sequence[str | os.PathLike[str]], robot: Robot) -> IdentificationData:
+    """Read controller or generic logs of ``robot`` (see the module docstring for ``qdd``).
+
+    Raises
+    ------
+    InvalidLog
+        A log that cannot be read (the reader names file and line), no logs at all,
+        or a log whose positions or speeds are outside the robot's ranges or limits.
+    InvalidInput
+        The robot's joint count differs from the logs'.
+    """
+    from joulepath.data._table import _check_limits  # the ingest check: ranges and speeds, named
+
+    files = [Path(p) for p in paths if not is_moves_sidecar(p)]
+    if not files:
+        raise InvalidLog(
+            "no joint logs given (only `joulepath simulate`'s *.moves.csv lists of programmed moves); "
+            "give the logs beside them"
+        )
+    h = hashlib.sha256()
+    parts: list[tuple[FloatArray, ...]] = []
+    labels: list[np.ndarray] = []
+    n_stretch = 0
+    for path in files:
+        log = read_log(path)
+        if log.q.shape[1] != robot.n_joints:
+            raise InvalidInput(
+                f"{path}: the log has {log.q.shape[1]} joints but robot {robot.name!r} has "
+                f"{robot.n_joints}; give the robot that was logged (--robot)"
+            )
+        _check_limits(log, robot)
+        h.update(path.read_bytes())
+        t = log.t
+        bounds = np.r_[0, find_gaps(t), t.size]
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+            if b - a < 3:
+                continue
+            sl = slice(a, b)
+            qdd = log.qdd[sl] if log.qdd is not None else _central(log.qd[sl], t[sl])
+            keep = slice(0, b - a) if log.qdd is not None else slice(1, b - a - 1)
+            tt = t[sl]
+            dt = np.r_[np.diff(tt), np.diff(tt)[-1:]]
+            parts.append((log.q[sl][keep], log.qd[sl][keep], qdd[keep], log.tau[sl][keep], dt[keep]))
+            labels.append(np.full(parts[-1][0].shape[0], n_stretch, dtype=np.int64))
+            n_stretch += 1
+    if not parts:
+        raise InvalidLog(
+            f"{files[0]}: no stretch of 3 or more samples between gaps; nothing to identify from"
+        )
+    q, qd, qdd, tau, dt = (np.concatenate([p[i] for p in parts]) for i in range(5))
+    return IdentificationData(
+        q=q,
+        qd=qd,
+        qdd=qdd,
+        tau=tau,
+        dt=dt,
+        stretch=np.concatenate(labels),
+        sources=tuple(str(p) for p in files),
+        data_hash=h.hexdigest(),
+    )
+
+
+__all__ = ["IdentificationData", "data_from_logs"]

@@ -1,0 +1,475 @@
+"""Least-squares identification of base inertial parameters, friction and drive losses.
+
+Steps (:func:`identify`):
+
+1. **Regressor.** ``tau = [Y_b(q, qd, qdd) | F(qd)] x`` stacked over every sample and
+   joint: ``Y_b`` the base columns of Pinocchio's joint torque regressor
+   (:func:`~joulepath.identify.base_parameters`), ``F`` the friction columns.
+2. **Excitation.** The condition number of the stacked regressor with unit-norm
+   columns (weighted rows). Data that leave a parameter unexcited (a joint that never
+   moves, a condition number over ``max_condition``) are refused with the parameter
+   named, never turned into a twin.
+3. **Drive losses.** Logged torque is motor side: ``tau/eta`` while driving,
+   ``tau*eta`` while braking or at rest. For a trial ``eta`` the logged torque is
+   mapped back to the joint side and the linear least-squares problem solved; ``eta``
+   minimises the motor-side residual (a bounded scalar search; fixed when given).
+4. **Weighting.** Two passes: ordinary least squares, then each joint's rows
+   weighted by the inverse of its residual standard deviation (Gautier's weighted LS).
+5. **Physical consistency.** The full parameters (10 per link) are searched in
+   log-Cholesky coordinates (:mod:`joulepath.identify._consistency`, consistent by
+   construction) with ``scipy.optimize.least_squares``: the same weighted data
+   residual (through a QR compression of the full regressor), plus a small pull
+   towards the nominal parameters (``prior_weight``) that fixes the directions the data
+   cannot see (which do not change any torque). Friction coefficients are kept ≥ 0
+   (the offset may take either sign). Started from the least-squares base solution
+   lifted onto the nominal parameters (minimum-norm change), or from the nominal
+   parameters when that lift is not consistent.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+from scipy.optimize import least_squares, minimize_scalar
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import IdentifiedFriction, Robot, motor_torque
+from joulepath.energy import joint_energy
+from joulepath.errors import InvalidInput
+from joulepath.identify._consistency import from_log_cholesky, min_eigenvalues, to_log_cholesky
+from joulepath.identify._data import IdentificationData
+from joulepath.identify._regressor import (
+    BaseParameters,
+    base_parameters,
+    friction_regressor,
+    inertial_regressor,
+    true_parameters,
+)
+
+REST_SPEED = np.radians(1.0)
+"""A joint whose logged speed never exceeds this (rad/s) never moved: its friction cannot be identified."""
+
+MAX_CONDITION = 1e4
+"""Default refusal threshold of the condition number of the column-normalised stacked regressor."""
+
+ETA_BOUNDS = (0.5, 1.0)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class IdentifyOptions:
+    """Settings of :func:`identify`.
+
+    Attributes
+    ----------
+    offset : bool
+        Identify a per-joint friction offset (a torque added in both directions of motion).
+    stribeck_speed : float or None
+        rad/s: identify a Stribeck term of this characteristic speed (None: none).
+    smoothing : float
+        rad/s: the ``tanh`` width standing for ``sign(qd)`` in the friction terms.
+    gear_efficiency : float or None
+        Fixed drive efficiency in (0, 1] (1: the log holds joint-side torque); None estimates it.
+    weighted : bool
+        Second, weighted pass (inverse residual standard deviation per joint).
+    consistent : bool
+        Refine to physically consistent parameters (log-Cholesky); False keeps the
+        least-squares base parameters only (and the nominal parameters elsewhere).
+    prior_weight : float
+        Weight of the pull towards the nominal parameters in the consistent refinement.
+    max_condition : float
+        Refuse data whose stacked, column-normalised regressor has a larger condition number.
+    holdout : float
+        Share of the samples (the last ones, in log order) kept out of the fit and scored.
+    """
+
+    offset: bool = True
+    stribeck_speed: float | None = None
+    smoothing: float = 0.005
+    gear_efficiency: float | None = None
+    weighted: bool = True
+    consistent: bool = True
+    prior_weight: float = 1e-4
+    max_condition: float = MAX_CONDITION
+    holdout: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.stribeck_speed is not None and not self.stribeck_speed > 0:
+            raise InvalidInput(f"stribeck_speed must be a positive speed in rad/s, got {self.stribeck_speed}")
+        if not self.smoothing > 0:
+            raise InvalidInput(f"smoothing must be a positive speed in rad/s, got {self.smoothing}")
+        if self.gear_efficiency is not None and not 0.0 < self.gear_efficiency <= 1.0:
+            raise InvalidInput(f"gear efficiency must be in (0, 1], got {self.gear_efficiency}")
+        if not 0.0 <= self.holdout < 0.9:
+            raise InvalidInput(f"holdout must be a share in [0, 0.9), got {self.holdout}")
+        if not self.max_condition > 1 or not self.prior_weight >= 0:
+            raise InvalidInput("max_condition must be > 1 and prior_weight ≥ 0")
+
+
+@dataclass(frozen=True, slots=True)
+class FitScores:
+    """How well identified torques and energies match the logged ones (motor side).
+
+    ``path_energy_error_pct`` is the median over the data's continuous stretches of
+    ``|E_pred - E_logged| / E_logged`` (energies ``Σ |tau qd| dt``).
+    """
+
+    n_samples: int
+    torque_r2: tuple[float, ...]
+    torque_rmse: tuple[float, ...]
+    energy_r2: float
+    energy_error_pct: float
+    path_energy_error_pct: float
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Identification:
+    """The identified model of one robot.
+
+    Attributes
+    ----------
+    robot_name : str
+    base : BaseParameters
+    beta_ls : ndarray
+        Least-squares base parameters (unconstrained).
+    phi : ndarray of shape (10 n,)
+        Full inertial parameters: physically consistent when ``consistent`` (else the
+        nominal parameters moved by the minimum-norm change that gives ``beta_ls``).
+    friction : IdentifiedFriction
+    gear_efficiency : float
+    condition_number : float
+        Of the stacked, weighted, column-normalised regressor ``[Y_b | F]``.
+    weakest : str
+        The parameter least excited by the data (largest share of the smallest singular vector).
+    weights : ndarray of shape (n,)
+        Row weight of each joint (1/N·m).
+    fit, held_out : FitScores
+        On the fitted samples; on the held-out ones (None without a hold-out).
+    min_pseudo_inertia_eig : ndarray of shape (n,)
+        Smallest eigenvalue of each link's pseudo-inertia (> 0: consistent).
+    """
+
+    robot_name: str
+    base: BaseParameters
+    beta_ls: FloatArray
+    phi: FloatArray
+    friction: IdentifiedFriction
+    gear_efficiency: float
+    condition_number: float
+    weakest: str
+    weights: FloatArray
+    fit: FitScores
+    held_out: FitScores | None
+    min_pseudo_inertia_eig: FloatArray
+    consistent: bool
+    options: IdentifyOptions
+    data_hash: str = ""
+    sources: tuple[str, ...] = field(default=())
+
+    @property
+    def beta(self) -> FloatArray:
+        """Base parameters of :attr:`phi` (equal to :attr:`beta_ls` up to the consistency constraint)."""
+        return self.base.project(self.phi)
+
+    def joint_torque(self, robot: Robot, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
+        """Joint-side torque ``Y phi + F f`` (N·m) for samples ``(N, n)``; ``robot`` gives the kinematics."""
+        Y = inertial_regressor(robot, q, qd, qdd)
+        out: FloatArray = Y @ self.phi + self.friction.torque(qd)
+        return out
+
+    def motor_torque(self, robot: Robot, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
+        """Torque as the drives log it (gear losses included), N·m."""
+        return motor_torque(self.joint_torque(robot, q, qd, qdd), qd, self.gear_efficiency)
+
+    def card(self) -> dict[str, Any]:
+        """JSON-ready summary (the twin's card adds what it was written from)."""
+        return {
+            "robot": self.robot_name,
+            "data_sha256": self.data_hash,
+            "logs": list(self.sources),
+            "n_base_parameters": self.base.n,
+            "condition_number": self.condition_number,
+            "least_excited_parameter": self.weakest,
+            "gear_efficiency": self.gear_efficiency,
+            "physically_consistent": self.consistent,
+            "min_pseudo_inertia_eigenvalue": [float(v) for v in self.min_pseudo_inertia_eig],
+            "fit": asdict(self.fit),
+            "held_out": None if self.held_out is None else asdict(self.held_out),
+            "options": asdict(self.options),
+            "base_parameters": {name: float(v) for name, v in zip(self.base.names, self.beta, strict=True)},
+            "base_parameters_least_squares": {
+                name: float(v) for name, v in zip(self.base.names, self.beta_ls, strict=True)
+            },
+        }
+
+
+def joint_side(tau_motor: FloatArray, qd: FloatArray, eta: float) -> FloatArray:
+    """Invert the drive-loss model: joint torque of a logged motor torque (see :func:`motor_torque`)."""
+    if eta == 1.0:
+        return tau_motor
+    out: FloatArray = np.where(tau_motor * qd > 0, tau_motor * eta, tau_motor / eta)
+    return out
+
+
+def _check_motion(data: IdentificationData, n_params: int) -> None:
+    if data.n_samples * data.n_joints < 2 * n_params:
+        raise InvalidInput(
+            f"{data.n_samples} samples give {data.n_samples * data.n_joints} torque equations for "
+            f"{n_params} parameters; log at least {2 * n_params // data.n_joints + 1} samples "
+            "(more moves)"
+        )
+    still = [j + 1 for j in range(data.n_joints) if np.abs(data.qd[:, j]).max() <= REST_SPEED]
+    if still:
+        raise InvalidInput(
+            f"joint(s) {', '.join(map(str, still))} never move in the logs (speed ≤ 1 deg/s): their "
+            "friction and inertia cannot be identified; log moves of every joint (e.g. random moves "
+            "from `joulepath simulate`) and identify again"
+        )
+
+
+def _excitation(A: FloatArray, names: tuple[str, ...]) -> tuple[float, str]:
+    """Condition number of ``A`` (rows x params) with unit-norm columns, and the least excited parameter."""
+    norms = np.linalg.norm(A, axis=0)
+    zero = np.nonzero(norms == 0)[0]
+    if zero.size:
+        return float("inf"), names[int(zero[0])]
+    R = scipy.linalg.qr(A / norms, mode="r")[0][: A.shape[1]]
+    _, s, vt = np.linalg.svd(R)
+    cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+    return cond, names[int(np.argmax(np.abs(vt[-1])))]
+
+
+def score_prediction(pred: FloatArray, data: IdentificationData) -> FitScores:
+    """Scores of predicted (motor-side) torques ``pred`` ``(N, n)`` against the data's."""
+    tau = data.tau
+    res = pred - tau
+    sst = ((tau - tau.mean(axis=0)) ** 2).sum(axis=0)
+    r2 = 1.0 - (res**2).sum(axis=0) / np.where(sst > 0, sst, np.inf)
+    e_true = joint_energy(tau, data.qd, data.dt).sum(axis=1)
+    e_pred = joint_energy(pred, data.qd, data.dt).sum(axis=1)
+    sse = float(((e_pred - e_true) ** 2).sum())
+    sst_e = float(((e_true - e_true.mean()) ** 2).sum())
+    errors = []
+    for s in np.unique(data.stretch):
+        m = data.stretch == s
+        total = e_true[m].sum()
+        if total > 0:
+            errors.append(abs(e_pred[m].sum() - total) / total)
+    return FitScores(
+        n_samples=data.n_samples,
+        torque_r2=tuple(float(v) for v in r2),
+        torque_rmse=tuple(float(v) for v in np.sqrt((res**2).mean(axis=0))),
+        energy_r2=1.0 - sse / sst_e if sst_e > 0 else float("nan"),
+        energy_error_pct=100.0 * abs(float(e_pred.sum() - e_true.sum())) / max(float(e_true.sum()), 1e-300),
+        path_energy_error_pct=100.0 * float(np.median(errors)) if errors else float("nan"),
+    )
+
+
+class _Problem:
+    """The stacked weighted least-squares problem of one data set."""
+
+    def __init__(self, A: FloatArray, tau: FloatArray, qd: FloatArray) -> None:
+        self.A, self.tau, self.qd = A, tau, qd  # A: (N, n, p)
+        self.n = tau.shape[1]
+
+    def solve(self, w: FloatArray, eta: float | None) -> tuple[float, FloatArray]:
+        N, n, p = self.A.shape
+        Aw = (self.A * w[None, :, None]).reshape(-1, p)
+        pinv = np.linalg.pinv(Aw)
+
+        def fit(e: float) -> tuple[float, FloatArray]:
+            target = joint_side(self.tau, self.qd, e)
+            x = pinv @ (target * w).ravel()
+            pred = motor_torque(self.A @ x, self.qd, e)
+            return float((((pred - self.tau) * w) ** 2).sum()), x
+
+        if eta is not None:
+            return eta, fit(eta)[1]
+        best = minimize_scalar(
+            lambda e: fit(e)[0], bounds=ETA_BOUNDS, method="bounded", options={"xatol": 1e-5}
+        )
+        e = float(best.x)
+        return e, fit(e)[1]
+
+
+def _friction_of(
+    f: FloatArray, terms: tuple[str, ...], n: int, options: IdentifyOptions
+) -> IdentifiedFriction:
+    blocks = {t: tuple(float(v) for v in f[k * n : (k + 1) * n]) for k, t in enumerate(terms)}
+    zero = (0.0,) * n
+    return IdentifiedFriction(
+        coulomb=blocks["coulomb"],
+        viscous=blocks["viscous"],
+        offset=blocks.get("offset", zero),
+        stribeck=blocks.get("stribeck", zero),
+        stribeck_speed=options.stribeck_speed or 0.05,
+        smoothing=options.smoothing,
+    )
+
+
+def _lift(base: BaseParameters, beta: FloatArray, prior: FloatArray) -> FloatArray:
+    """Full parameters closest to ``prior`` (least squares) whose base parameters are ``beta``."""
+    B = base.matrix()
+    out: FloatArray = prior + np.linalg.lstsq(B, beta - B @ prior, rcond=None)[0]
+    return out
+
+
+def _prior_scale(prior: FloatArray) -> FloatArray:
+    floors = np.array([0.1, 0.01, 0.01, 0.01, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
+    n = prior.size // 10
+    out: FloatArray = np.maximum(np.abs(prior), np.tile(floors, n))
+    return out
+
+
+def _consistent(
+    Y: FloatArray,
+    F: FloatArray,
+    tau_joint: FloatArray,
+    w: FloatArray,
+    start_phi: FloatArray,
+    start_f: FloatArray,
+    prior: FloatArray,
+    lower_f: FloatArray,
+    prior_weight: float,
+) -> tuple[FloatArray, FloatArray]:
+    N, n, n_phi = Y.shape
+    A = np.concatenate([Y, F], axis=2) * w[None, :, None]
+    b = (tau_joint * w).reshape(-1, 1)
+    Raug = scipy.linalg.qr(np.hstack([A.reshape(-1, A.shape[2]), b]), mode="r")[0]
+    q = A.shape[2]
+    R, c = Raug[:q, :q], Raug[:q, q]
+    scale = _prior_scale(prior)
+    links = n_phi // 10
+    reg = np.sqrt(prior_weight * N * n)
+
+    def phi_of(z: FloatArray) -> FloatArray:
+        return np.concatenate([from_log_cholesky(z[10 * i : 10 * i + 10]) for i in range(links)])
+
+    def residual(z: FloatArray) -> FloatArray:
+        with np.errstate(all="ignore"):  # trial steps far out (exp overflow) just read as very bad
+            phi = phi_of(z)
+            x = np.concatenate([phi, z[10 * links :]])
+            out = np.concatenate([R @ x - c, reg * (phi - prior) / scale])
+        clean: FloatArray = np.nan_to_num(out, nan=1e150, posinf=1e150, neginf=-1e150)
+        return clean
+
+    try:
+        theta0 = np.concatenate([to_log_cholesky(start_phi[10 * i : 10 * i + 10]) for i in range(links)])
+    except np.linalg.LinAlgError:
+        theta0 = np.concatenate([to_log_cholesky(prior[10 * i : 10 * i + 10]) for i in range(links)])
+    f0 = np.maximum(start_f, lower_f + 1e-9)
+    z0 = np.concatenate([theta0, f0])
+    lo = np.concatenate([np.full(theta0.size, -np.inf), lower_f])
+    sol = least_squares(residual, z0, bounds=(lo, np.inf), method="trf", x_scale="jac", max_nfev=300)
+    return phi_of(sol.x), sol.x[10 * links :]
+
+
+def identify(
+    data: IdentificationData, robot: Robot, options: IdentifyOptions | None = None
+) -> Identification:
+    """Identify base inertial parameters, friction and drive losses of ``robot`` from ``data``.
+
+    ``robot`` gives the kinematics (and the nominal parameters the consistent
+    refinement is pulled towards). See the module docstring for the steps.
+
+    Raises
+    ------
+    InvalidInput
+        The data cannot identify the model: too few samples, a joint that never
+        moves, or a condition number over ``options.max_condition`` (the least
+        excited parameter is named).
+    """
+    options = options or IdentifyOptions()
+    if data.n_joints != robot.n_joints:
+        raise InvalidInput(
+            f"the data hold {data.n_joints} joints but robot {robot.name!r} has {robot.n_joints}"
+        )
+    fit_data, held = data, None
+    if options.holdout > 0:
+        cut = int(round((1.0 - options.holdout) * data.n_samples))
+        idx = np.arange(data.n_samples)
+        fit_data, held = data.subset(idx < cut), data.subset(idx >= cut)
+    base = base_parameters(robot)
+    n = robot.n_joints
+    F, terms = friction_regressor(
+        fit_data.qd, smoothing=options.smoothing, offset=options.offset, stribeck_speed=options.stribeck_speed
+    )
+    _check_motion(fit_data, base.n + F.shape[2])
+    Y = inertial_regressor(robot, fit_data.q, fit_data.qd, fit_data.qdd)
+    A = np.concatenate([Y[:, :, base.independent], F], axis=2)
+    names = (*base.names, *(f"joint{j + 1}.{t}" for t in terms for j in range(n)))
+    problem = _Problem(A, fit_data.tau, fit_data.qd)
+    w = np.ones(n)
+    eta, x = problem.solve(w, options.gear_efficiency)
+    if options.weighted:
+        res = motor_torque(A @ x, fit_data.qd, eta) - fit_data.tau
+        sigma = np.sqrt((res**2).mean(axis=0))
+        sigma = np.maximum(sigma, 1e-6 * max(float(sigma.max()), 1e-12))
+        w = 1.0 / sigma
+        eta, x = problem.solve(w, options.gear_efficiency)
+    cond, weakest = _excitation((A * w[None, :, None]).reshape(-1, A.shape[2]), names)
+    if not cond <= options.max_condition:
+        raise InvalidInput(
+            f"the logs do not excite the dynamics enough to identify them: condition number {cond:.3g} of "
+            f"the stacked regressor (limit {options.max_condition:.3g}); least excited: {weakest}; log more "
+            "varied moves (other speeds, ranges and joint combinations) and identify again"
+        )
+    beta_ls, f_ls = x[: base.n], x[base.n :]
+    prior = true_parameters(robot)
+    phi = _lift(base, beta_ls, prior)
+    f = f_ls
+    if options.consistent:
+        lower_f = np.concatenate([np.full(n, -np.inf if t == "offset" else 0.0) for t in terms])
+        phi, f = _consistent(
+            Y,
+            F,
+            joint_side(fit_data.tau, fit_data.qd, eta),
+            w,
+            phi,
+            f_ls,
+            prior,
+            lower_f,
+            options.prior_weight,
+        )
+    friction = _friction_of(f, terms, n, options)
+    eig = min_eigenvalues(phi)
+
+    def predict(d: IdentificationData) -> FloatArray:
+        Yd = inertial_regressor(robot, d.q, d.qd, d.qdd)
+        return motor_torque(Yd @ phi + friction.torque(d.qd), d.qd, eta)
+
+    return Identification(
+        robot_name=robot.name,
+        base=base,
+        beta_ls=beta_ls,
+        phi=phi,
+        friction=friction,
+        gear_efficiency=eta,
+        condition_number=cond,
+        weakest=weakest,
+        weights=w,
+        fit=score_prediction(
+            motor_torque(Y @ phi + friction.torque(fit_data.qd), fit_data.qd, eta), fit_data
+        ),
+        held_out=None if held is None else score_prediction(predict(held), held),
+        min_pseudo_inertia_eig=eig,
+        consistent=bool(np.all(eig > 0)),
+        options=options,
+        data_hash=data.data_hash,
+        sources=data.sources,
+    )
+
+
+__all__ = [
+    "ETA_BOUNDS",
+    "FitScores",
+    "Identification",
+    "IdentifyOptions",
+    "MAX_CONDITION",
+    "REST_SPEED",
+    "identify",
+    "joint_side",
+    "score_prediction",
+]

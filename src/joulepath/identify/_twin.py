@@ -1,0 +1,152 @@
+"""The calibrated twin: an identification turned into a robot and written as a twin folder.
+
+The folder's files are declared once in :mod:`joulepath.dynamics` (``TWIN_*_FILE``)
+and read back by :func:`joulepath.load_robot`:
+
+* ``robot.irml`` — the nominal description (kinematics, limits, range sets) with
+  each link's identified mass, centre of mass and inertia (a payload logged with the
+  robot is part of the last link; the description has no separate payload);
+* ``friction.json`` — identified friction and gear efficiency;
+* ``card.json`` — data hash, fit and held-out scores, condition number, base parameters.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from joulepath._io import atomic_write_text, check_replaceable, make_folder
+from joulepath.description import (
+    PRESETS,
+    Inertial,
+    RobotDescription,
+    chain_from_description,
+    preset_path,
+    transform_inertial,
+)
+from joulepath.description._chain import dh_link
+from joulepath.dynamics import (
+    TWIN_CARD_FILE,
+    TWIN_FRICTION_FILE,
+    TWIN_ROBOT_FILE,
+    Calibration,
+    Robot,
+)
+from joulepath.errors import InvalidInput
+from joulepath.identify._fit import Identification
+
+CARD_FORMAT = "joulepath-twin-card/1"
+
+
+def link_inertials(phi: np.ndarray) -> list[Inertial]:
+    """Per link: mass, centre of mass and inertia about it (joint frame) of parameters ``phi``."""
+    out = []
+    for p in np.asarray(phi, dtype=float).reshape(-1, 10):
+        m = float(p[0])
+        c = p[1:4] / m
+        i_o = np.array([[p[4], p[5], p[7]], [p[5], p[6], p[8]], [p[7], p[8], p[9]]])
+        i_c = i_o - m * (c @ c * np.eye(3) - np.outer(c, c))
+        out.append(Inertial.from_arrays(m, c, 0.5 * (i_c + i_c.T)))
+    return out
+
+
+def twin_description(nominal: RobotDescription, ident: Identification) -> RobotDescription:
+    """``nominal`` with every link's mass properties replaced by the identified ones (no payload)."""
+    if len(nominal.joints) * 10 != ident.phi.size:
+        raise InvalidInput(
+            f"the identification has {ident.phi.size // 10} links but robot {nominal.name!r} has "
+            f"{len(nominal.joints)}"
+        )
+    joints = []
+    for j, body in zip(nominal.joints, link_inertials(ident.phi), strict=True):
+        # chain_from_description moves DH-frame mass properties into the joint frame by dh_link
+        back = np.asarray(np.linalg.inv(dh_link(j.d, j.r, j.alpha)), dtype=np.float64)
+        joints.append(replace(j, inertial=transform_inertial(body, back)))
+    return replace(nominal, joints=tuple(joints), payload=None, source=None)
+
+
+def load_name(robot: Robot) -> str | None:
+    """What :func:`joulepath.load_robot` loads ``robot`` by: a bundled name, else its file (resolved)."""
+    if robot.calibration is not None:
+        return robot.calibration.twin_of
+    if robot.source is None:
+        return None
+    for name in PRESETS:
+        if Path(robot.source).resolve() == preset_path(name).resolve():
+            return name
+    return str(Path(robot.source).resolve())
+
+
+def twin_robot(nominal: Robot, ident: Identification) -> Robot:
+    """The identified robot, usable wherever a robot is (its friction is :attr:`Robot.friction`)."""
+    if nominal.description is None:
+        raise InvalidInput(
+            f"robot {nominal.name!r} comes from a URDF; a twin is written as IRML and needs an IRML "
+            "robot (e.g. a bundled one) as its nominal description"
+        )
+    desc = twin_description(nominal.description, ident)
+    calibration = Calibration(
+        friction=ident.friction,
+        gear_efficiency=ident.gear_efficiency,
+        twin_of=load_name(nominal),
+    )
+    return Robot(
+        chain_from_description(desc),
+        description=desc,
+        source=f"twin of {nominal.name}",
+        calibration=calibration,
+    )
+
+
+def write_twin(
+    ident: Identification,
+    nominal: Robot,
+    out: str | os.PathLike[str],
+    *,
+    extra: dict[str, Any] | None = None,
+) -> list[Path]:
+    """Write the twin folder; refuses (before writing anything) files it may not replace.
+
+    Returns the paths written. ``extra`` adds entries to the card.
+    """
+    from joulepath.description import irml_string
+
+    robot = twin_robot(nominal, ident)
+    folder = Path(out)
+    paths = [folder / name for name in (TWIN_ROBOT_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE)]
+    for p in paths:
+        check_replaceable(p)
+    make_folder(folder)
+    assert robot.description is not None and robot.calibration is not None
+    card = {"format": CARD_FORMAT, "twin_of": robot.calibration.twin_of, **ident.card(), **(extra or {})}
+    atomic_write_text(paths[0], irml_string(robot.description))
+    atomic_write_text(paths[1], json.dumps(robot.calibration.to_json(), indent=2) + "\n")
+    atomic_write_text(paths[2], json.dumps(_finite(card), indent=2, default=_jsonable) + "\n")
+    return paths
+
+
+def _finite(value: Any) -> Any:
+    """NaN and infinities as null (strict JSON)."""
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    if isinstance(value, float | np.floating) and not np.isfinite(value):
+        return None
+    return value
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"not JSON serializable: {type(value).__name__}")
+
+
+__all__ = ["CARD_FORMAT", "link_inertials", "load_name", "twin_description", "twin_robot", "write_twin"]
