@@ -10,6 +10,7 @@ from pathlib import Path
 import typer
 
 from joulepath.cli._common import check_out_folder, console
+from joulepath.description import DEFAULT_ROBOT
 
 
 def _split(
@@ -54,7 +55,7 @@ def train(
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     jobs: int = typer.Option(1, min=1, help="Local processes for the grid search."),
     scheduler: str = typer.Option("", help="Dask scheduler address (tcp://HOST:PORT) for the grid search."),
-    robot: str = typer.Option("irb120", help="Robot of the data."),
+    robot: str = typer.Option(DEFAULT_ROBOT, help="Robot of the data."),
 ) -> int:
     """Tune (grid search + CV), refit and test energy models; save them with cards and reports."""
     from joulepath import load_robot

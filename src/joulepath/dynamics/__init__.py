@@ -2,18 +2,22 @@
 
 from joulepath.dynamics._derivatives import DynamicsDerivatives, inverse_dynamics_derivatives
 from joulepath.dynamics._friction import (
+    FRICTION_SUFFIX,
     NOMINAL_FRICTION,
     CoulombViscousFriction,
     ElastoPlasticFriction,
     Friction,
     FrictionSum,
     friction_derivative,
+    read_friction_file,
 )
 from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le
 from joulepath.dynamics._rnea import PinocchioRnea
-from joulepath.dynamics._robot import METHODS, Robot, load_robot
+from joulepath.dynamics._robot import DEFAULT_ROBOT, METHODS, Robot, load_robot
 
 __all__ = [
+    "DEFAULT_ROBOT",
+    "FRICTION_SUFFIX",
     "CoulombViscousFriction",
     "DynamicsDerivatives",
     "ElastoPlasticFriction",
@@ -28,4 +32,5 @@ __all__ = [
     "lagrange_euler",
     "load_robot",
     "mass_matrix_le",
+    "read_friction_file",
 ]

@@ -50,6 +50,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from joulepath.description import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput
 from joulepath.optimize import ALGORITHMS, AUTO, resolve_algorithm
 
@@ -66,6 +67,7 @@ class DataStage:
     """
 
     plant: str = "lab"
+    range_set: str = "collection"
     train_moves: int = 40
     test_moves: int = 15
     micro_moves: int = 0
@@ -138,7 +140,7 @@ class Experiment:
     """A whole study: data -> synthetic data -> models -> importance -> optimized moves -> benchmark."""
 
     name: str
-    robot: str = "irb120"
+    robot: str = DEFAULT_ROBOT
     seed: int = 0
     jobs: int = 1
     scheduler: str = ""
@@ -396,6 +398,7 @@ def load_experiment(path: str | os.PathLike[str]) -> Experiment:
 
 def _check_robot(exp: Experiment, source: str) -> None:
     from joulepath.dynamics import load_robot
+    from joulepath.dynamics._robot import FALLBACK_RANGE_SETS
     from joulepath.errors import JoulepathError
 
     try:
@@ -403,7 +406,7 @@ def _check_robot(exp: Experiment, source: str) -> None:
     except JoulepathError as err:
         raise InvalidInput(f"{source}: robot = {exp.robot!r}: {err}") from err
     names = robot.range_set_names
-    if exp.optimize.range_set not in names:
+    if exp.optimize.range_set not in (*names, *FALLBACK_RANGE_SETS):
         raise InvalidInput(
             f"{source}: [optimize] range_set = {exp.optimize.range_set!r} is not a range set of "
             f"{robot.name}; use one of {', '.join(names)}"

@@ -298,9 +298,16 @@ def _data_stage(ctx: _Context) -> dict[str, Any]:
                 paths, origin = logs[name], "logs"
             elif n:
                 sim = simulate(
-                    folder / "logs" / f"{name}.csv", plant=plant, n_moves=n, seed=seed, robot=exp.robot
+                    folder / "logs" / f"{name}.csv",
+                    plant=plant,
+                    n_moves=n,
+                    seed=seed,
+                    robot=exp.robot,
+                    range_set=d.range_set,
                 )
                 paths, origin = [str(sim.log)], f"simulated on the {plant} plant"
+                if sim.range_set != d.range_set:
+                    origin += f", nominal ranges ({robot.name} has no {d.range_set!r} range set)"
             else:
                 (folder / f"{name}.parquet").unlink(missing_ok=True)
                 continue
@@ -554,7 +561,7 @@ def _compare_with_physics(ctx: _Context, folder: Path) -> None:
     from matplotlib.figure import Figure
 
     from joulepath.data import EnergyTable
-    from joulepath.dynamics import NOMINAL_FRICTION, load_robot
+    from joulepath.dynamics import load_robot
     from joulepath.learn import best_model, physics_predict
 
     robot = load_robot(ctx.exp.robot)
@@ -564,12 +571,17 @@ def _compare_with_physics(ctx: _Context, folder: Path) -> None:
     section = EnergyTable(frame=frame.iloc[: min(len(frame), 480)], feature_set=test.feature_set)
     measured = section.frame["E"].to_numpy()
     learned = model.predict(section.frame)
-    physics = physics_predict(section, robot, friction=NOMINAL_FRICTION)["E"]
+    physics = physics_predict(section, robot, friction=robot.friction)["E"]
     fig = Figure(figsize=(10, 3.4))
     ax = fig.subplots()
     ax.plot(measured, "k-", lw=1.2, label="measured")
     ax.plot(learned, "-", lw=0.9, label=f"learned ({model.family})")
-    ax.plot(physics, "--", lw=0.9, label="dynamics model + nominal friction")
+    ax.plot(
+        physics,
+        "--",
+        lw=0.9,
+        label="dynamics model + nominal friction" if robot.friction else "dynamics model (rigid body)",
+    )
     ax.set_xlabel("test row (25 ms each)")
     ax.set_ylabel("E per row (J)")
     ax.legend(fontsize="small")
@@ -592,9 +604,9 @@ def _compare_with_physics(ctx: _Context, folder: Path) -> None:
         "learned_batch_per_row_s": timed(lambda: model.predict(frame), 3) / len(frame),
         "learned_single_s": timed(lambda: model.predict(one.frame), 20),
         "learned_size_bytes": size,
-        "physics_batch_per_row_s": timed(lambda: physics_predict(test, robot, friction=NOMINAL_FRICTION), 3)
+        "physics_batch_per_row_s": timed(lambda: physics_predict(test, robot, friction=robot.friction), 3)
         / len(frame),
-        "physics_single_s": timed(lambda: physics_predict(one, robot, friction=NOMINAL_FRICTION), 20),
+        "physics_single_s": timed(lambda: physics_predict(one, robot, friction=robot.friction), 20),
     }
     atomic_write_text(folder / "latency.json", json.dumps(latency, indent=2))
 
@@ -694,6 +706,10 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
         joints = _joints(ctx, robot.n_joints)
         rows = []
         tasks = random_tasks(robot, o.tasks, seed=exp.seed, range_set=o.range_set)
+        if robot.ranges_for(o.range_set)[0] != o.range_set:
+            ctx.tell(
+                f"optimize: {robot.name} has no {o.range_set!r} range set; tasks drawn in its nominal ranges"
+            )
         seeds = np.random.SeedSequence(exp.seed).spawn(len(tasks))
         for k, (q0, qf, T) in enumerate(tasks):
             ctx.progress("optimize", k, len(tasks))
@@ -750,7 +766,6 @@ def _optimum(robot: Any, res: Any) -> dict[str, Any]:
     reference starts from the minimum-jerk move (``benchmarks/optimizer_peers.py`` also
     starts it from the optimized path and keeps the better of the two).
     """
-    from joulepath.dynamics import NOMINAL_FRICTION
     from joulepath.optimize import acceleration_limit
     from joulepath.optimize._reference import reference_optimum
 
@@ -758,7 +773,7 @@ def _optimum(robot: Any, res: Any) -> dict[str, Any]:
     amax = acceleration_limit(robot, s.config["accel_time"])
     q0, qf = np.asarray(s.start_rad), np.asarray(s.end_rad)
     solves = [
-        reference_optimum(robot, q0, qf, s.duration_s, friction=NOMINAL_FRICTION, acceleration_limit=amax)
+        reference_optimum(robot, q0, qf, s.duration_s, friction=robot.friction, acceleration_limit=amax)
     ]
     ok = [r for r in solves if r.max_violation < 1e-6]
     best = min(ok or solves, key=lambda r: r.energy_fine_J)

@@ -21,6 +21,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from joulepath._typing import FloatArray
 from joulepath.data import FEATURE_SETS
+from joulepath.dynamics import DEFAULT_ROBOT
 from joulepath.energy import joint_energy
 
 INPUTS = ("thesis", "physics")
@@ -49,7 +50,7 @@ class PhysicsFeatures(TransformerMixin, BaseEstimator):  # type: ignore[misc]
         ``ddq{i}`` for i = 1..6 and ``dt``. None: the physics inputs of ``full40``.
     """
 
-    def __init__(self, robot: str = "irb120", columns: tuple[str, ...] | None = None) -> None:
+    def __init__(self, robot: str = DEFAULT_ROBOT, columns: tuple[str, ...] | None = None) -> None:
         self.robot = robot
         self.columns = columns
 
@@ -100,9 +101,7 @@ def physics_transform(X: FloatArray, index: dict[str, int], robot: Any) -> Float
     qd = X[:, [index[f"dq{i}"] for i in j]]
     qdd = X[:, [index[f"ddq{i}"] for i in j]]
     dt = X[:, index["dt"]][:, None]
-    from joulepath.dynamics import NOMINAL_FRICTION
-
-    tau = robot.inverse_dynamics(q, qd, qdd, friction=NOMINAL_FRICTION)
+    tau = robot.inverse_dynamics(q, qd, qdd, friction=robot.friction)
     energy = joint_energy(tau, qd, dt[:, 0])  # the one definition: |tau_i qd_i| dt
     signed = joint_energy(tau, qd, dt[:, 0], mode="signed")
     out: FloatArray = np.concatenate(

@@ -291,7 +291,12 @@ class EnergyModel:
                 raise InvalidModel(f"{file}: not a readable XGBoost JSON model ({err})") from err
             steps: list[tuple[str, Any]] = []
             if card["inputs"] == "physics":
-                phys = PhysicsFeatures(robot=card.get("robot_source", "irb120"), columns=cols)
+                if not card.get("robot_source"):
+                    raise InvalidModel(
+                        f"{card_path}: a model on physics inputs must name its robot (robot_source); "
+                        "train it again with `joulepath train --robot ...`"
+                    )
+                phys = PhysicsFeatures(robot=card["robot_source"], columns=cols)
                 phys.fit(np.zeros((1, len(cols))))
                 steps.append(("physics", phys))
             steps.append(("model", model))

@@ -18,6 +18,7 @@ from sklearn.model_selection import ParameterGrid
 
 from joulepath._io import atomic_write_text
 from joulepath.data import TARGETS, EnergyTable
+from joulepath.dynamics import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._evaluate import physics_baseline, score
 from joulepath.learn._families import FAMILIES, GRIDS, SUBSTITUTIONS, grid_for, make_pipeline
@@ -65,7 +66,7 @@ class TrainConfig:
     seed: int = 0
     n_jobs: int = 1
     scheduler: str | None = None
-    robot: str = "irb120"
+    robot: str = DEFAULT_ROBOT
 
     def __post_init__(self) -> None:
         bad = [f for f in self.families if f not in FAMILIES]
@@ -200,7 +201,7 @@ def train(
         Receives the grid search's progress as numbers (for progress bars; no
         need to parse ``progress`` messages).
     """
-    from joulepath.dynamics import NOMINAL_FRICTION, load_robot
+    from joulepath.dynamics import load_robot
 
     for name, table in (("training", train_table), ("test", test_table)):
         if len(table.frame) == 0:
@@ -334,10 +335,13 @@ def train(
     robot = load_robot(config.robot)
     baselines = [
         physics_baseline(test_table, robot, friction=None, label="dynamics model, no friction"),
-        physics_baseline(
-            test_table, robot, friction=NOMINAL_FRICTION, label="dynamics model + nominal friction"
-        ),
     ]
+    if robot.friction is not None:
+        baselines.append(
+            physics_baseline(
+                test_table, robot, friction=robot.friction, label="dynamics model + nominal friction"
+            )
+        )
     results = pd.DataFrame(rows)
     atomic_write_text(out / "results.csv", results.to_csv(index=False))
     report = {

@@ -19,6 +19,7 @@ from joulepath.data import (
     write_controller_log,
 )
 from joulepath.data._schema import MOVES_SIDECAR_COLUMNS
+from joulepath.description import DEFAULT_ROBOT
 from joulepath.dynamics import Robot, load_robot
 from joulepath.export import Move, draw_moves
 from joulepath.sim._controller import ControllerConfig, MotionPlan, log_times, plan_moves
@@ -34,6 +35,8 @@ class SimulatedLog:
     n_rows: int
     n_moves: int
     duration_s: float
+    range_set: str = "collection"
+    plant_note: str = ""
 
 
 def measure(
@@ -81,7 +84,7 @@ def simulate(
     plant: str = "lab",
     n_moves: int = 1000,
     seed: int | np.random.SeedSequence = 0,
-    robot: str = "irb120",
+    robot: str = DEFAULT_ROBOT,
     range_set: str = "collection",
     config: ControllerConfig | None = None,
 ) -> SimulatedLog:
@@ -94,6 +97,7 @@ def simulate(
     """
     r = load_robot(robot)
     rng = np.random.default_rng(seed)
+    used, _, _ = r.ranges_for(range_set)
     moves = draw_moves(r, n_moves, range_set=range_set, rng=rng)
     plan, measured = measure(r, plant, moves, rng=rng, config=config)
     path = Path(out)
@@ -102,7 +106,10 @@ def simulate(
     check_replaceable(side)
     write_controller_log(path, log_text(r, measured))
     atomic_write_text(side, moves_text(plan))
-    return SimulatedLog(path, side, int(measured.t.size), len(plan.segments), float(measured.t[-1]))
+    note = make_plant(plant, r).note
+    return SimulatedLog(
+        path, side, int(measured.t.size), len(plan.segments), float(measured.t[-1]), used, note
+    )
 
 
 THESIS_PLAN = (
@@ -136,7 +143,7 @@ def simulate_plan(
     out: str | os.PathLike[str],
     *,
     seed: int = 0,
-    robot: str = "irb120",
+    robot: str = DEFAULT_ROBOT,
     plan: Sequence[tuple[str, str, int]] = THESIS_PLAN,
     workers: int = 2,
     progress: Callable[[dict[str, object]], None] | None = None,
