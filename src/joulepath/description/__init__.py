@@ -24,8 +24,8 @@ from joulepath.description._pinocchio import chain_from_urdf, pinocchio_model
 from joulepath.description._presets import DEFAULT_ROBOT, HOME, PRESETS, preset_description, preset_path
 
 __all__ = [
-    "DEFAULT_ROBOT",
     "Chain",
+    "DEFAULT_ROBOT",
     "Finding",
     "HOME",
     "Inertial",

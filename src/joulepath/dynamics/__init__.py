@@ -16,11 +16,11 @@ from joulepath.dynamics._rnea import PinocchioRnea
 from joulepath.dynamics._robot import DEFAULT_ROBOT, METHODS, Robot, load_robot
 
 __all__ = [
-    "DEFAULT_ROBOT",
-    "FRICTION_SUFFIX",
     "CoulombViscousFriction",
+    "DEFAULT_ROBOT",
     "DynamicsDerivatives",
     "ElastoPlasticFriction",
+    "FRICTION_SUFFIX",
     "Friction",
     "FrictionSum",
     "METHODS",

@@ -66,8 +66,8 @@ register_exporter(
 __all__ = [
     "DEFAULT_CONTROLLER",
     "EXPORTERS",
-    "MODES",
     "Exporter",
+    "MODES",
     "Move",
     "check_path",
     "collection_module",
