@@ -168,7 +168,7 @@ def optimize(
         f"within every limit; largest TCP deviation {s.max_tcp_deviation_mm:.1f} mm"
     )
     if r.friction is None:
-        console.print(f"physics: rigid body only, no friction modelled (friction: {r.friction_note})")
+        console.print(f"physics: no friction modelled for {r.name}; friction: {r.friction_note}")
     if s.saved_lab_pct is not None:
         if s.lab_plant.startswith("emulated IRB 120"):
             console.print(f"on the emulated lab robot: {s.saved_lab_pct:.1f} % saved")

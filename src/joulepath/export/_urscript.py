@@ -51,8 +51,13 @@ def servo_targets(trajectory: Trajectory, period: float) -> tuple[FloatArray, Fl
     return times, spline(times), spline(times, 1)
 
 
+def _num(value: float) -> str:
+    text = f"{value:.{DECIMALS}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+
+
 def _row(values: FloatArray) -> str:
-    return "[" + ", ".join(f"{v:.{DECIMALS}f}" for v in values) + "]"
+    return "[" + ", ".join(_num(float(v)) for v in values) + "]"
 
 
 def urscript_program(

@@ -387,7 +387,7 @@ def plot_test_scores(results: pd.DataFrame, baselines: Sequence[dict[str, Any]],
     paths = []
     for target, group in results.groupby("target"):
         fig, axes = plt.subplots(1, 2, figsize=(8, 3.2))
-        labels = list(group["family"]) + ["physics", "physics+fr"]
+        labels = list(group["family"]) + ["physics", "physics+fr"][: len(baselines)]
         r2 = list(group["test_r2"]) + [b["scores"][target]["r2"] for b in baselines]
         mae = list(group["test_mae"]) + [b["scores"][target]["mae"] for b in baselines]
         axes[0].bar(labels, r2, color="tab:blue")

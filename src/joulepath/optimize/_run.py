@@ -12,7 +12,7 @@ import numpy as np
 
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
-from joulepath.dynamics import Robot
+from joulepath.dynamics import NOMINAL_FRICTION, Robot
 from joulepath.energy import joint_power, path_energy
 from joulepath.errors import InvalidInput, InvalidModel, LimitViolation
 from joulepath.optimize._problem import FITNESS, PARAMETRIZATIONS, TrajectoryProblem
@@ -304,9 +304,28 @@ def optimize_move(
         joints=joints,
         dt=SAMPLE_PERIOD,
     )
-    spec = config.search
+    spec = _search_for(robot, config)
     outcome, wall = timed(spec.run, task, config, np.random.default_rng(config.seed))
     return verify_move(robot, task, default, outcome, config, spec.name, wall)
+
+
+def _search_for(robot: Robot, config: OptimizeConfig) -> AlgorithmSpec:
+    """The search to run for this robot.
+
+    The gradient search (``optimize/_search.py``) optimizes with the IRB 120's
+    ``NOMINAL_FRICTION``; until it takes the robot's own friction, a robot with other
+    friction (any arm but the IRB 120) gets CMA-ES under ``auto`` and is refused an
+    explicit gradient search, rather than optimizing another robot's friction.
+    """
+    spec = config.search
+    if spec.name != "gradient" or robot.friction is NOMINAL_FRICTION:
+        return spec
+    if config.algorithm == AUTO:
+        return resolve_algorithm("cmaes", config.fitness)
+    raise InvalidInput(
+        f"the gradient search models the IRB 120's friction only, and {robot.name}'s friction is "
+        f"{robot.friction_note}; use --algo cmaes (or auto) for {robot.name}"
+    )
 
 
 def verify_move(
