@@ -47,7 +47,7 @@ def train(
     data: Path = typer.Option(..., "--data", help="Training energy table (.parquet)."),
     test: Path = typer.Option(..., "--test", help="Test table of other moves (.parquet)."),
     family: str = typer.Option("all", help="mlp, svr, par, xgb (comma separated) or all."),
-    target: str = typer.Option("E", help="Targets: E, E1..E6 (comma separated) or all."),
+    target: str = typer.Option("E", help="Targets: E, E1..En (comma separated) or all."),
     grid: str = typer.Option("quick", help="quick, or thesis (Tables 2.2-2.5)."),
     cv: int = typer.Option(5, min=2, help="Folds."),
     inputs: str = typer.Option("physics", help="physics (raw + nominal model terms) or thesis (raw)."),
@@ -59,15 +59,17 @@ def train(
 ) -> int:
     """Tune (grid search + CV), refit and test energy models; save them with cards and reports."""
     from joulepath import load_robot
-    from joulepath.data import TARGETS, load_table
+    from joulepath.data import load_table, target_columns
+    from joulepath.data._schema import MAX_JOINTS
     from joulepath.errors import InvalidInput
     from joulepath.learn import FAMILIES, TrainConfig
     from joulepath.learn import train as run
 
     check_out_folder(out)
+    train_table, test_table = load_table(data), load_table(test)
     config = TrainConfig(
         families=_split(family, "--family", FAMILIES, FAMILIES),
-        targets=_split(target, "--target", TARGETS, TARGETS),
+        targets=_split(target, "--target", target_columns(MAX_JOINTS), train_table.targets),
         grid=grid,
         cv=cv,
         inputs=inputs,
@@ -77,7 +79,6 @@ def train(
         robot=robot,
     )
     load_robot(robot)  # an unknown robot fails now, not after the training
-    train_table, test_table = load_table(data), load_table(test)
     for path, table, what in ((data, train_table, "--data"), (test, test_table, "--test")):
         if len(table.frame) == 0:
             raise InvalidInput(

@@ -108,8 +108,10 @@ class Robot:
 
     @property
     def home(self) -> FloatArray:
-        """Home configuration (rad): q = 0 in ABB's convention."""
-        return np.zeros(self.n_joints)
+        """Home configuration (rad): q = 0 (ABB's convention), or mid-range for a joint whose range excludes 0."""
+        lo, hi = self.chain.lower, self.chain.upper
+        outside = np.isfinite(lo) & np.isfinite(hi) & ((lo > 0) | (hi < 0))
+        return np.where(outside, (lo + hi) / 2, 0.0)
 
     def joint_ranges(self, name: str = "nominal") -> tuple[FloatArray, FloatArray]:
         """``(lower, upper)`` of a named range set (``"nominal"``, or e.g. ``"lab"``)."""

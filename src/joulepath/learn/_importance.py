@@ -85,7 +85,9 @@ def rank_joints(importance: pd.DataFrame) -> list[int]:
     The optimizer's informed local search scales the coefficients of the first
     ones — derived from the data at hand, not hard-coded as in the thesis.
     """
-    score = {j: 0.0 for j in range(1, N_JOINTS + 1)}
+    joints = [_joint_of(str(feature)) for feature in importance.index]
+    n = max([j for j in joints if j is not None], default=N_JOINTS)
+    score = {j: 0.0 for j in range(1, n + 1)}
     for feature, value in importance["mean"].items():
         joint = _joint_of(str(feature))
         if joint is not None:

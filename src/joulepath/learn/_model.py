@@ -31,6 +31,7 @@ from sklearn.svm import LinearSVR
 
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
+from joulepath.data import joints_in
 from joulepath.errors import InvalidModel, MissingDependency
 from joulepath.learn._features import PHYSICS_VERSION, PhysicsFeatures, physics_transform
 from joulepath.learn._svr import ScalableSVR
@@ -275,7 +276,9 @@ class EnergyModel:
             if not isinstance(card["file"], str) or not card["file"].endswith(".json"):
                 raise InvalidModel(f"{src / str(card['file'])}: an XGBoost model must be a .json booster")
             file = model_file(src, card, card_path)
-            doc = check_xgboost_json(file, n_features=n_model_features(len(cols), card["inputs"]))
+            doc = check_xgboost_json(
+                file, n_features=n_model_features(len(cols), card["inputs"], joints_in(cols) or 6)
+            )
             trained = doc["learner"].get("attributes", {}).get(_XGB_COLUMNS_ATTR)
             if trained is not None and trained != json.dumps(list(cols)):
                 raise InvalidModel(

@@ -17,7 +17,8 @@ from sklearn.exceptions import ConvergenceWarning
 from sklearn.model_selection import ParameterGrid
 
 from joulepath._io import atomic_write_text
-from joulepath.data import TARGETS, EnergyTable
+from joulepath.data import EnergyTable, target_columns
+from joulepath.data._schema import MAX_JOINTS
 from joulepath.dynamics import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._evaluate import physics_baseline, score
@@ -72,9 +73,10 @@ class TrainConfig:
         bad = [f for f in self.families if f not in FAMILIES]
         if bad or not self.families:
             raise InvalidInput(f"families {bad or '()'} unknown; use any of {', '.join(FAMILIES)} or all")
-        badt = [t for t in self.targets if t not in TARGETS]
+        known = target_columns(MAX_JOINTS)
+        badt = [t for t in self.targets if t not in known]
         if badt or not self.targets:
-            raise InvalidInput(f"targets {badt or '()'} unknown; use any of {', '.join(TARGETS)}")
+            raise InvalidInput(f"targets {badt or '()'} unknown; use any of {', '.join(known)}")
         if self.grid not in GRIDS:
             raise InvalidInput(f"grid must be one of {GRIDS}, got {self.grid!r}")
         if self.inputs not in INPUTS:
@@ -217,7 +219,18 @@ def train(
         connect_scheduler(config.scheduler).close()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    cols = input_columns(train_table.feature_set, config.inputs)
+    if train_table.n_joints != test_table.n_joints:
+        raise InvalidInput(
+            f"the training table holds a {train_table.n_joints}-joint arm, the test table a "
+            f"{test_table.n_joints}-joint arm; give tables of one robot"
+        )
+    beyond = [t for t in config.targets if t not in train_table.targets]
+    if beyond:
+        raise InvalidInput(
+            f"targets {', '.join(beyond)} name joints the {train_table.n_joints}-joint arm of the table "
+            f"does not have; use any of {', '.join(train_table.targets)}"
+        )
+    cols = input_columns(train_table.feature_set, config.inputs, train_table.n_joints)
     X = train_table.frame[list(cols)].to_numpy(dtype=np.float64)
     groups = train_table.frame["move_id"].to_numpy()
     rows: list[dict[str, Any]] = []

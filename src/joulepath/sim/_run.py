@@ -13,6 +13,7 @@ import numpy as np
 from joulepath._io import atomic_write_text, check_replaceable, make_folder
 from joulepath.data import (
     controller_log_text,
+    generic_log_text,
     ingest,
     moves_sidecar_path,
     save_table,
@@ -59,7 +60,9 @@ def measure(
 
 
 def log_text(robot: Robot, m: Measured) -> str:
-    """The measurement as the controller's CSV text."""
+    """The measurement as the controller's CSV text (a generic joint log for an arm not of 6 joints)."""
+    if robot.n_joints != 6:
+        return generic_log_text(m.t, m.q, m.qd, m.tau)
     pose = robot.fk(m.q)
     quat = pose.quaternion
     euler = pose.euler_zyx_deg  # (z, y, x)
