@@ -139,6 +139,12 @@ def generic_required(n_joints: int = N_JOINTS) -> tuple[str, ...]:
     return ("t", *(f"{p}{i}" for i in range(1, n_joints + 1) for p in ("q", "dq", "tau")))
 
 
+def card_joints(columns: object) -> int:
+    """Joints of a list of model input columns: :func:`joints_in`, or 6 when that is not 5..7."""
+    n = joints_in(columns)
+    return n if MIN_JOINTS <= n <= MAX_JOINTS else N_JOINTS
+
+
 def joints_in(columns: object) -> int:
     """Number of joints whose ``q{i}`` columns are among ``columns`` (1, 2, ... without a hole)."""
     names = set(map(str, columns))  # type: ignore[call-overload]

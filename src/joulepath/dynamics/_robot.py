@@ -108,7 +108,7 @@ class Robot:
 
     @property
     def home(self) -> FloatArray:
-        """Home configuration (rad): q = 0 (ABB's convention), or mid-range for a joint whose range excludes 0."""
+        """Home configuration (rad): q = 0 (ABB), or mid-range for a joint whose range excludes 0."""
         lo, hi = self.chain.lower, self.chain.upper
         outside = np.isfinite(lo) & np.isfinite(hi) & ((lo > 0) | (hi < 0))
         return np.where(outside, (lo + hi) / 2, 0.0)

@@ -31,7 +31,7 @@ from sklearn.svm import LinearSVR
 
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
-from joulepath.data import joints_in
+from joulepath.data._schema import card_joints
 from joulepath.errors import InvalidModel, MissingDependency
 from joulepath.learn._features import PHYSICS_VERSION, PhysicsFeatures, physics_transform
 from joulepath.learn._svr import ScalableSVR
@@ -277,7 +277,7 @@ class EnergyModel:
                 raise InvalidModel(f"{src / str(card['file'])}: an XGBoost model must be a .json booster")
             file = model_file(src, card, card_path)
             doc = check_xgboost_json(
-                file, n_features=n_model_features(len(cols), card["inputs"], joints_in(cols) or 6)
+                file, n_features=n_model_features(len(cols), card["inputs"], card_joints(cols))
             )
             trained = doc["learner"].get("attributes", {}).get(_XGB_COLUMNS_ATTR)
             if trained is not None and trained != json.dumps(list(cols)):

@@ -32,8 +32,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from joulepath._typing import FloatArray
-from joulepath.data import FEATURE_SETS, joints_in, target_columns
-from joulepath.data._schema import MAX_JOINTS
+from joulepath.data import FEATURE_SETS, target_columns
+from joulepath.data._schema import MAX_JOINTS, card_joints
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._families import FAMILIES
 from joulepath.learn._features import INPUTS, input_columns, n_physics_terms
@@ -99,7 +99,7 @@ def check_card(card: Any, card_path: Path) -> dict[str, Any]:
     cols = card["input_columns"]
     if not isinstance(cols, list) or not all(isinstance(c, str) for c in cols):
         raise InvalidModel(f"{card_path}: input_columns must be a list of column names, got {cols!r}")
-    expected = list(input_columns(card["feature_set"], card["inputs"], joints_in(cols) or 6))
+    expected = list(input_columns(card["feature_set"], card["inputs"], card_joints(cols)))
     stored = card.get("input_columns_sha256")
     if stored is not None and stored != input_columns_sha256(cols):
         raise InvalidModel(
@@ -353,7 +353,7 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
         )
     cols = tuple(card["input_columns"])
     n_in = len(cols)
-    n = n_model_features(n_in, card["inputs"], joints_in(cols) or 6)
+    n = n_model_features(n_in, card["inputs"], card_joints(cols))
     if physics:
         phys = steps["physics"]
         if not isinstance(phys, PhysicsFeatures) or not hasattr(phys, "index_"):
