@@ -52,6 +52,7 @@ from typing import Any
 
 from joulepath.description import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput
+from joulepath.export import EXPORTERS
 from joulepath.optimize import ALGORITHMS, AUTO, resolve_algorithm
 
 ALL_TARGETS = ("E", "E1", "E2", "E3", "E4", "E5", "E6")
@@ -112,7 +113,9 @@ class OptimizeStage:
     ``algorithm`` is ``auto`` or a name of :data:`joulepath.optimize.ALGORITHMS`;
     ``generations`` and ``population`` set the evolutionary searches; ``reference``
     also solves every task with the reference solver (CasADi + IPOPT, slow) so the
-    report can state the share of the optimum's saving reached.
+    report can state the share of the optimum's saving reached. ``export`` names the
+    program each task folder gets (:data:`joulepath.export.EXPORTERS`; empty: the
+    controller the robot declares, RAPID for the IRB 120).
     """
 
     tasks: int = 3
@@ -122,6 +125,7 @@ class OptimizeStage:
     population: int = 100
     range_set: str = "lab"
     reference: bool = False
+    export: str = ""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -173,6 +177,7 @@ _ALLOWED: dict[str, tuple[str, ...]] = {
     "methods": ("copula", "copulagan", "ctgan", "tvae"),
     "families": ("mlp", "svr", "par", "xgb"),
     "targets": ALL_TARGETS,
+    "export": ("", *EXPORTERS),
 }
 BOUNDS: dict[str, dict[str, tuple[int, int]]] = {
     "": {"seed": (0, 2**32 - 1), "jobs": (1, 256)},

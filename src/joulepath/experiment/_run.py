@@ -721,7 +721,7 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
                 seed=int(seeds[k].generate_state(1)[0]),
             )
             res = optimize_move(robot, q0, qf, T, cfg, models=models, joints_ranked=joints)
-            write_run(res, robot, folder / f"task-{k:03d}")
+            write_run(res, robot, folder / f"task-{k:03d}", export=o.export or None)
             s = res.summary
             optimum = _optimum(robot, res) if o.reference else None
             rows.append(
