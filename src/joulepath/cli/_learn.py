@@ -123,7 +123,7 @@ def train(
 
 def importance(
     data: Path = typer.Option(..., "--data", help="Energy table (.parquet)."),
-    target: str = typer.Option("E", help="Target: E or E1..E6."),
+    target: str = typer.Option("E", help="Target: E or E1..En."),
     out: Path = typer.Option(..., "--out", help="Folder for importance.csv and the plot."),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
 ) -> int:

@@ -665,13 +665,13 @@ def _plot_heatmap(means: pd.DataFrame, path: Path) -> None:
 
 
 # ----------------------------------------------------------------------------- optimize
-def _models_for(ctx: _Context, fitness: str) -> tuple[Any, ...]:
+def _models_for(ctx: _Context, fitness: str, n_joints: int = 6) -> tuple[Any, ...]:
     from joulepath.learn import best_model
 
     if fitness == "surrogate":
         return (best_model(ctx.root / "models", "E"),)
     if fitness == "surrogate-joints":
-        return tuple(best_model(ctx.root / "models", f"E{i}") for i in range(1, 7))
+        return tuple(best_model(ctx.root / "models", f"E{i}") for i in range(1, n_joints + 1))
     return ()
 
 
@@ -702,7 +702,7 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
         for old in folder.glob("task-*"):
             shutil.rmtree(old)
         robot = load_robot(exp.robot)
-        models = _models_for(ctx, o.fitness)
+        models = _models_for(ctx, o.fitness, robot.n_joints)
         joints = _joints(ctx, robot.n_joints)
         rows = []
         tasks = random_tasks(robot, o.tasks, seed=exp.seed, range_set=o.range_set)

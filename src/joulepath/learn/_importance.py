@@ -34,7 +34,7 @@ def feature_importance(
     from sklearn.inspection import permutation_importance
 
     if target not in table.frame.columns:
-        raise InvalidInput(f"unknown target {target!r}; use one of E, E1..E6")
+        raise InvalidInput(f"unknown target {target!r}; use one of {', '.join(table.targets)}")
     rng = np.random.default_rng(seed)
     frame = table.frame
     if len(frame) > max_rows:
