@@ -485,7 +485,9 @@ CASES = [
     C("log-hour-gap", "ingest {in}/a.csv --out {out}/t.parquet", 0, "gap", {"a.csv": "\n".join(LOG_LINES[:31]+ [",".join([f"{3600 + float(r.split(',')[0]):.6f}"] + r.split(",")[1:])for r in LOG_LINES[31:]])+ "\n"}),  # split there, not refused (design)
     C("log-milliseconds", "ingest {in}/a.csv --out {out}/t.parquet", 2, "a.csv", {"a.csv": "\n".join([LOG_LINES[0]]+ [",".join([f"{1000 * float(r.split(',')[0]):.3f}"] + r.split(",")[1:])for r in LOG_LINES[1:]])+ "\n"}),
     C("log-degrees", "ingest {in}/a.csv --out {out}/t.parquet --robot irb120", 2, "a.csv", {"a.csv": _log(scale=0.3 * 57.29578)}),
-    C("log-seven-joints", "ingest {in}/a.csv --out {out}/t.parquet", 2, "a.csv", {"a.csv": _log(joints=7)}),
+    C("log-seven-joints", "ingest {in}/a.csv --out {out}/t.parquet", 0, "21 inputs", {"a.csv": _log(joints=7)}),
+    C("log-eight-joints", "ingest {in}/a.csv --out {out}/t.parquet", 2, "5 to 7 joints", {"a.csv": _log(joints=8)}),
+    C("log-four-joints", "ingest {in}/a.csv --out {out}/t.parquet", 2, "a.csv", {"a.csv": _log(joints=4)}),
     C("log-motionless", "ingest {in}/a.csv --out {out}/t.parquet", 2, "a.csv", {"a.csv": _log(scale=0.0)}),
     C("log-controller-header-short", "ingest {in}/a.csv --out {out}/t.parquet", 2, "a.csv", {"a.csv": "t,q1,dq1,tau1,q2,dq2,tau2,q3,dq3,tau3,q4,dq4,tau4,q5,dq5,tau5,q6,dq6,tau6,x,y,z\n0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n"}),
     C("log-is-a-folder", "ingest {in} --out {out}/t.parquet", 2, "", {}),

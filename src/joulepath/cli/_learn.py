@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 
 import typer
@@ -66,10 +67,9 @@ def train(
     from joulepath.learn import train as run
 
     check_out_folder(out)
-    train_table, test_table = load_table(data), load_table(test)
     config = TrainConfig(
         families=_split(family, "--family", FAMILIES, FAMILIES),
-        targets=_split(target, "--target", target_columns(MAX_JOINTS), train_table.targets),
+        targets=_split(target, "--target", target_columns(MAX_JOINTS), target_columns(MAX_JOINTS)),
         grid=grid,
         cv=cv,
         inputs=inputs,
@@ -79,6 +79,9 @@ def train(
         robot=robot,
     )
     load_robot(robot)  # an unknown robot fails now, not after the training
+    train_table, test_table = load_table(data), load_table(test)
+    if target.strip() == "all":  # every target of the table's arm: E1..En and E
+        config = replace(config, targets=train_table.targets)
     for path, table, what in ((data, train_table, "--data"), (test, test_table, "--test")):
         if len(table.frame) == 0:
             raise InvalidInput(

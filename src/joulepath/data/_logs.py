@@ -185,8 +185,8 @@ def moves_sidecar_path(log: str | os.PathLike[str]) -> Path:
 
 
 def generic_joints(header: list[str]) -> int:
-    """Joints of a generic log header: the largest ``i`` of its ``q{i}`` columns (0 if none)."""
-    found = [int(m.group(2)) for h in header if (m := _JOINT_COLUMN.match(h)) and m.group(1) == "q"]
+    """Joints of a generic log header: the largest ``i`` of ``q{i}``, ``dq{i}``, ``tau{i}`` (0 if none)."""
+    found = [int(m.group(2)) for h in header if (m := _JOINT_COLUMN.match(h)) and m.group(1) != "ddq"]
     return max(found, default=0)
 
 
