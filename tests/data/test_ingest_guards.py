@@ -132,21 +132,21 @@ def test_ingest_speed_far_over_the_limit_refused(tmp_path, signals, irb120):
         ingest([p], robot=irb120)
 
 
-def test_ingest_refuses_a_robot_without_six_joints(tmp_path, signals):
+def test_ingest_refuses_a_robot_of_another_joint_count(tmp_path, signals):
     class Seven:
         name = "seven"
         n_joints = 7
 
     t, q, qd, tau = signals
     p = _generic(tmp_path / "g.csv", t, q, qd, tau)
-    with pytest.raises(InvalidInput, match="has 7 joints"):
+    with pytest.raises(InvalidInput, match="logs 6 joints, but robot 'seven' has 7"):
         ingest([p], robot=Seven())  # type: ignore[arg-type]
 
 
 # --------------------------------------------------------------------------- joint count
 
 
-@pytest.mark.parametrize("extra", [("q7", "dq7", "tau7"), ("q0",), ("ddq9",)])
+@pytest.mark.parametrize("extra", [("q8", "dq8", "tau8"), ("q0",), ("ddq9",)])
 def test_read_log_unexpected_joint_columns_refused(tmp_path, signals, extra):
     t, q, qd, tau = signals
     p = _generic(tmp_path / "j.csv", t, q, qd, tau, **{c: q[:, 0] for c in extra})
@@ -154,11 +154,19 @@ def test_read_log_unexpected_joint_columns_refused(tmp_path, signals, extra):
         read_log(p)
 
 
-def test_cli_seven_joint_log_refused(tmp_path, signals, capsys):
+def test_cli_eight_joint_log_refused(tmp_path, signals, capsys):
     t, q, qd, tau = signals
-    p = _generic(tmp_path / "j7.csv", t, q, qd, tau, q7=q[:, 0], dq7=qd[:, 0], tau7=tau[:, 0])
-    out = tmp_path / "j7.parquet"
-    _refused(capsys, ["ingest", str(p), "--out", str(out)], "this looks like a 7-joint log", out)
+    extra = {f"{p}{i}": s[:, 0] for i in (7, 8) for p, s in (("q", q), ("dq", qd), ("tau", tau))}
+    p = _generic(tmp_path / "j8.csv", t, q, qd, tau, **extra)
+    out = tmp_path / "j8.parquet"
+    _refused(capsys, ["ingest", str(p), "--out", str(out)], "arms of 5 to 7 joints", out)
+
+
+def test_seven_joint_log_missing_a_column_refused(tmp_path, signals):
+    t, q, qd, tau = signals
+    p = _generic(tmp_path / "j7.csv", t, q, qd, tau, q7=q[:, 0], dq7=qd[:, 0])
+    with pytest.raises(InvalidLog, match=r"header lacks column\(s\) tau7 of a 7-joint log"):
+        read_log(p)
 
 
 # --------------------------------------------------------------------------- empty results

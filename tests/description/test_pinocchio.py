@@ -43,12 +43,10 @@ def test_chain_from_urdf_unaligned_axis(tmp_path):
 @pytest.mark.parametrize(
     ("kwargs", "pattern"),
     [
-        ({"n": 5}, r"has 5 movable joints; joulepath needs a serial arm with 6 revolute joints"),
-        (
-            {"types": ["revolute"] * 5 + ["prismatic"]},
-            r"joint 'j6' is JointModelP.*use type=\"revolute\"",
-        ),
-        ({"types": ["continuous"] + ["revolute"] * 5}, r"joint 'j1' is JointModelRUB"),
+        ({"n": 4}, r"has 4 movable joints \(j1, j2, j3, j4\); joulepath takes serial arms of 5 to 7"),
+        ({"n": 8}, r"has 8 movable joints .*lock the extra ones"),
+        ({"types": ["revolute"] * 5 + ["prismatic"]}, r"joint 'j6' is prismatic.*--lock j6=VALUE"),
+        ({"types": ["revolute"] * 5 + ["floating"]}, r"joint 'j6' is floating"),
     ],
 )
 def test_chain_from_urdf_refuses_other_arms(tmp_path, kwargs, pattern):

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
 
 from joulepath.cli._common import check_out_file, check_out_folder, console, robot_inputs
+from joulepath.description import DEFAULT_ROBOT
 
 if TYPE_CHECKING:
     from joulepath.dynamics import Robot
@@ -40,7 +42,9 @@ rapid_app = typer.Typer(help="Write RAPID programs for the ABB controller.", no_
 @rapid_app.command("collect")
 def rapid_collect(
     out: Path = typer.Option(..., "--out", help="Folder for JPCollect.mod and JPMeasure.mod."),
-    robot: str = typer.Option("irb120", help="Robot name or .irml/.urdf path."),
+    robot: str = typer.Option(
+        DEFAULT_ROBOT, help="Robot name (irb120, ur5, panda, ...) or .irml/.urdf path."
+    ),
     moves: int = typer.Option(1000, min=1, help="Number of random moves."),
     range_set: str = typer.Option("collection", help="Joint bounds: collection (App. D.1), lab, nominal."),
     mode: str = typer.Option(
@@ -54,19 +58,32 @@ def rapid_collect(
     force: bool = typer.Option(
         False, "--force", help="Replace JPCollect.mod and JPMeasure.mod if --out already holds them."
     ),
+    export: str = typer.Option(
+        "", "--export", help="rapid: write ABB RAPID for a robot that is not an ABB arm anyway (warns)."
+    ),
 ) -> int:
     """Write the data-collection programs of thesis Appendix D (collection + measurement).
 
     Programs already in --out are never replaced silently: the command refuses
-    (exit 2, nothing written) unless --force is given.
+    (exit 2, nothing written) unless --force is given. RAPID runs on ABB
+    controllers: another vendor's robot is refused unless --export rapid is given.
     """
     from joulepath import load_robot
     from joulepath._io import atomic_write_text, make_folder
     from joulepath.errors import InvalidInput
-    from joulepath.export import collection_programs
+    from joulepath.export import collection_programs, refuse_foreign
 
     files = EXCITE_FILES if mode == "excitation" else COLLECT_FILES
+    if export not in ("", "rapid"):
+        raise typer.BadParameter(f"rapid collect writes RAPID only; got {export!r}", param_hint="--export")
     check_out_folder(out, files=files, inputs=robot_inputs(robot))
+    r = load_robot(robot)
+    warning = refuse_foreign(r, "rapid", explicit=export == "rapid")
+    if warning:
+        print(f"warning: {warning}", file=sys.stderr)
+    used = r.ranges_for(range_set)[0]
+    if used != range_set:
+        console.print(f"note: {r.name} has no {range_set!r} range set; the moves use its nominal ranges")
     existing = [name for name in files if (out / name).exists()]
     if existing and not force:
         raise InvalidInput(
@@ -74,11 +91,9 @@ def rapid_collect(
             f"{'them' if len(existing) > 1 else 'it'}, or choose another --out"
         )
     if mode == "excitation":
-        programs = _excitation_programs(load_robot(robot), range_set=range_set, seed=seed)
+        programs = _excitation_programs(r, range_set=range_set, seed=seed)
     else:
-        programs = collection_programs(
-            load_robot(robot), n_moves=moves, range_set=range_set, mode=mode, seed=seed
-        )
+        programs = collection_programs(r, n_moves=moves, range_set=range_set, mode=mode, seed=seed)
     make_folder(out)
     for name, text in programs.items():
         atomic_write_text(out / name, text)
@@ -96,7 +111,15 @@ def simulate(
         0, min=0, max=2**32 - 1, help="Seed of the random moves and of the plant's noise."
     ),
     plan: str = typer.Option("", help="'thesis': real, sim, micro and test datasets in one go."),
-    robot: str = typer.Option("irb120", help="Robot name or .irml path."),
+    robot: str = typer.Option(
+        DEFAULT_ROBOT, help="Robot name (irb120, ur5, panda, ...) or .irml/.urdf path."
+    ),
+    range_set: str = typer.Option(
+        "collection",
+        "--range-set",
+        help="Joint bounds of the moves: collection (App. D.1), lab, nominal; a robot without the set "
+        "uses its nominal ranges.",
+    ),
     workers: int = typer.Option(2, min=1, help="Processes for --plan."),
     mode: str = typer.Option(
         "moves", help="moves: random moves; excitation: an exciting trajectory for `joulepath identify`."
@@ -146,7 +169,11 @@ def simulate(
             target, plant=plant, robot=robot, seed=seed, periods=periods, harmonics=harmonics
         )
     with console.status(f"simulating {moves} moves on the {plant} plant..."):
-        res = run(target, plant=plant, n_moves=moves, seed=seed, robot=robot)
+        res = run(target, plant=plant, n_moves=moves, seed=seed, robot=robot, range_set=range_set)
+    if res.range_set != range_set:
+        console.print(f"note: {robot} has no {range_set!r} range set; the moves use its nominal ranges")
+    if plant == "lab" and not res.plant_note.startswith("emulated IRB 120"):
+        console.print(f"note: the lab plant is a {res.plant_note}")
     console.print(
         f"wrote {res.log} ({res.n_rows:,} rows, {res.n_moves} moves: simulated {res.duration_s:.1f} s "
         f"of robot motion) and {res.moves}"

@@ -5,11 +5,13 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 
 import typer
 
 from joulepath.cli._common import check_out_folder, console
+from joulepath.description import DEFAULT_ROBOT
 
 
 def _split(
@@ -46,7 +48,7 @@ def train(
     data: Path = typer.Option(..., "--data", help="Training energy table (.parquet)."),
     test: Path = typer.Option(..., "--test", help="Test table of other moves (.parquet)."),
     family: str = typer.Option("all", help="mlp, svr, par, xgb (comma separated) or all."),
-    target: str = typer.Option("E", help="Targets: E, E1..E6 (comma separated) or all."),
+    target: str = typer.Option("E", help="Targets: E, E1..En (comma separated) or all."),
     grid: str = typer.Option("quick", help="quick, or thesis (Tables 2.2-2.5)."),
     cv: int = typer.Option(5, min=2, help="Folds."),
     inputs: str = typer.Option("physics", help="physics (raw + nominal model terms) or thesis (raw)."),
@@ -54,11 +56,12 @@ def train(
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     jobs: int = typer.Option(1, min=1, help="Local processes for the grid search."),
     scheduler: str = typer.Option("", help="Dask scheduler address (tcp://HOST:PORT) for the grid search."),
-    robot: str = typer.Option("irb120", help="Robot of the data."),
+    robot: str = typer.Option(DEFAULT_ROBOT, help="Robot of the data."),
 ) -> int:
     """Tune (grid search + CV), refit and test energy models; save them with cards and reports."""
     from joulepath import load_robot
-    from joulepath.data import TARGETS, load_table
+    from joulepath.data import load_table, target_columns
+    from joulepath.data._schema import MAX_JOINTS
     from joulepath.errors import InvalidInput
     from joulepath.learn import FAMILIES, TrainConfig
     from joulepath.learn import train as run
@@ -66,7 +69,7 @@ def train(
     check_out_folder(out)
     config = TrainConfig(
         families=_split(family, "--family", FAMILIES, FAMILIES),
-        targets=_split(target, "--target", TARGETS, TARGETS),
+        targets=_split(target, "--target", target_columns(MAX_JOINTS), target_columns(MAX_JOINTS)),
         grid=grid,
         cv=cv,
         inputs=inputs,
@@ -77,6 +80,8 @@ def train(
     )
     load_robot(robot)  # an unknown robot fails now, not after the training
     train_table, test_table = load_table(data), load_table(test)
+    if target.strip() == "all":  # every target of the table's arm: E1..En and E
+        config = replace(config, targets=train_table.targets)
     for path, table, what in ((data, train_table, "--data"), (test, test_table, "--test")):
         if len(table.frame) == 0:
             raise InvalidInput(
@@ -121,7 +126,7 @@ def train(
 
 def importance(
     data: Path = typer.Option(..., "--data", help="Energy table (.parquet)."),
-    target: str = typer.Option("E", help="Target: E or E1..E6."),
+    target: str = typer.Option("E", help="Target: E or E1..En."),
     out: Path = typer.Option(..., "--out", help="Folder for importance.csv and the plot."),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
 ) -> int:

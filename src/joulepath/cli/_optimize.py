@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -9,11 +10,12 @@ import numpy as np
 import typer
 
 from joulepath.cli._common import check_out_folder, console, parse_joints
-from joulepath.cli._robot import load_robot_for_cli, unchecked_option
+from joulepath.cli._robot import load_robot_for_cli, lock_option, unchecked_option
+from joulepath.description import DEFAULT_ROBOT
 
 
 def _models(
-    model_dir: Path | None, fitness: str, family: str, robot_name: str, n_joints: int = 6
+    model_dir: Path | None, fitness: str, family: str, robot_name: str, n_joints: int, robot_arg: str = ""
 ) -> tuple[tuple[object, ...], tuple[int, ...] | None]:
     from joulepath.errors import InvalidModel
     from joulepath.learn import best_model, read_joints_json
@@ -29,10 +31,21 @@ def _models(
         raise typer.BadParameter(
             f"--fitness {fitness} needs --model (a `joulepath train` output folder)", param_hint="--model"
         )
-    targets = ("E",) if fitness == "surrogate" else tuple(f"E{i}" for i in range(1, 7))
+    targets = ("E",) if fitness == "surrogate" else tuple(f"E{i}" for i in range(1, n_joints + 1))
     models = tuple(best_model(model_dir, t, family=family or None) for t in targets)
     for m in models:
-        if m.card.get("robot") not in (None, robot_name):
+        on_card, source = m.card.get("robot"), m.card.get("robot_source")
+        if not on_card and not source:
+            raise InvalidModel(
+                f"{model_dir}: the {m.family} model for {m.target} names no robot on its card; "
+                "retrain it with `joulepath train --robot ...` (cards name the robot of their data)"
+            )
+        if not on_card and source not in (robot_arg, robot_name):
+            raise InvalidModel(
+                f"{model_dir}: the {m.family} model for {m.target} was trained for robot {source!r}, "
+                f"not {robot_arg!r}; train a model on this robot's data"
+            )
+        if on_card and on_card != robot_name:
             raise InvalidModel(
                 f"{model_dir}: the {m.family} model for {m.target} was trained on data of robot "
                 f"{m.card.get('robot')!r}, not {robot_name!r}; train a model on this robot's data"
@@ -81,21 +94,35 @@ def optimize(
     generations: int = typer.Option(200, min=1, help="Generation cap (ga, de, ma-*)."),
     population: int = typer.Option(100, min=4, help="Population (ga, de, ma-*)."),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
-    robot: str = typer.Option("irb120", help="Robot name or .irml/.urdf path."),
+    robot: str = typer.Option(
+        DEFAULT_ROBOT, help="Robot name (irb120, ur5, panda, ...) or .irml/.urdf path."
+    ),
+    export: str = typer.Option(
+        "",
+        "--export",
+        help="Program to write: rapid, urscript, urscript-cb3 or ros2 (default: the robot's own controller).",
+    ),
+    lock: list[str] = lock_option(),
     unchecked: bool = unchecked_option(),
     out: Path = typer.Option(..., "--out", help="Run folder."),
 ) -> int:
-    """Find the least-energy path between two configurations in a fixed time; verify; export RAPID.
+    """Find the least-energy path between two configurations in a fixed time; verify; export the program.
 
-    Exit code 0: the optimized path respects every limit and path.mod was written;
-    1: it ran, but the result breaks a limit and no program was written; 2: bad input
-    (an infeasible task included).
+    The program is that of the robot's own controller (IRB 120: RAPID path.mod; UR:
+    URScript path.script; other arms: ROS 2 trajectory.yaml + trajectory.csv), or the
+    one --export names. Exit code 0: the optimized path respects every limit and the
+    program was written; 1: it ran, but the result breaks a limit and no program was
+    written; 2: bad input (an infeasible task included).
     """
+    from joulepath.export import select_exporter
     from joulepath.optimize import MAX_DURATION, OptimizeConfig, optimize_move, write_run
     from joulepath.trajectory import sample_times
 
     check_out_folder(out)
-    r = load_robot_for_cli(robot, unchecked=unchecked)
+    r = load_robot_for_cli(robot, unchecked=unchecked, lock=lock)
+    exporter, warning = select_exporter(r, export or None)
+    if warning is not None:
+        print(f"warning: {warning}", file=sys.stderr)
     q0 = parse_joints(start, option="--start", degrees=degrees, n=r.n_joints)
     qf = parse_joints(end, option="--end", degrees=degrees, n=r.n_joints)
     config = OptimizeConfig(
@@ -112,18 +139,26 @@ def optimize(
     )
     if np.isfinite(duration) and 0 < duration <= MAX_DURATION:
         sample_times(duration)  # a whole number of samples: checked before any model is loaded
-    models, joints = _models(model, fitness, family, r.name, r.n_joints)
+    models, joints = _models(model, fitness, family, r.name, r.n_joints, robot)
     with console.status(f"optimizing with {config.search.name} on the {fitness} fitness..."):
         result = optimize_move(
             r, np.array(q0), np.array(qf), duration, config, models=models, joints_ranked=joints
         )
-    files = write_run(result, r, out)
+    files = write_run(result, r, out, export=exporter.name)
     s = result.summary
+    program = ", ".join(exporter.files)
     if not s.limits_ok:
         console.print(
             f"REFUSED: the optimized path breaks a limit ({'; '.join(s.limit_excess)}); "
-            f"path.mod was NOT written and no saving is claimed (default {s.energy_default_J:.3f} J)"
+            f"{program} was NOT written and no saving is claimed (default {s.energy_default_J:.3f} J)"
         )
+        console.print(f"wrote {', '.join(sorted(files))} in {out}")
+        return 1
+    if not all(name in files for name in exporter.files):
+        import json
+
+        why = json.loads((out / "result.json").read_text()).get("program_refused", "")
+        console.print(f"REFUSED: {program} was NOT written: {why}")
         console.print(f"wrote {', '.join(sorted(files))} in {out}")
         return 1
     console.print(
@@ -132,8 +167,13 @@ def optimize(
         f"({s.algorithm}, {s.iterations} iterations, {s.evaluations:,} evaluations, {s.wall_s:.2f} s); "
         f"within every limit; largest TCP deviation {s.max_tcp_deviation_mm:.1f} mm"
     )
+    if r.friction is None:
+        console.print(f"physics: no friction modelled for {r.name}; friction: {r.friction_note}")
     if s.saved_lab_pct is not None:
-        console.print(f"on the emulated lab robot: {s.saved_lab_pct:.1f} % saved")
+        if s.lab_plant.startswith("emulated IRB 120"):
+            console.print(f"on the emulated lab robot: {s.saved_lab_pct:.1f} % saved")
+        else:
+            console.print(f"on a {s.lab_plant}: {s.saved_lab_pct:.1f} % saved")
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
     return 0
 
@@ -147,7 +187,7 @@ def bench_optimizers(
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     jobs: int = typer.Option(2, min=1, help="Local processes."),
     scheduler: str = typer.Option("", help="Dask scheduler address."),
-    robot: str = typer.Option("irb120"),
+    robot: str = typer.Option(DEFAULT_ROBOT),
     out: Path = typer.Option(..., "--out", help="Folder for the results CSV."),
 ) -> int:
     """The thesis' optimizer benchmark (§4.5.1): every GA/DE/MA configuration on random tasks."""
@@ -161,7 +201,8 @@ def bench_optimizers(
         [("physics", "single")] if model is None else [("surrogate", "single"), ("surrogate-joints", "multi")]
     )
     for fitness, kind in variants:
-        models, joints = _models(model, fitness, "", robot) if model else ((), None)
+        r = load_robot_for_cli(robot)
+        models, joints = _models(model, fitness, "", r.name, r.n_joints, robot) if model else ((), None)
         with console.status(f"{kind}-objective ({fitness}): {tasks} tasks...") as status:
             frame = run(
                 robot=robot,

@@ -25,16 +25,50 @@ def unchecked_option() -> Any:
     return typer.Option(False, "--unchecked", help=UNCHECKED_HELP)
 
 
-def load_robot_for_cli(name_or_path: str, *, unchecked: bool = False) -> Robot:
+def lock_option() -> Any:
+    """The ``--lock JOINT=VALUE`` option (repeatable), for any command that takes a URDF robot."""
+    return typer.Option(
+        [],
+        "--lock",
+        help="URDF: fix a joint (a gripper's finger, a mimic joint, a branch) at VALUE "
+        "(rad; m if prismatic); "
+        "repeat for several.",
+    )
+
+
+def parse_locks(items: list[str] | None) -> dict[str, float]:
+    """``["finger=0", "j7=0.5"]`` -> ``{"finger": 0.0, "j7": 0.5}``; BadParameter otherwise."""
+    import math
+
+    out: dict[str, float] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        try:
+            number = float(value)
+        except ValueError:
+            number = math.nan
+        if not sep or not name.strip() or not math.isfinite(number):
+            raise typer.BadParameter(
+                f"{item!r} is not JOINT=VALUE (a joint name and a finite number, e.g. finger_joint=0)",
+                param_hint="--lock",
+            )
+        out[name.strip()] = number
+    return out
+
+
+def load_robot_for_cli(name_or_path: str, *, unchecked: bool = False, lock: list[str] | None = None) -> Robot:
     """Load a robot for a command: refused with the finding when it fails the physical check.
 
     With ``unchecked`` (the ``--unchecked`` option) the robot is used anyway and one
     warning line on stderr names the first error, so that the output of an expert's
-    run is never taken for a checked one.
+    run is never taken for a checked one. Warnings from reading the description (a
+    joint named like a gripper, a continuous joint given ±360°) go to stderr too.
     """
     from joulepath import load_robot
 
-    robot = load_robot(name_or_path, checked=not unchecked)
+    robot = load_robot(name_or_path, checked=not unchecked, lock=parse_locks(lock) or None)
+    for where, message in robot.chain.notes:
+        print(f"warning: {robot.name}: {where} {message}", file=sys.stderr)
     if unchecked:
         errors = [f for f in robot.check_physical() if f.severity == "error"]
         if errors:
@@ -49,14 +83,17 @@ def load_robot_for_cli(name_or_path: str, *, unchecked: bool = False) -> Robot:
 
 @robot_app.command("show")
 def show(
-    robot: str = typer.Argument(..., help="Bundled robot name (irb120) or an .irml/.urdf path."),
+    robot: str = typer.Argument(..., help="Robot name (irb120, ur5, panda, ...) or an .irml/.urdf path."),
     strict: bool = typer.Option(False, help="Exit with code 1 when the physical check finds errors."),
+    lock: list[str] = lock_option(),
 ) -> int:
     """Print a robot's description and its physical-validity check (also for a robot that fails it)."""
     from joulepath import load_robot
+    from joulepath.export import declared_controller
 
-    r = load_robot(robot, checked=False)  # showing what is wrong is this command's job
+    r = load_robot(robot, checked=False, lock=parse_locks(lock) or None)  # showing what is wrong is our job
     console.print(r.summary(), markup=False)
+    console.print(f"controller: {declared_controller(r)} (--export overrides); friction: {r.friction_note}")
     home = r.fk(r.home)
     x, y, z = home.position_mm
     w, qx, qy, qz = home.quaternion
@@ -80,13 +117,14 @@ def show(
 
 @robot_app.command("fk")
 def fk(
-    robot: str = typer.Argument(..., help="Bundled robot name or an .irml/.urdf path."),
+    robot: str = typer.Argument(..., help="Robot name (irb120, ur5, panda, ...) or an .irml/.urdf path."),
     q: str = typer.Option(..., "--q", help="Joint positions, comma separated."),
     degrees: bool = typer.Option(False, "--degrees", help="--q is in degrees (default rad)."),
+    lock: list[str] = lock_option(),
     unchecked: bool = unchecked_option(),
 ) -> int:
     """Print the tool0 pose for one configuration, in the controller's units."""
-    r = load_robot_for_cli(robot, unchecked=unchecked)
+    r = load_robot_for_cli(robot, unchecked=unchecked, lock=lock)
     values = parse_joints(q, option="--q", degrees=degrees, n=r.n_joints)
     pose = r.fk(values)
     x, y, z = pose.position_mm

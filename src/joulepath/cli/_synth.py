@@ -7,6 +7,7 @@ from pathlib import Path
 import typer
 
 from joulepath.cli._common import check_out_file, check_out_folder, console, robot_inputs
+from joulepath.description import DEFAULT_ROBOT
 
 
 def synth(
@@ -22,7 +23,7 @@ def synth(
     repair_kinematics: bool = typer.Option(
         False, "--repair-kinematics", help="Recompute the TCP columns from q (and their derivatives)."
     ),
-    robot: str = typer.Option("irb120", "--robot", help="Robot for --repair-kinematics."),
+    robot: str = typer.Option(DEFAULT_ROBOT, "--robot", help="Robot for --repair-kinematics."),
     save_model: Path | None = typer.Option(
         None, "--save-model", help="Also save the fitted synthesizer (a pickle + SHA-256 sidecar)."
     ),

@@ -4,6 +4,7 @@ from joulepath.data._features import find_gaps, segment_moves, tcp_columns
 from joulepath.data._logs import (
     JointLog,
     controller_log_text,
+    generic_log_text,
     is_moves_sidecar,
     moves_sidecar_path,
     read_log,
@@ -16,7 +17,11 @@ from joulepath.data._schema import (
     GENERIC_REQUIRED,
     LOG_COLUMNS,
     TARGETS,
+    feature_columns,
+    generic_required,
+    joints_in,
     table_columns,
+    target_columns,
 )
 from joulepath.data._table import EnergyTable, check_columns, ingest, load_table, save_table
 
@@ -31,15 +36,20 @@ __all__ = [
     "TARGETS",
     "check_columns",
     "controller_log_text",
+    "feature_columns",
     "find_gaps",
+    "generic_log_text",
+    "generic_required",
     "ingest",
     "is_moves_sidecar",
+    "joints_in",
     "load_table",
     "moves_sidecar_path",
     "read_log",
     "save_table",
     "segment_moves",
     "table_columns",
+    "target_columns",
     "tcp_columns",
     "write_controller_log",
 ]

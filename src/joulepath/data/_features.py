@@ -10,7 +10,7 @@ from scipy.signal import find_peaks
 
 from joulepath._typing import FloatArray
 from joulepath.data._logs import JointLog
-from joulepath.data._schema import FEATURE_SETS, N_JOINTS, TARGETS, table_columns
+from joulepath.data._schema import FEATURE_SETS, TARGETS, table_columns
 from joulepath.energy import joint_energy
 
 REST_SPEED = 1.0 * np.pi / 180.0
@@ -183,7 +183,7 @@ def log_to_frame(
     feature_set : {"full40", "joint"}
     tcp : (position m (n, 3), quaternion w-first (n, 4), EulerZYX z,y,x rad (n, 3)), optional
         TCP signals for ``full40``; default: the ones the log carries.
-    speed_scale : ndarray of shape (6,), optional
+    speed_scale : ndarray of shape (n,), optional
         Joint speed limits for move segmentation.
     move_offset : int
         Added to the move labels (to keep ``move_id`` unique across files).
@@ -217,7 +217,8 @@ def log_to_frame(
     last = np.r_[labels[1:] != labels[:-1], True]
     cols: dict[str, np.ndarray] = {"move_id": labels + move_offset, "t": t}
     qdd = log.qdd[idx] if log.qdd is not None else _differentiate(qd, t, first, last)
-    for i in range(N_JOINTS):
+    n = q.shape[1]
+    for i in range(n):
         cols[f"q{i + 1}"] = q[:, i]
         cols[f"dq{i + 1}"] = qd[:, i]
         cols[f"ddq{i + 1}"] = qdd[:, i]
@@ -231,12 +232,12 @@ def log_to_frame(
             tcp_columns(pos, quat, np.unwrap(eul, axis=0), lambda v: _differentiate(v, t, first, last))
         )
     energy = joint_energy(tau, qd, dt)  # the one definition: |tau_i qd_i| dt
-    for i in range(N_JOINTS):
+    for i in range(n):
         cols[f"E{i + 1}"] = energy[:, i]
     cols["E"] = energy.sum(axis=1)
     cols["dt"] = dt
     frame = pd.DataFrame(cols)
-    return frame[list(table_columns(feature_set))]
+    return frame[list(table_columns(feature_set, n))]
 
 
 __all__ = ["FEATURE_SETS", "TARGETS", "find_gaps", "log_to_frame", "sample_lengths", "segment_moves"]

@@ -19,9 +19,10 @@ Units are checked, not assumed: ``t`` must be in seconds (a median sample period
 over :data:`MAX_SAMPLE_PERIOD_S`, or logged speeds about 1000 times the rate of the
 logged positions, mean milliseconds); a speed column that is about 57 times (or 1/57
 of) the rate of its position column means degrees mixed with radians. A generic
-log's header must name exactly joints 1..6: ``q7`` or ``tau0`` is refused, never
-dropped. Gaps in ``t`` are not refused here: ingestion splits the moves there
-(:func:`joulepath.data.find_gaps`).
+log's header must name joints 1..n of an arm of 5 to 7 joints (``q1..q7``, ``dq1..dq7``,
+``tau1..tau7`` for a 7-joint arm), each with ``q``, ``dq`` and ``tau``: ``tau0`` or
+``q9`` or a missing ``tau3`` is refused, never dropped. Gaps in ``t`` are not
+refused here: ingestion splits the moves there (:func:`joulepath.data.find_gaps`).
 """
 
 from __future__ import annotations
@@ -43,9 +44,12 @@ from joulepath._typing import FloatArray
 from joulepath.data._schema import (
     GENERIC_REQUIRED,
     LOG_COLUMNS,
+    MAX_JOINTS,
+    MIN_JOINTS,
     MOVES_SIDECAR_COLUMNS,
     MOVES_SIDECAR_SUFFIX,
     N_JOINTS,
+    generic_required,
 )
 from joulepath.errors import InvalidLog
 from joulepath.units import DEG, MM
@@ -72,9 +76,9 @@ class JointLog:
     kind : {"controller", "generic"}
     t : ndarray of shape (n,)
         s.
-    q, qd, tau : ndarray of shape (n, 6)
-        rad, rad/s, N·m.
-    qdd : ndarray of shape (n, 6) or None
+    q, qd, tau : ndarray of shape (n, n_joints)
+        rad, rad/s, N·m (a controller log has 6 joints, a generic log 5 to 7).
+    qdd : ndarray of shape (n, n_joints) or None
         Logged accelerations (generic logs only), rad/s².
     tcp_position : ndarray of shape (n, 3) or None
         m (controller logs).
@@ -180,23 +184,32 @@ def moves_sidecar_path(log: str | os.PathLike[str]) -> Path:
     return p.with_name(p.name.removesuffix(".csv") + MOVES_SIDECAR_SUFFIX)
 
 
+def generic_joints(header: list[str]) -> int:
+    """Joints of a generic log header: the largest ``i`` of ``q{i}``, ``dq{i}``, ``tau{i}`` (0 if none)."""
+    found = [int(m.group(2)) for h in header if (m := _JOINT_COLUMN.match(h)) and m.group(1) != "ddq"]
+    return max(found, default=0)
+
+
 def _check_joint_columns(header: list[str], source: str) -> None:
-    """Refuse generic-log columns of joints other than 1..6 (never drop them)."""
+    """Refuse generic-log columns of joints other than 1..n, n = 5..7 (never drop them)."""
+    n = generic_joints(header)
+    if not MIN_JOINTS <= n <= MAX_JOINTS:
+        n = N_JOINTS
     other = sorted(
-        {
-            int(m.group(2))
-            for h in header
-            if (m := _JOINT_COLUMN.match(h)) and not 1 <= int(m.group(2)) <= N_JOINTS
-        }
+        {int(m.group(2)) for h in header if (m := _JOINT_COLUMN.match(h)) and not 1 <= int(m.group(2)) <= n}
     )
     if other:
         cols = [h for h in header if (m := _JOINT_COLUMN.match(h)) and int(m.group(2)) in other]
-        n = max([N_JOINTS, *other])
         raise InvalidLog(
             f"{source}: line 1: column(s) {', '.join(cols)} name joint(s) {', '.join(map(str, other))}, "
-            f"but joulepath reads logs of 6-joint arms (q1..q6, dq1..dq6, tau1..tau6)"
-            + (f"; this looks like a {n}-joint log" if n > N_JOINTS else "")
-            + ": log a 6-joint arm, or remove those columns if they are not joints of the arm"
+            f"but joulepath reads logs of arms of {MIN_JOINTS} to {MAX_JOINTS} joints, numbered from 1 "
+            "(q1..qn, dq1..dqn, tau1..taun): remove those columns if they are not joints of the arm"
+        )
+    missing = [c for c in generic_required(n) if c not in header]
+    if missing:
+        raise InvalidLog(
+            f"{source}: line 1: header lacks column(s) {', '.join(missing)} of a {n}-joint log; a generic "
+            f"log needs t and q{{i}}, dq{{i}}, tau{{i}} for i = 1..{n} (s, rad, rad/s, N·m)"
         )
 
 
@@ -209,7 +222,7 @@ def detect_kind(header: list[str], source: str) -> str:
             f"{source}: line 1: this is the list of programmed moves that `joulepath simulate` writes "
             f"beside its log (*{MOVES_SIDECAR_SUFFIX}), not a joint log; give the log itself"
         )
-    if "x" not in header and all(c in header for c in GENERIC_REQUIRED):
+    if "x" not in header and all(c in header for c in generic_required(MIN_JOINTS)):
         dup = sorted({h for h in header if header.count(h) > 1})
         if dup:
             raise InvalidLog(f"{source}: line 1: duplicated column(s) {', '.join(dup)}")
@@ -424,7 +437,7 @@ def read_log(path: str | os.PathLike[str]) -> JointLog:
     cols = _parse(p, source, header)
     _check_rows(cols, header, source)
     t = cols["t"]
-    joints = range(1, N_JOINTS + 1)
+    joints = range(1, (N_JOINTS if kind == "controller" else generic_joints(header)) + 1)
     q = np.column_stack([cols[f"q{i}"] for i in joints])
     qd = np.column_stack([cols[f"dq{i}"] for i in joints])
     tau = np.column_stack([cols[f"tau{i}"] for i in joints])
@@ -484,6 +497,18 @@ def controller_log_text(
     text = _numtostr(data)
     body = "\n".join(",".join(row) for row in text.tolist())
     return ",".join(LOG_COLUMNS) + "\n" + body + "\n"
+
+
+def generic_log_text(t: FloatArray, q: FloatArray, qd: FloatArray, tau: FloatArray) -> str:
+    """A generic joint log's CSV text (s, rad, rad/s, N·m; 10 significant digits) for any joint count."""
+    n = q.shape[1]
+    head = ["t", *(f"{p}{i}" for i in range(1, n + 1) for p in ("q", "dq", "tau"))]
+    cols = [t[:, None]]
+    for i in range(n):
+        cols += [q[:, i : i + 1], qd[:, i : i + 1], tau[:, i : i + 1]]
+    data = np.concatenate(cols, axis=1)
+    body = "\n".join(",".join(f"{v:.10g}" for v in row) for row in data.tolist())
+    return ",".join(head) + "\n" + body + "\n"
 
 
 def write_controller_log(path: str | os.PathLike[str], text: str) -> Path:

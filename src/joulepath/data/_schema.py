@@ -18,6 +18,12 @@ A table has one row per log sample. Columns, in this order:
 * the targets (float64, J): ``E1 .. E6`` with ``E_i = |tau_i * dq_i| * dt`` and
   their sum ``E``; ``dt`` is the row's sample length (s).
 
+That is a 6-joint arm's table. An arm of ``n`` joints (5 to 7) has the same columns
+with ``i = 1..n`` (:func:`feature_columns`, :func:`target_columns`,
+:func:`table_columns`): ``full40`` then holds ``3 n + 22`` inputs; the name stays
+the thesis' ("the full feature set of Appendix F"). The table's metadata stores
+``n_joints``.
+
 Derivatives are finite differences of the logged signals within each move, as the
 thesis computed them. The feature set, robot and units are stored in the Parquet
 file's metadata (:data:`METADATA_KEY`).
@@ -103,6 +109,46 @@ METADATA_KEY = b"joulepath"
 SCHEMA_VERSION = 1
 
 
-def table_columns(feature_set: str) -> tuple[str, ...]:
-    """All columns of a table holding ``feature_set``, in order."""
-    return (*META, *FEATURE_SETS[feature_set], *TARGETS, "dt")
+MIN_JOINTS, MAX_JOINTS = 5, 7
+"""Joint counts of the arms an energy table may hold."""
+
+
+def feature_columns(feature_set: str, n_joints: int = N_JOINTS) -> tuple[str, ...]:
+    """The model inputs of ``feature_set`` for an arm of ``n_joints`` joints, in order."""
+    state = tuple(f"{p}{i}" for i in range(1, n_joints + 1) for p in ("q", "dq"))
+    acc = tuple(f"ddq{i}" for i in range(1, n_joints + 1))
+    if feature_set == "joint":
+        return (*state, *acc)
+    tcp = FEATURES_FULL[len(JOINT_STATE) : FEATURES_FULL.index(JOINT_ACC[0])]
+    rates = FEATURES_FULL[FEATURES_FULL.index(JOINT_ACC[-1]) + 1 :]
+    return (*state, *tcp, *acc, *rates)
+
+
+def target_columns(n_joints: int = N_JOINTS) -> tuple[str, ...]:
+    """``E1 .. En`` and ``E`` (J)."""
+    return (*(f"E{i}" for i in range(1, n_joints + 1)), "E")
+
+
+def table_columns(feature_set: str, n_joints: int = N_JOINTS) -> tuple[str, ...]:
+    """All columns of a table holding ``feature_set`` for an arm of ``n_joints`` joints, in order."""
+    return (*META, *feature_columns(feature_set, n_joints), *target_columns(n_joints), "dt")
+
+
+def generic_required(n_joints: int = N_JOINTS) -> tuple[str, ...]:
+    """Required columns of a generic joint log of ``n_joints`` joints."""
+    return ("t", *(f"{p}{i}" for i in range(1, n_joints + 1) for p in ("q", "dq", "tau")))
+
+
+def card_joints(columns: object) -> int:
+    """Joints of a list of model input columns: :func:`joints_in`, or 6 when that is not 5..7."""
+    n = joints_in(columns)
+    return n if MIN_JOINTS <= n <= MAX_JOINTS else N_JOINTS
+
+
+def joints_in(columns: object) -> int:
+    """Number of joints whose ``q{i}`` columns are among ``columns`` (1, 2, ... without a hole)."""
+    names = set(map(str, columns))  # type: ignore[call-overload]
+    n = 0
+    while f"q{n + 1}" in names:
+        n += 1
+    return n

@@ -21,12 +21,17 @@ from joulepath.data._features import GAP_FACTOR, REST_SPEED, find_gaps, log_to_f
 from joulepath.data._logs import JointLog, is_moves_sidecar, read_log
 from joulepath.data._schema import (
     FEATURE_SETS,
+    MAX_JOINTS,
     METADATA_KEY,
+    MIN_JOINTS,
     MOVES_SIDECAR_SUFFIX,
     N_JOINTS,
     SCHEMA_VERSION,
     TARGETS,
+    feature_columns,
+    joints_in,
     table_columns,
+    target_columns,
 )
 from joulepath.errors import InvalidInput, InvalidLog
 
@@ -58,8 +63,18 @@ class EnergyTable:
     sources: tuple[dict[str, Any], ...] = field(default_factory=tuple)
 
     @property
+    def n_joints(self) -> int:
+        """Joints of the logged arm (from the ``q{i}`` columns)."""
+        return joints_in(self.frame.columns)
+
+    @property
     def features(self) -> tuple[str, ...]:
-        return FEATURE_SETS[self.feature_set]
+        return feature_columns(self.feature_set, self.n_joints)
+
+    @property
+    def targets(self) -> tuple[str, ...]:
+        """``E1 .. En`` and ``E`` of this table's arm."""
+        return target_columns(self.n_joints)
 
     @property
     def n_moves(self) -> int:
@@ -69,6 +84,7 @@ class EnergyTable:
         return {
             "schema_version": SCHEMA_VERSION,
             "feature_set": self.feature_set,
+            "n_joints": self.n_joints,
             "robot": self.robot,
             "sources": list(self.sources),
             "units": "SI: s, rad, rad/s, rad/s^2, m, m/s, m/s^2, J",
@@ -142,8 +158,15 @@ def load_table(path: str | os.PathLike[str]) -> EnergyTable:
         frame = arrow.to_pandas(ignore_metadata=True)  # pandas' own metadata is not needed
     except (ValueError, TypeError, KeyError, pa.ArrowException) as err:
         raise _corrupt(p, f"its columns cannot be read ({' '.join(str(err).split())[:200]})") from err
-    check_columns(frame, feature_set, source=str(p))
-    frame = frame[list(table_columns(feature_set))]
+    n_joints = meta.get("n_joints", N_JOINTS)
+    if (
+        isinstance(n_joints, bool)
+        or not isinstance(n_joints, int)
+        or not MIN_JOINTS <= n_joints <= MAX_JOINTS
+    ):
+        raise _corrupt(p, f"its metadata gives {n_joints!r} joints, not {MIN_JOINTS} to {MAX_JOINTS}")
+    check_columns(frame, feature_set, source=str(p), n_joints=n_joints)
+    frame = frame[list(table_columns(feature_set, n_joints))]
     _check_values(frame, p)
     return EnergyTable(frame=frame, feature_set=feature_set, robot=robot, sources=tuple(sources))
 
@@ -163,9 +186,12 @@ def _check_values(frame: pd.DataFrame, p: Path) -> None:
         )
 
 
-def check_columns(frame: pd.DataFrame, feature_set: str, *, source: str) -> None:
-    """Raise InvalidLog naming the missing and unexpected columns of a table."""
-    want = table_columns(feature_set)
+def check_columns(frame: pd.DataFrame, feature_set: str, *, source: str, n_joints: int | None = None) -> None:
+    """Raise InvalidLog naming the missing and unexpected columns of a table.
+
+    ``n_joints`` None: the joints the frame's ``q{i}`` columns name (6 if none).
+    """
+    want = table_columns(feature_set, n_joints or joints_in(frame.columns) or N_JOINTS)
     missing = [c for c in want if c not in frame.columns]
     extra = [c for c in frame.columns if c not in want]
     if missing or extra:
@@ -212,7 +238,7 @@ def _check_limits(log: JointLog, robot: Robot) -> None:
     """
     lower, upper, vmax = robot.lower, robot.upper, robot.velocity_limit
     problems: list[str] = []
-    for j in range(N_JOINTS):
+    for j in range(log.q.shape[1]):
         q, qd = log.q[:, j], log.qd[:, j]
         lo = float(lower[j]) - RANGE_TOLERANCE_RAD if np.isfinite(lower[j]) else -np.inf
         hi = float(upper[j]) + RANGE_TOLERANCE_RAD if np.isfinite(upper[j]) else np.inf
@@ -296,7 +322,7 @@ def ingest(
     paths : sequence of path
         Controller or generic logs (see :func:`read_log`).
     robot : Robot, optional
-        The robot that was logged; must have 6 joints.
+        The robot that was logged; it has the logs' number of joints.
     progress : callable, optional
         Called with one line per file read, skipped or noted.
 
@@ -305,16 +331,11 @@ def ingest(
     InvalidLog
         For the first log that cannot be used; nothing is returned then.
     InvalidInput
-        ``robot`` does not have 6 joints.
+        ``robot`` has another number of joints than the logs.
     """
     if not paths:
         raise InvalidLog("no log files given")
-    if robot is not None and robot.n_joints != N_JOINTS:
-        raise InvalidInput(
-            f"robot {robot.name!r} has {robot.n_joints} joints, but the energy table holds 6-joint arms; "
-            "give a 6-joint robot"
-        )
-    logs = []
+    logs: list[JointLog] = []
     skipped = []
     for p in paths:
         if is_moves_sidecar(p):
@@ -326,6 +347,17 @@ def ingest(
                 )
             continue
         log = read_log(p)
+        n_log = log.q.shape[1]
+        if robot is not None and robot.n_joints != n_log:
+            raise InvalidInput(
+                f"{p}: logs {n_log} joints, but robot {robot.name!r} has {robot.n_joints}; "
+                "give the robot that was logged"
+            )
+        if logs and logs[0].q.shape[1] != n_log:
+            raise InvalidLog(
+                f"{p}: logs {n_log} joints, but {logs[0].source} logs {logs[0].q.shape[1]}; "
+                "one table holds the logs of one arm"
+            )
         if robot is not None:
             _check_limits(log, robot)
         if robot is not None and log.kind == "controller":

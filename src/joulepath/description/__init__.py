@@ -19,15 +19,19 @@ from joulepath.description._model import (
     RangeSet,
     RobotDescription,
 )
+from joulepath.description._named import NAMED_ARMS, NamedArm, named_arm_path
 from joulepath.description._pinocchio import chain_from_urdf, pinocchio_model
-from joulepath.description._presets import HOME, PRESETS, preset_description, preset_path
+from joulepath.description._presets import DEFAULT_ROBOT, HOME, PRESETS, preset_description, preset_path
 
 __all__ = [
     "Chain",
+    "DEFAULT_ROBOT",
     "Finding",
     "HOME",
     "Inertial",
     "JointDescription",
+    "NAMED_ARMS",
+    "NamedArm",
     "PRESETS",
     "RangeSet",
     "RobotDescription",
@@ -38,6 +42,7 @@ __all__ = [
     "combine_inertials",
     "dh_transform",
     "irml_string",
+    "named_arm_path",
     "parse_irml",
     "pinocchio_model",
     "preset_description",

@@ -239,6 +239,7 @@ def check_chain(chain: Chain) -> list[Finding]:
         out += check_inertial(f"link of {label}", body)
     out += check_axes(labels, chain.axes)
     out += check_limits(labels, chain.lower, chain.upper, chain.velocity, chain.effort, tag="<limit>")
+    out += [Finding("warning", where, message) for where, message in chain.notes]
     out.sort(key=lambda f: f.severity != "error")
     return out
 

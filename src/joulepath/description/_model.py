@@ -193,6 +193,8 @@ class Chain:
     velocity: FloatArray
     effort: FloatArray
     gravity: FloatArray = field(default_factory=lambda: np.array([0.0, 0.0, -9.80665]))
+    notes: tuple[tuple[str, str], ...] = ()
+    """``(where, message)`` warnings from reading the description (e.g. a joint named like a gripper)."""
 
     @property
     def n_joints(self) -> int:

@@ -200,19 +200,112 @@ def _limit(values: Any, *, positive: bool) -> np.ndarray:
     return arr
 
 
-def chain_from_urdf(path: str | os.PathLike[str], *, tool_frame: str | None = None) -> Chain:
-    """Read a URDF of a serial arm with six revolute joints through Pinocchio's parser.
+_CONTINUOUS = {
+    "JointModelRUBX": (1.0, 0.0, 0.0),
+    "JointModelRUBY": (0.0, 1.0, 0.0),
+    "JointModelRUBZ": (0.0, 0.0, 1.0),
+}
+MIN_JOINTS, MAX_JOINTS = 5, 7
+"""Actuated joints of the arms joulepath takes (after locking)."""
+CONTINUOUS_RANGE = 2 * np.pi
+"""rad each way given to a continuous joint (the URDF gives it no range)."""
+_GRIPPER_LIKE = re.compile(r"grip|finger|jaw|hand|claw|tool_?changer", re.I)
+
+
+def _kind(short: str) -> str:
+    """A Pinocchio joint model's short name in URDF words."""
+    if short in _AXES or short == "JointModelRevoluteUnaligned":
+        return "revolute"
+    if short in _CONTINUOUS or short == "JointModelRevoluteUnboundedUnaligned":
+        return "continuous"
+    if short.startswith("JointModelP") and not short.startswith("JointModelPlanar"):
+        return "prismatic"
+    if short == "JointModelFreeFlyer":
+        return "floating"
+    if short == "JointModelPlanar":
+        return "planar"
+    if short == "JointModelMimic":
+        return "mimic"
+    return short.removeprefix("JointModel").lower()
+
+
+def _vec(el: ET.Element | None, attr: str, default: str) -> np.ndarray:
+    raw = el.get(attr) if el is not None else None
+    return np.array([float(v) for v in (raw or default).split()])
+
+
+def _lock_in_urdf(data: bytes, lock: dict[str, float], p: Path) -> str:
+    """The URDF text with the joints of ``lock`` made fixed at the given values (rad, or m).
+
+    A locked joint becomes ``type="fixed"`` with its origin moved by the value about
+    (or along) its axis, so Pinocchio merges the links beyond it into the arm.
+    """
+    pin = _pin()
+    root = DET.fromstring(data, forbid_dtd=True)
+    joints = {(el.get("name") or "").strip(): el for el in root.findall("joint")}
+    movable = [n for n, el in joints.items() if el.get("type") != "fixed"]
+    for name, value in lock.items():
+        el = joints.get(name)
+        if el is None or el.get("type") == "fixed":
+            raise InvalidRobotDescription(
+                f"{p}: has no movable joint {name!r} to lock; its movable joints: {', '.join(movable)}"
+            )
+        if not np.isfinite(value):
+            raise InvalidRobotDescription(f"{p}: the lock value of joint {name!r} is not a finite number")
+        kind = el.get("type")
+        if kind not in ("revolute", "continuous", "prismatic"):
+            raise InvalidRobotDescription(f"{p}: joint {name!r} is {kind}; only a 1-axis joint can be locked")
+        origin = el.find("origin")
+        xyz, rpy = _vec(origin, "xyz", "0 0 0"), _vec(origin, "rpy", "0 0 0")
+        axis = _vec(el.find("axis"), "xyz", "1 0 0")
+        if not np.linalg.norm(axis) > 0:
+            raise InvalidRobotDescription(f"{p}: joint {name!r} has a zero axis")
+        axis = axis / np.linalg.norm(axis)
+        placement = pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
+        if kind == "prismatic":
+            motion = pin.SE3(np.eye(3), axis * value)
+        else:
+            motion = pin.SE3(pin.AngleAxis(value, axis).toRotationMatrix(), np.zeros(3))
+        moved = placement * motion
+        if origin is None:
+            origin = ET.SubElement(el, "origin")
+        origin.set("xyz", " ".join(repr(float(v)) for v in moved.translation))
+        origin.set("rpy", " ".join(repr(float(v)) for v in pin.rpy.matrixToRpy(moved.rotation)))
+        el.set("type", "fixed")
+        for tag in ("axis", "limit", "mimic", "dynamics", "safety_controller", "calibration"):
+            for child in el.findall(tag):
+                el.remove(child)
+    for el in root.findall("joint"):  # a joint mimicking a locked one can no longer follow it
+        mimic = el.find("mimic")
+        if mimic is not None and mimic.get("joint") in lock:
+            el.remove(mimic)
+    return ET.tostring(root, encoding="unicode")
+
+
+def chain_from_urdf(
+    path: str | os.PathLike[str],
+    *,
+    tool_frame: str | None = None,
+    lock: dict[str, float] | None = None,
+    name: str | None = None,
+) -> Chain:
+    """Read a URDF of a serial arm of 5 to 7 revolute joints through Pinocchio's parser.
 
     The tool frame is ``tool_frame`` when given, else the first of
     ``tool0, flange, ee_link, tool, end_effector`` present, else the last link.
     Masses of fixed links are merged into their parent joint's body by Pinocchio.
+    ``lock`` fixes joints at the given values first (``{"panda_finger_joint1": 0.0}``;
+    rad, or m for a prismatic joint): the way to use an arm whose URDF carries a
+    gripper, mimic joints or a branch. A continuous joint is taken as revolute with
+    the range ±360° (:data:`CONTINUOUS_RANGE`, noted on the chain); a joint named like
+    a gripper or finger gives a warning (:attr:`Chain.notes`).
 
     Raises
     ------
     InvalidRobotDescription
-        Unreadable or malformed file (the message names the element), not six
-        joints, a joint that is not a single revolute axis (prismatic, continuous,
-        floating), or a branching tree.
+        Unreadable or malformed file (the message names the element); a prismatic,
+        floating or other non-revolute joint; a tree-shaped robot; fewer than 5 or
+        more than 7 movable joints. Each message names the joints and how to fix it.
     """
     pin = _pin()
     p = Path(path)
@@ -230,6 +323,8 @@ def chain_from_urdf(path: str | os.PathLike[str], *, tool_frame: str | None = No
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as err:
         raise InvalidRobotDescription(f"{p}: not UTF-8 text ({err.reason}); save it as UTF-8") from err
+    if lock:
+        text = _lock_in_urdf(data, dict(lock), p)
     try:
         with _stderr_fd_captured() as said:
             model = pin.buildModelFromXML(text)
@@ -241,33 +336,75 @@ def chain_from_urdf(path: str | os.PathLike[str], *, tool_frame: str | None = No
     if errors:  # urdfdom skips an element it cannot read (e.g. a link's <inertial>) and goes on
         raise InvalidRobotDescription(f"{p}: Pinocchio's URDF parser refused part of it ({errors[0]})")
     n = model.njoints - 1
-    if n != 6:
+    hint = "lock it (--lock NAME=VALUE, or load_robot(..., lock={...})) or make it fixed in the URDF"
+    for i in range(1, n + 1):
+        kind = _kind(model.joints[i].shortname())
+        if kind not in ("revolute", "continuous"):
+            raise InvalidRobotDescription(
+                f"{p}: joint {model.names[i]!r} is {kind}; joulepath takes arms of revolute joints only: "
+                + hint.replace("NAME", model.names[i])
+            )
+    for i in range(1, n + 1):
+        if model.parents[i] != i - 1:
+            parent = model.parents[i]
+            siblings = [model.names[k] for k in range(1, n + 1) if model.parents[k] == parent]
+            after = repr(model.names[parent]) if parent else "the base"
+            raise InvalidRobotDescription(
+                f"{p}: is tree-shaped: joints {', '.join(map(repr, siblings))} all follow {after}; "
+                f"joulepath takes one serial chain: {hint} for every joint off the arm"
+            )
+    names_all = [model.names[i] for i in range(1, n + 1)]
+    if not MIN_JOINTS <= n <= MAX_JOINTS:
         raise InvalidRobotDescription(
-            f"{p}: has {n} movable joints; joulepath needs a serial arm with 6 revolute joints "
-            '(fix the other joints, type="fixed")'
+            f"{p}: has {n} movable joint{'s' if n != 1 else ''} ({', '.join(names_all)}); joulepath takes "
+            f"serial arms of {MIN_JOINTS} to {MAX_JOINTS} revolute joints"
+            + (
+                "; lock the extra ones (--lock NAME=VALUE) or make them fixed in the URDF"
+                if n > MAX_JOINTS
+                else ""
+            )
         )
     axes = np.empty((n, 3))
+    lower, upper = np.empty(n), np.empty(n)
+    velocity, effort = np.empty(n), np.empty(n)
+    notes: list[tuple[str, str]] = []
+    raw_lo = _limit(model.lowerPositionLimit, positive=False)
+    raw_hi = _limit(model.upperPositionLimit, positive=False)
+    raw_v = _limit(model.velocityLimit, positive=True)
+    raw_e = _limit(model.effortLimit, positive=True)
     for i in range(1, n + 1):
         jm = model.joints[i]
         short = jm.shortname()
-        name = model.names[i]
+        jname = model.names[i]
         if short in _AXES:
             axes[i - 1] = _AXES[short]
-        elif short == "JointModelRevoluteUnaligned":
-            axes[i - 1] = np.asarray(jm.extract().axis, dtype=float)
+        elif short in _CONTINUOUS:
+            axes[i - 1] = _CONTINUOUS[short]
         else:
-            raise InvalidRobotDescription(
-                f"{p}: joint {name!r} is {short}, not a single-axis revolute joint with limits; "
-                'use type="revolute"'
+            axes[i - 1] = np.asarray(jm.extract().axis, dtype=float)
+        if _kind(short) == "continuous":
+            lower[i - 1], upper[i - 1] = -CONTINUOUS_RANGE, CONTINUOUS_RANGE
+            notes.append(
+                (
+                    f"joint {jname!r}",
+                    "is continuous (no range in the URDF): joulepath gives it ±360°; give it "
+                    'type="revolute" with <limit lower upper> if the arm allows less',
+                )
             )
-        if model.parents[i] != i - 1:
-            raise InvalidRobotDescription(
-                f"{p}: joint {name!r} does not follow joint {model.names[i - 1]!r}: "
-                "only serial chains are supported"
+        else:
+            lower[i - 1], upper[i - 1] = raw_lo[jm.idx_q], raw_hi[jm.idx_q]
+        velocity[i - 1], effort[i - 1] = raw_v[jm.idx_v], raw_e[jm.idx_v]
+        if _GRIPPER_LIKE.search(jname):
+            notes.append(
+                (
+                    f"joint {jname!r}",
+                    "is named like a gripper or finger but counted as a joint of the arm; lock it "
+                    f"(--lock {jname}=VALUE) if it is not one",
+                )
             )
-    names = [f.name for f in model.frames]
+    frame_names = [f.name for f in model.frames]
     wanted = (tool_frame,) if tool_frame else _TOOL_FRAMES
-    fid = next((model.getFrameId(w) for w in wanted if w in names), None)
+    fid = next((model.getFrameId(w) for w in wanted if w in frame_names), None)
     if fid is None:
         if tool_frame:
             raise InvalidRobotDescription(f"{p}: has no frame named {tool_frame!r}")
@@ -278,19 +415,20 @@ def chain_from_urdf(path: str | os.PathLike[str], *, tool_frame: str | None = No
         raise InvalidRobotDescription(f"{p}: tool frame {frame.name!r} is not on the last joint")
     inert = [model.inertias[i] for i in range(1, n + 1)]
     return Chain(
-        name=model.name or p.stem,
-        joint_names=tuple(model.names[i] for i in range(1, n + 1)),
+        name=name or model.name or p.stem,
+        joint_names=tuple(names_all),
         placements=np.array([model.jointPlacements[i].homogeneous for i in range(1, n + 1)]),
         axes=axes,
         masses=np.array([x.mass for x in inert]),
         coms=np.array([np.asarray(x.lever) for x in inert]),
         inertias=np.array([np.asarray(x.inertia) for x in inert]),
         tool=tool,
-        lower=_limit(model.lowerPositionLimit, positive=False),
-        upper=_limit(model.upperPositionLimit, positive=False),
-        velocity=_limit(model.velocityLimit, positive=True),
-        effort=_limit(model.effortLimit, positive=True),
+        lower=lower,
+        upper=upper,
+        velocity=velocity,
+        effort=effort,
         gravity=np.array([0.0, 0.0, -9.80665]),
+        notes=tuple(notes),
     )
 
 

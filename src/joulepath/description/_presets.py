@@ -9,6 +9,9 @@ from joulepath.description._irml import read_irml
 from joulepath.description._model import RobotDescription
 from joulepath.errors import InvalidRobotDescription
 
+DEFAULT_ROBOT = "irb120"
+"""The robot every command and config uses when none is named (the thesis' ABB IRB 120)."""
+
 PRESETS = ("irb120",)
 """Names accepted by :func:`preset_path` and :func:`joulepath.load_robot`."""
 

@@ -10,22 +10,26 @@ from joulepath.dynamics._calibration import (
 )
 from joulepath.dynamics._derivatives import DynamicsDerivatives, inverse_dynamics_derivatives
 from joulepath.dynamics._friction import (
+    FRICTION_SUFFIX,
     NOMINAL_FRICTION,
     CoulombViscousFriction,
     ElastoPlasticFriction,
     Friction,
     FrictionSum,
     friction_derivative,
+    read_friction_file,
 )
 from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le
 from joulepath.dynamics._rnea import PinocchioRnea
-from joulepath.dynamics._robot import METHODS, Robot, load_robot
+from joulepath.dynamics._robot import DEFAULT_ROBOT, METHODS, Robot, load_robot
 
 __all__ = [
     "Calibration",
     "CoulombViscousFriction",
+    "DEFAULT_ROBOT",
     "DynamicsDerivatives",
     "ElastoPlasticFriction",
+    "FRICTION_SUFFIX",
     "Friction",
     "FrictionSum",
     "IdentifiedFriction",
@@ -42,4 +46,5 @@ __all__ = [
     "load_robot",
     "mass_matrix_le",
     "motor_torque",
+    "read_friction_file",
 ]

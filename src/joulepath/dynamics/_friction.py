@@ -11,7 +11,9 @@ Parameters are scalars (every joint) or sequences of one value per joint.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -178,3 +180,58 @@ NOMINAL_FRICTION = CoulombViscousFriction(
 No identified friction of the IRB 120 is public; these values are of the size
 reported for robots of its class. The ``sim`` plant uses them, the ``lab`` plant
 departs from them, and the physics baseline of the energy models uses them."""
+
+
+FRICTION_SUFFIX = ".friction.toml"
+"""A robot's friction file sits beside its description: ``ur5.urdf`` -> ``ur5.friction.toml``."""
+_FRICTION_KEYS = {"coulomb", "viscous", "smoothing", "source"}
+MAX_FRICTION_BYTES = 64 << 10
+
+
+def read_friction_file(path: str | os.PathLike[str], n_joints: int) -> CoulombViscousFriction:
+    """Read a friction file: Coulomb + viscous friction, one value per joint (TOML, data only).
+
+    ::
+
+        # ur5.friction.toml: identified on our UR5, joint side
+        coulomb = [5.2, 5.0, 3.1, 1.2, 1.1, 1.1]   # N·m
+        viscous = [3.0, 3.1, 1.9, 0.5, 0.5, 0.5]   # N·m·s/rad
+        smoothing = 0.005                            # rad/s (optional, default 0.005)
+        source = "identified 2026-05, payload 0"     # optional, shown in outputs
+
+    Raises
+    ------
+    InvalidInput
+        Unreadable file, unknown key, not one non-negative finite value per joint.
+    """
+    import tomllib
+
+    p = Path(path)
+    try:
+        if p.stat().st_size > MAX_FRICTION_BYTES:
+            raise InvalidInput(f"{p}: is larger than {MAX_FRICTION_BYTES >> 10} KiB; is it a friction file?")
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise InvalidInput(f"{p}: cannot be read ({err.strerror})") from err
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        raise InvalidInput(f"{p}: not a TOML friction file ({err})") from err
+    unknown = sorted(set(data) - _FRICTION_KEYS)
+    if unknown:
+        raise InvalidInput(f"{p}: unknown key {unknown[0]!r}; a friction file holds {sorted(_FRICTION_KEYS)}")
+    values = {}
+    for key in ("coulomb", "viscous"):
+        raw = data.get(key)
+        ok = isinstance(raw, list) and len(raw) == n_joints
+        ok = ok and all(isinstance(v, int | float) and not isinstance(v, bool) for v in raw or [])
+        arr = np.asarray(raw if ok else [], dtype=float)
+        if not ok or not np.all(np.isfinite(arr)) or np.any(arr < 0):
+            raise InvalidInput(
+                f"{p}: {key} must be a list of {n_joints} non-negative numbers (one per joint), got {raw!r}"
+            )
+        values[key] = tuple(float(v) for v in arr)
+    smoothing = data.get("smoothing", 0.005)
+    if isinstance(smoothing, bool) or not isinstance(smoothing, int | float) or not 0 <= smoothing < 1:
+        raise InvalidInput(f"{p}: smoothing must be a number of rad/s in [0, 1), got {smoothing!r}")
+    return CoulombViscousFriction(
+        coulomb=values["coulomb"], viscous=values["viscous"], smoothing=float(smoothing)
+    )

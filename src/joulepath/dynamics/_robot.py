@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 from functools import cached_property
 from pathlib import Path
 from typing import Any
@@ -12,7 +13,9 @@ import numpy as np
 from joulepath import energy as _energy
 from joulepath._typing import ArrayLike, FloatArray
 from joulepath.description import (
+    DEFAULT_ROBOT,
     HOME,
+    NAMED_ARMS,
     PRESETS,
     Chain,
     Finding,
@@ -22,19 +25,24 @@ from joulepath.description import (
     chain_from_urdf,
     check_inertial,
     check_physical,
+    named_arm_path,
     pinocchio_model,
     preset_path,
     read_irml,
 )
 from joulepath.description._check import check_chain
 from joulepath.dynamics._calibration import Calibration, read_calibration, twin_paths
-from joulepath.dynamics._friction import NOMINAL_FRICTION, Friction
+from joulepath.dynamics._friction import FRICTION_SUFFIX, NOMINAL_FRICTION, Friction, read_friction_file
 from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le
 from joulepath.dynamics._rnea import PinocchioRnea
 from joulepath.errors import InvalidInput, InvalidRobotDescription
 from joulepath.kinematics import Pose, check_q, forward_kinematics, geometric_jacobian
 
 METHODS = ("pinocchio", "lagrange-euler")
+_IRB120 = re.compile(r"irb[ _-]?120", re.I)
+_FROM_FILES = object()
+FALLBACK_RANGE_SETS = ("lab", "collection")
+"""Range sets whose absence falls back to the nominal ranges (:meth:`Robot.ranges_for`)."""
 
 
 class Robot:
@@ -58,17 +66,16 @@ class Robot:
         source: str | None = None,
         payload: Inertial | None = None,
         calibration: Calibration | None = None,
+        friction: Friction | None | object = _FROM_FILES,
+        friction_note: str = "",
     ) -> None:
         self.chain = chain
         self.description = description
         self.source = source
         self.payload = payload
         self.calibration = calibration
-
-    @property
-    def friction(self) -> Friction:
-        """The joint friction of this robot's physics: identified for a twin, else ``NOMINAL_FRICTION``."""
-        return self.calibration.friction if self.calibration is not None else NOMINAL_FRICTION
+        self._given_friction = friction
+        self._given_friction_note = friction_note
 
     # ------------------------------------------------------------------ facts
     @property
@@ -104,22 +111,81 @@ class Robot:
 
     @property
     def home(self) -> FloatArray:
-        """Home configuration (rad): q = 0 in ABB's convention."""
-        return np.zeros(self.n_joints)
+        """Home configuration (rad): q = 0 (ABB), or mid-range for a joint whose range excludes 0."""
+        lo, hi = self.chain.lower, self.chain.upper
+        outside = np.isfinite(lo) & np.isfinite(hi) & ((lo > 0) | (hi < 0))
+        return np.where(outside, (lo + hi) / 2, 0.0)
 
     def joint_ranges(self, name: str = "nominal") -> tuple[FloatArray, FloatArray]:
         """``(lower, upper)`` of a named range set (``"nominal"``, or e.g. ``"lab"``)."""
         if name == "nominal":
             return self.lower, self.upper
         if self.description is None:
-            raise InvalidInput(f"robot {self.name!r} has only the 'nominal' range set")
+            raise InvalidInput(
+                f"robot {self.name!r} has only the 'nominal' range set (asked for {name!r}); "
+                "use --range-set nominal"
+            )
         rs = self.description.range_set(name)
         return np.array(rs.lower), np.array(rs.upper)
+
+    def ranges_for(self, name: str) -> tuple[str, FloatArray, FloatArray]:
+        """``(name used, lower, upper)`` of a range set, the nominal ranges standing in for a missing default.
+
+        The default sets :data:`FALLBACK_RANGE_SETS` (``"lab"``, ``"collection"``) exist
+        for robots with a lab description (the IRB 120); for any other robot the
+        nominal ranges are used, and the name returned is ``"nominal"`` so that the
+        caller can say so. Any other missing name is refused.
+        """
+        if name in FALLBACK_RANGE_SETS and name not in self.range_set_names:
+            lower, upper = self.joint_ranges()
+            return "nominal", lower, upper
+        lower, upper = self.joint_ranges(name)
+        return name, lower, upper
 
     @property
     def range_set_names(self) -> tuple[str, ...]:
         extra = tuple(rs.name for rs in self.description.range_sets) if self.description else ()
         return ("nominal", *extra)
+
+    @cached_property
+    def _friction(self) -> tuple[Friction | None, str]:
+        if self._given_friction is not _FROM_FILES:
+            given: Friction | None = self._given_friction  # type: ignore[assignment]
+            return given, self._given_friction_note or ("given" if given is not None else "none")
+        beside = None
+        if self.source and Path(self.source).is_file():
+            src = Path(self.source)
+            beside = src.with_name(src.stem + FRICTION_SUFFIX)
+            if beside.is_file():
+                return read_friction_file(beside, self.n_joints), f"friction file {beside}"
+        if _IRB120.search(self.name) and self.n_joints == 6:
+            return (
+                NOMINAL_FRICTION,
+                "NOMINAL_FRICTION (assumed for the IRB 120; no identified friction is public)",
+            )
+        where = f"no {beside.name} beside the description" if beside else "no friction file"
+        return None, f"none ({where}): the physics is rigid body only"
+
+    @property
+    def friction(self) -> Friction | None:
+        """The robot's joint friction, or None: rigid body only.
+
+        From, in order: a twin's identified friction (:attr:`calibration`); the
+        ``friction`` given to the constructor; a friction file
+        beside the description (``ur5.urdf`` -> ``ur5.friction.toml``, see
+        :func:`~joulepath.dynamics.read_friction_file`); for the IRB 120,
+        :data:`~joulepath.dynamics.NOMINAL_FRICTION`. :attr:`friction_note` says which.
+        """
+        if self.calibration is not None:
+            return self.calibration.friction
+        return self._friction[0]
+
+    @property
+    def friction_note(self) -> str:
+        """Where :attr:`friction` comes from, in words (shown in outputs)."""
+        if self.calibration is not None:
+            return f"identified (twin {self.source})"
+        return self._friction[1]
 
     # ------------------------------------------------------------- kinematics
     def fk(self, q: ArrayLike) -> Pose:
@@ -274,6 +340,8 @@ class Robot:
             source=self.source,
             payload=load,
             calibration=self.calibration,
+            friction=self._given_friction,
+            friction_note=self._given_friction_note,
         )
 
     # ----------------------------------------------------------------- checks
@@ -310,10 +378,17 @@ class Robot:
 
 
 def load_robot(
-    name_or_path: str | os.PathLike[str], *, tool_frame: str | None = None, checked: bool = True
+    name_or_path: str | os.PathLike[str],
+    *,
+    tool_frame: str | None = None,
+    checked: bool = True,
+    lock: dict[str, float] | None = None,
 ) -> Robot:
-    """Load a bundled robot by name (``"irb120"``), a robot file (``.irml`` or ``.urdf``) or a twin folder.
+    """Load a bundled robot (``"irb120"``), a named arm, a robot file (``.irml``, ``.urdf``) or a twin folder.
 
+    Named arms (``"ur3"``, ``"ur5"``, ``"ur10"``, ``"panda"``, ``"xarm7"``, ...,
+    :data:`~joulepath.description.NAMED_ARMS`) are URDFs of the ``example-robot-data``
+    package (``pip install 'joulepath[robots]'``), with their grippers locked.
     A twin folder (written by ``joulepath identify``) gives its identified robot with
     its identified friction and drive losses (:attr:`Robot.calibration`).
 
@@ -328,6 +403,9 @@ def load_robot(
         A bundled robot's name or a robot file.
     tool_frame : str, optional
         URDF only: the frame used as tool0.
+    lock : dict of str to float, optional
+        URDF only: joints fixed at these values (rad; m for a prismatic joint) before
+        the arm is read, e.g. a gripper's fingers (added to a named arm's own locks).
     checked : bool, default True
         For experts: ``False`` loads a robot that fails the physical check (to
         inspect it, as ``joulepath robot show`` does); its dynamics may be
@@ -346,6 +424,14 @@ def load_robot(
     6
     """
     text = os.fspath(name_or_path)
+    if text in NAMED_ARMS:
+        arm = NAMED_ARMS[text]
+        path = named_arm_path(text)
+        chain = chain_from_urdf(path, tool_frame=tool_frame, lock={**arm.lock, **(lock or {})}, name=text)
+        robot = Robot(chain, source=str(path))
+        if checked:
+            _refuse_unphysical(robot, text)
+        return robot
     if text not in PRESETS and Path(text).is_dir():
         return _load_twin(Path(text), checked=checked)
     if text in PRESETS:
@@ -354,14 +440,17 @@ def load_robot(
         path = Path(text)
         if not path.exists():
             raise InvalidRobotDescription(
-                f"{text}: no such file and not a bundled robot (bundled: {', '.join(PRESETS)})"
+                f"{text}: no such file and not a bundled robot (bundled: {', '.join(PRESETS)}; "
+                f"named arms with the [robots] extra: {', '.join(NAMED_ARMS)})"
             )
     suffix = path.suffix.lower()
+    if lock and suffix != ".urdf":
+        raise InvalidRobotDescription(f"{path}: joints can be locked in a URDF only; remove the lock")
     if suffix in (".irml", ".xml"):
         desc = read_irml(path)
         robot = Robot(chain_from_description(desc), description=desc, source=str(path))
     elif suffix == ".urdf":
-        robot = Robot(chain_from_urdf(path, tool_frame=tool_frame), source=str(path))
+        robot = Robot(chain_from_urdf(path, tool_frame=tool_frame, lock=lock), source=str(path))
     else:
         raise InvalidRobotDescription(f"{path}: unknown robot file type {suffix!r}; use .irml or .urdf")
     if checked:
@@ -390,4 +479,4 @@ def _refuse_unphysical(robot: Robot, given: str) -> None:
     )
 
 
-__all__ = ["HOME", "METHODS", "Robot", "load_robot"]
+__all__ = ["DEFAULT_ROBOT", "HOME", "METHODS", "Robot", "load_robot"]

@@ -55,7 +55,9 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from joulepath.description import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput
+from joulepath.export import EXPORTERS
 from joulepath.optimize import ALGORITHMS, AUTO, resolve_algorithm
 
 ALL_TARGETS = ("E", "E1", "E2", "E3", "E4", "E5", "E6")
@@ -71,6 +73,7 @@ class DataStage:
     """
 
     plant: str = "lab"
+    range_set: str = "collection"
     train_moves: int = 40
     test_moves: int = 15
     micro_moves: int = 0
@@ -115,7 +118,9 @@ class OptimizeStage:
     ``algorithm`` is ``auto`` or a name of :data:`joulepath.optimize.ALGORITHMS`;
     ``generations`` and ``population`` set the evolutionary searches; ``reference``
     also solves every task with the reference solver (CasADi + IPOPT, slow) so the
-    report can state the share of the optimum's saving reached.
+    report can state the share of the optimum's saving reached. ``export`` names the
+    program each task folder gets (:data:`joulepath.export.EXPORTERS`; empty: the
+    controller the robot declares, RAPID for the IRB 120).
     """
 
     tasks: int = 3
@@ -125,6 +130,7 @@ class OptimizeStage:
     population: int = 100
     range_set: str = "lab"
     reference: bool = False
+    export: str = ""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -157,7 +163,7 @@ class Experiment:
     """A whole study: data -> synthetic data -> models -> importance -> optimized moves -> benchmark."""
 
     name: str
-    robot: str = "irb120"
+    robot: str = DEFAULT_ROBOT
     seed: int = 0
     jobs: int = 1
     scheduler: str = ""
@@ -192,6 +198,7 @@ _ALLOWED: dict[str, tuple[str, ...]] = {
     "methods": ("copula", "copulagan", "ctgan", "tvae"),
     "families": ("mlp", "svr", "par", "xgb"),
     "targets": ALL_TARGETS,
+    "export": ("", *EXPORTERS),
 }
 BOUNDS: dict[str, dict[str, tuple[int, int]]] = {
     "": {"seed": (0, 2**32 - 1), "jobs": (1, 256)},
@@ -418,6 +425,7 @@ def load_experiment(path: str | os.PathLike[str]) -> Experiment:
 
 def _check_robot(exp: Experiment, source: str) -> None:
     from joulepath.dynamics import load_robot
+    from joulepath.dynamics._robot import FALLBACK_RANGE_SETS
     from joulepath.errors import JoulepathError
 
     try:
@@ -425,7 +433,7 @@ def _check_robot(exp: Experiment, source: str) -> None:
     except JoulepathError as err:
         raise InvalidInput(f"{source}: robot = {exp.robot!r}: {err}") from err
     names = robot.range_set_names
-    if exp.optimize.range_set not in names:
+    if exp.optimize.range_set not in (*names, *FALLBACK_RANGE_SETS):
         raise InvalidInput(
             f"{source}: [optimize] range_set = {exp.optimize.range_set!r} is not a range set of "
             f"{robot.name}; use one of {', '.join(names)}"

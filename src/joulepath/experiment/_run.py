@@ -303,9 +303,16 @@ def _data_stage(ctx: _Context) -> dict[str, Any]:
                 paths, origin = logs[name], "logs"
             elif n:
                 sim = simulate(
-                    folder / "logs" / f"{name}.csv", plant=plant, n_moves=n, seed=seed, robot=exp.robot
+                    folder / "logs" / f"{name}.csv",
+                    plant=plant,
+                    n_moves=n,
+                    seed=seed,
+                    robot=exp.robot,
+                    range_set=d.range_set,
                 )
                 paths, origin = [str(sim.log)], f"simulated on the {plant} plant"
+                if sim.range_set != d.range_set:
+                    origin += f", nominal ranges ({robot.name} has no {d.range_set!r} range set)"
             else:
                 (folder / f"{name}.parquet").unlink(missing_ok=True)
                 continue
@@ -559,7 +566,7 @@ def _compare_with_physics(ctx: _Context, folder: Path) -> None:
     from matplotlib.figure import Figure
 
     from joulepath.data import EnergyTable
-    from joulepath.dynamics import NOMINAL_FRICTION, load_robot
+    from joulepath.dynamics import load_robot
     from joulepath.learn import best_model, physics_predict
 
     robot = load_robot(ctx.exp.robot)
@@ -569,12 +576,17 @@ def _compare_with_physics(ctx: _Context, folder: Path) -> None:
     section = EnergyTable(frame=frame.iloc[: min(len(frame), 480)], feature_set=test.feature_set)
     measured = section.frame["E"].to_numpy()
     learned = model.predict(section.frame)
-    physics = physics_predict(section, robot, friction=NOMINAL_FRICTION)["E"]
+    physics = physics_predict(section, robot, friction=robot.friction)["E"]
     fig = Figure(figsize=(10, 3.4))
     ax = fig.subplots()
     ax.plot(measured, "k-", lw=1.2, label="measured")
     ax.plot(learned, "-", lw=0.9, label=f"learned ({model.family})")
-    ax.plot(physics, "--", lw=0.9, label="dynamics model + nominal friction")
+    ax.plot(
+        physics,
+        "--",
+        lw=0.9,
+        label="dynamics model + nominal friction" if robot.friction else "dynamics model (rigid body)",
+    )
     ax.set_xlabel("test row (25 ms each)")
     ax.set_ylabel("E per row (J)")
     ax.legend(fontsize="small")
@@ -597,9 +609,9 @@ def _compare_with_physics(ctx: _Context, folder: Path) -> None:
         "learned_batch_per_row_s": timed(lambda: model.predict(frame), 3) / len(frame),
         "learned_single_s": timed(lambda: model.predict(one.frame), 20),
         "learned_size_bytes": size,
-        "physics_batch_per_row_s": timed(lambda: physics_predict(test, robot, friction=NOMINAL_FRICTION), 3)
+        "physics_batch_per_row_s": timed(lambda: physics_predict(test, robot, friction=robot.friction), 3)
         / len(frame),
-        "physics_single_s": timed(lambda: physics_predict(one, robot, friction=NOMINAL_FRICTION), 20),
+        "physics_single_s": timed(lambda: physics_predict(one, robot, friction=robot.friction), 20),
     }
     atomic_write_text(folder / "latency.json", json.dumps(latency, indent=2))
 
@@ -658,13 +670,13 @@ def _plot_heatmap(means: pd.DataFrame, path: Path) -> None:
 
 
 # ----------------------------------------------------------------------------- optimize
-def _models_for(ctx: _Context, fitness: str) -> tuple[Any, ...]:
+def _models_for(ctx: _Context, fitness: str, n_joints: int = 6) -> tuple[Any, ...]:
     from joulepath.learn import best_model
 
     if fitness == "surrogate":
         return (best_model(ctx.root / "models", "E"),)
     if fitness == "surrogate-joints":
-        return tuple(best_model(ctx.root / "models", f"E{i}") for i in range(1, 7))
+        return tuple(best_model(ctx.root / "models", f"E{i}") for i in range(1, n_joints + 1))
     return ()
 
 
@@ -695,10 +707,14 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
         for old in folder.glob("task-*"):
             shutil.rmtree(old)
         robot = load_robot(exp.robot)
-        models = _models_for(ctx, o.fitness)
+        models = _models_for(ctx, o.fitness, robot.n_joints)
         joints = _joints(ctx, robot.n_joints)
         rows = []
         tasks = random_tasks(robot, o.tasks, seed=exp.seed, range_set=o.range_set)
+        if robot.ranges_for(o.range_set)[0] != o.range_set:
+            ctx.tell(
+                f"optimize: {robot.name} has no {o.range_set!r} range set; tasks drawn in its nominal ranges"
+            )
         seeds = np.random.SeedSequence(exp.seed).spawn(len(tasks))
         for k, (q0, qf, T) in enumerate(tasks):
             ctx.progress("optimize", k, len(tasks))
@@ -710,7 +726,7 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
                 seed=int(seeds[k].generate_state(1)[0]),
             )
             res = optimize_move(robot, q0, qf, T, cfg, models=models, joints_ranked=joints)
-            write_run(res, robot, folder / f"task-{k:03d}")
+            write_run(res, robot, folder / f"task-{k:03d}", export=o.export or None)
             s = res.summary
             optimum = _optimum(robot, res) if o.reference else None
             rows.append(

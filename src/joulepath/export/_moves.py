@@ -41,6 +41,6 @@ def random_moves(
 def draw_moves(
     robot: Robot, n_moves: int, *, range_set: str = "collection", rng: np.random.Generator
 ) -> list[Move]:
-    """``n_moves`` random moves inside one of the robot's range sets."""
-    lower, upper = robot.joint_ranges(range_set)
+    """``n_moves`` random moves inside one of the robot's range sets (nominal for a missing default one)."""
+    _, lower, upper = robot.ranges_for(range_set)
     return random_moves(n_moves, lower, upper, rng=rng)

@@ -26,9 +26,12 @@ from joulepath.abb import EXTERNAL_AXES_UNUSED, SPEEDS, ZONES
 from joulepath.data import LOG_COLUMNS
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, LimitViolation
+from joulepath.export._base import check_path
 from joulepath.export._moves import draw_moves
+from joulepath.trajectory import Trajectory
 
 N_JOINTS = 6
+"""Axes of a RAPID ``jointtarget``'s ``robax``: RAPID programs here drive 6-axis arms."""
 MODES = ("rand", "table")
 
 
@@ -261,7 +264,8 @@ def collection_programs(
 
     In ``mode="table"`` the moves are those ``joulepath simulate --seed seed`` runs.
     """
-    lower, upper = robot.joint_ranges(range_set)
+    _six_axes(robot)
+    _, lower, upper = robot.ranges_for(range_set)
     moves = None
     if mode == "table":
         drawn = draw_moves(robot, n_moves, range_set=range_set, rng=np.random.default_rng(seed))
@@ -279,6 +283,19 @@ def collection_programs(
         "JPCollect.mod": collect,
         "JPMeasure.mod": measurement_module(sample_period=sample_period),
     }
+
+
+def _six_axes(robot: Robot) -> None:
+    if robot.n_joints != N_JOINTS:
+        raise InvalidInput(
+            f"RAPID jointtargets drive 6-axis arms, but {robot.name} has {robot.n_joints} joints; "
+            "use --export ros2"
+        )
+
+
+def render_rapid(robot: Robot, trajectory: Trajectory, duration: float) -> dict[str, str]:
+    """``{"path.mod": ...}``: :func:`path_module` of the path (default and optimized move, 5 times each)."""
+    return {"path.mod": path_module(robot, trajectory.q, trajectory.qd, duration)}
 
 
 def _jt(q_deg: FloatArray) -> str:
@@ -316,24 +333,8 @@ def path_module(
     q = np.asarray(path_q, dtype=float)
     qd = np.asarray(path_qd, dtype=float)
     n = q.shape[0]
-    if q.ndim != 2 or q.shape[1] != N_JOINTS or n < 2:
-        raise InvalidInput(f"path must have shape (n_steps >= 2, 6), got {q.shape}")
-    lo, hi = robot.joint_ranges()
-    bad = np.nonzero((q < lo - 1e-9) | (q > hi + 1e-9))
-    if bad[0].size:
-        k, j = int(bad[0][0]), int(bad[1][0])
-        raise LimitViolation(
-            f"sample {k}: joint {j + 1} at {np.degrees(q[k, j]):.2f} deg leaves its range "
-            f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg; path.mod is not written"
-        )
-    vmax = robot.velocity_limit
-    over = np.nonzero(np.abs(qd) > vmax * (1 + 1e-9))
-    if over[0].size:
-        k, j = int(over[0][0]), int(over[1][0])
-        raise LimitViolation(
-            f"sample {k}: joint {j + 1} speed {np.degrees(abs(qd[k, j])):.1f} deg/s exceeds its limit "
-            f"{np.degrees(vmax[j]):.1f} deg/s; path.mod is not written"
-        )
+    _six_axes(robot)
+    check_path(robot, q, qd, what="path.mod")
     if every < 1 or repeats < 1:
         raise InvalidInput("every and repeats must be ≥ 1")
     idx = list(range(every, n - 1, every)) + [n - 1]

@@ -59,9 +59,9 @@ def score(table: EnergyTable, target: str, predicted: FloatArray) -> Scores:
 
 
 def physics_predict(table: EnergyTable, robot: Any, *, friction: Any = None) -> dict[str, FloatArray]:
-    """The dynamics model as a predictor of E1..E6 and E on the table's rows."""
+    """The dynamics model as a predictor of E1..En and E on the table's rows."""
     f = table.frame
-    j = range(1, N_JOINTS + 1)
+    j = range(1, table.n_joints + 1)
     q = f[[f"q{i}" for i in j]].to_numpy()
     qd = f[[f"dq{i}" for i in j]].to_numpy()
     qdd = f[[f"ddq{i}" for i in j]].to_numpy()

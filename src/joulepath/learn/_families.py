@@ -27,6 +27,7 @@ from sklearn.neural_network import MLPRegressor
 from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
 
+from joulepath.dynamics import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.learn._features import PhysicsFeatures
 from joulepath.learn._svr import ScalableSVR
@@ -142,7 +143,7 @@ def make_pipeline(
     seed: int,
     inputs: str = "physics",
     columns: tuple[str, ...] | None = None,
-    robot: str = "irb120",
+    robot: str = DEFAULT_ROBOT,
 ) -> Pipeline:
     """The family's pipeline with its default hyperparameters."""
     steps: list[tuple[str, Any]] = []

@@ -20,7 +20,8 @@ from sklearn.base import BaseEstimator, TransformerMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from joulepath._typing import FloatArray
-from joulepath.data import FEATURE_SETS
+from joulepath.data import feature_columns, joints_in
+from joulepath.dynamics import DEFAULT_ROBOT
 from joulepath.energy import joint_energy
 
 INPUTS = ("thesis", "physics")
@@ -28,12 +29,20 @@ PHYSICS_VERSION = 2
 """Version of the physics inputs; a model card records it and loading refuses another."""
 N_JOINTS = 6
 N_PHYSICS_TERMS = 4 * N_JOINTS + 1
-"""Columns :func:`physics_transform` appends: per-joint energy, its sum, signed energy, |qd| dt, qd² dt."""
+"""Columns :func:`physics_transform` appends for a 6-joint arm (:func:`n_physics_terms`)."""
 
 
-def input_columns(feature_set: str, inputs: str) -> tuple[str, ...]:
+def n_physics_terms(n_joints: int) -> int:
+    """Columns :func:`physics_transform` appends.
+
+    Per-joint energy, its sum, signed energy, ``|qd| dt`` and ``qd² dt``.
+    """
+    return 4 * n_joints + 1
+
+
+def input_columns(feature_set: str, inputs: str, n_joints: int = N_JOINTS) -> tuple[str, ...]:
     """Table columns a model reads, in order."""
-    base = FEATURE_SETS[feature_set]
+    base = feature_columns(feature_set, n_joints)
     return (*base, "dt") if inputs == "physics" else base
 
 
@@ -46,10 +55,10 @@ class PhysicsFeatures(TransformerMixin, BaseEstimator):  # type: ignore[misc]
         Bundled robot name or path to an .irml/.urdf file.
     columns : tuple of str or None
         Names of the input columns, in order; must contain ``q{i}``, ``dq{i}``,
-        ``ddq{i}`` for i = 1..6 and ``dt``. None: the physics inputs of ``full40``.
+        ``ddq{i}`` for i = 1..n and ``dt``. None: the physics inputs of ``full40`` (6 joints).
     """
 
-    def __init__(self, robot: str = "irb120", columns: tuple[str, ...] | None = None) -> None:
+    def __init__(self, robot: str = DEFAULT_ROBOT, columns: tuple[str, ...] | None = None) -> None:
         self.robot = robot
         self.columns = columns
 
@@ -61,7 +70,8 @@ class PhysicsFeatures(TransformerMixin, BaseEstimator):  # type: ignore[misc]
         cols = self._cols()
         if len(cols) != X.shape[1]:
             raise ValueError(f"X has {X.shape[1]} columns but `columns` names {len(cols)}")
-        need = [f"{p}{i}" for p in ("q", "dq", "ddq") for i in range(1, N_JOINTS + 1)] + ["dt"]
+        n = joints_in(cols) or N_JOINTS
+        need = [f"{p}{i}" for p in ("q", "dq", "ddq") for i in range(1, n + 1)] + ["dt"]
         missing = [c for c in need if c not in cols]
         if missing:
             raise ValueError(f"PhysicsFeatures needs columns {missing} among its inputs")
@@ -95,14 +105,12 @@ class PhysicsFeatures(TransformerMixin, BaseEstimator):  # type: ignore[misc]
 
 def physics_transform(X: FloatArray, index: dict[str, int], robot: Any) -> FloatArray:
     """The pure function behind :class:`PhysicsFeatures` (X of shape (n, n_inputs))."""
-    j = range(1, N_JOINTS + 1)
+    j = range(1, joints_in(index) + 1)
     q = X[:, [index[f"q{i}"] for i in j]]
     qd = X[:, [index[f"dq{i}"] for i in j]]
     qdd = X[:, [index[f"ddq{i}"] for i in j]]
     dt = X[:, index["dt"]][:, None]
-    from joulepath.dynamics import NOMINAL_FRICTION
-
-    tau = robot.inverse_dynamics(q, qd, qdd, friction=NOMINAL_FRICTION)
+    tau = robot.inverse_dynamics(q, qd, qdd, friction=robot.friction)
     energy = joint_energy(tau, qd, dt[:, 0])  # the one definition: |tau_i qd_i| dt
     signed = joint_energy(tau, qd, dt[:, 0], mode="signed")
     out: FloatArray = np.concatenate(

@@ -34,7 +34,7 @@ def feature_importance(
     from sklearn.inspection import permutation_importance
 
     if target not in table.frame.columns:
-        raise InvalidInput(f"unknown target {target!r}; use one of E, E1..E6")
+        raise InvalidInput(f"unknown target {target!r}; use one of {', '.join(table.targets)}")
     rng = np.random.default_rng(seed)
     frame = table.frame
     if len(frame) > max_rows:
@@ -85,7 +85,9 @@ def rank_joints(importance: pd.DataFrame) -> list[int]:
     The optimizer's informed local search scales the coefficients of the first
     ones — derived from the data at hand, not hard-coded as in the thesis.
     """
-    score = {j: 0.0 for j in range(1, N_JOINTS + 1)}
+    joints = [_joint_of(str(feature)) for feature in importance.index]
+    n = max([j for j in joints if j is not None], default=N_JOINTS)
+    score = {j: 0.0 for j in range(1, n + 1)}
     for feature, value in importance["mean"].items():
         joint = _joint_of(str(feature))
         if joint is not None:

@@ -31,6 +31,7 @@ from sklearn.svm import LinearSVR
 
 from joulepath._io import atomic_write_text
 from joulepath._typing import FloatArray
+from joulepath.data._schema import card_joints
 from joulepath.errors import InvalidModel, MissingDependency
 from joulepath.learn._features import PHYSICS_VERSION, PhysicsFeatures, physics_transform
 from joulepath.learn._svr import ScalableSVR
@@ -275,7 +276,9 @@ class EnergyModel:
             if not isinstance(card["file"], str) or not card["file"].endswith(".json"):
                 raise InvalidModel(f"{src / str(card['file'])}: an XGBoost model must be a .json booster")
             file = model_file(src, card, card_path)
-            doc = check_xgboost_json(file, n_features=n_model_features(len(cols), card["inputs"]))
+            doc = check_xgboost_json(
+                file, n_features=n_model_features(len(cols), card["inputs"], card_joints(cols))
+            )
             trained = doc["learner"].get("attributes", {}).get(_XGB_COLUMNS_ATTR)
             if trained is not None and trained != json.dumps(list(cols)):
                 raise InvalidModel(
@@ -291,7 +294,12 @@ class EnergyModel:
                 raise InvalidModel(f"{file}: not a readable XGBoost JSON model ({err})") from err
             steps: list[tuple[str, Any]] = []
             if card["inputs"] == "physics":
-                phys = PhysicsFeatures(robot=card.get("robot_source", "irb120"), columns=cols)
+                if not card.get("robot_source"):
+                    raise InvalidModel(
+                        f"{card_path}: a model on physics inputs must name its robot (robot_source); "
+                        "train it again with `joulepath train --robot ...`"
+                    )
+                phys = PhysicsFeatures(robot=card["robot_source"], columns=cols)
                 phys.fit(np.zeros((1, len(cols))))
                 steps.append(("physics", phys))
             steps.append(("model", model))

@@ -17,7 +17,9 @@ from sklearn.exceptions import ConvergenceWarning
 from sklearn.model_selection import ParameterGrid
 
 from joulepath._io import atomic_write_text
-from joulepath.data import TARGETS, EnergyTable
+from joulepath.data import EnergyTable, target_columns
+from joulepath.data._schema import MAX_JOINTS
+from joulepath.dynamics import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._evaluate import physics_baseline, score
 from joulepath.learn._families import FAMILIES, GRIDS, SUBSTITUTIONS, grid_for, make_pipeline
@@ -65,15 +67,16 @@ class TrainConfig:
     seed: int = 0
     n_jobs: int = 1
     scheduler: str | None = None
-    robot: str = "irb120"
+    robot: str = DEFAULT_ROBOT
 
     def __post_init__(self) -> None:
         bad = [f for f in self.families if f not in FAMILIES]
         if bad or not self.families:
             raise InvalidInput(f"families {bad or '()'} unknown; use any of {', '.join(FAMILIES)} or all")
-        badt = [t for t in self.targets if t not in TARGETS]
+        known = target_columns(MAX_JOINTS)
+        badt = [t for t in self.targets if t not in known]
         if badt or not self.targets:
-            raise InvalidInput(f"targets {badt or '()'} unknown; use any of {', '.join(TARGETS)}")
+            raise InvalidInput(f"targets {badt or '()'} unknown; use any of {', '.join(known)}")
         if self.grid not in GRIDS:
             raise InvalidInput(f"grid must be one of {GRIDS}, got {self.grid!r}")
         if self.inputs not in INPUTS:
@@ -200,7 +203,7 @@ def train(
         Receives the grid search's progress as numbers (for progress bars; no
         need to parse ``progress`` messages).
     """
-    from joulepath.dynamics import NOMINAL_FRICTION, load_robot
+    from joulepath.dynamics import load_robot
 
     for name, table in (("training", train_table), ("test", test_table)):
         if len(table.frame) == 0:
@@ -216,7 +219,18 @@ def train(
         connect_scheduler(config.scheduler).close()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    cols = input_columns(train_table.feature_set, config.inputs)
+    if train_table.n_joints != test_table.n_joints:
+        raise InvalidInput(
+            f"the training table holds a {train_table.n_joints}-joint arm, the test table a "
+            f"{test_table.n_joints}-joint arm; give tables of one robot"
+        )
+    beyond = [t for t in config.targets if t not in train_table.targets]
+    if beyond:
+        raise InvalidInput(
+            f"targets {', '.join(beyond)} name joints the {train_table.n_joints}-joint arm of the table "
+            f"does not have; use any of {', '.join(train_table.targets)}"
+        )
+    cols = input_columns(train_table.feature_set, config.inputs, train_table.n_joints)
     X = train_table.frame[list(cols)].to_numpy(dtype=np.float64)
     groups = train_table.frame["move_id"].to_numpy()
     rows: list[dict[str, Any]] = []
@@ -334,10 +348,13 @@ def train(
     robot = load_robot(config.robot)
     baselines = [
         physics_baseline(test_table, robot, friction=None, label="dynamics model, no friction"),
-        physics_baseline(
-            test_table, robot, friction=NOMINAL_FRICTION, label="dynamics model + nominal friction"
-        ),
     ]
+    if robot.friction is not None:
+        baselines.append(
+            physics_baseline(
+                test_table, robot, friction=robot.friction, label="dynamics model + nominal friction"
+            )
+        )
     results = pd.DataFrame(rows)
     atomic_write_text(out / "results.csv", results.to_csv(index=False))
     report = {
@@ -383,7 +400,7 @@ def plot_test_scores(results: pd.DataFrame, baselines: Sequence[dict[str, Any]],
     paths = []
     for target, group in results.groupby("target"):
         fig, axes = plt.subplots(1, 2, figsize=(8, 3.2))
-        labels = list(group["family"]) + ["physics", "physics+fr"]
+        labels = list(group["family"]) + ["physics", "physics+fr"][: len(baselines)]
         r2 = list(group["test_r2"]) + [b["scores"][target]["r2"] for b in baselines]
         mae = list(group["test_mae"]) + [b["scores"][target]["mae"] for b in baselines]
         axes[0].bar(labels, r2, color="tab:blue")

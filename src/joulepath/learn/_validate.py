@@ -32,10 +32,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from joulepath._typing import FloatArray
-from joulepath.data import FEATURE_SETS, TARGETS
+from joulepath.data import FEATURE_SETS, target_columns
+from joulepath.data._schema import MAX_JOINTS, card_joints
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._families import FAMILIES
-from joulepath.learn._features import INPUTS, N_PHYSICS_TERMS, input_columns
+from joulepath.learn._features import INPUTS, input_columns, n_physics_terms
 
 if TYPE_CHECKING:
     from joulepath.learn._model import EnergyModel
@@ -50,9 +51,9 @@ def input_columns_sha256(columns: Sequence[str]) -> str:
     return hashlib.sha256(json.dumps(list(columns)).encode()).hexdigest()
 
 
-def n_model_features(n_inputs: int, inputs: str) -> int:
+def n_model_features(n_inputs: int, inputs: str, n_joints: int = 6) -> int:
     """Columns the estimator sees: the inputs, plus the physics terms for ``inputs="physics"``."""
-    return n_inputs + (N_PHYSICS_TERMS if inputs == "physics" else 0)
+    return n_inputs + (n_physics_terms(n_joints) if inputs == "physics" else 0)
 
 
 # --------------------------------------------------------------------------- card
@@ -76,7 +77,7 @@ def check_card(card: Any, card_path: Path) -> dict[str, Any]:
             raise InvalidModel(f"{card_path}: the card lacks {key!r}; train the model again")
     choices: tuple[tuple[str, Sequence[str]], ...] = (
         ("family", FAMILIES),
-        ("target", TARGETS),
+        ("target", target_columns(MAX_JOINTS)),
         ("feature_set", tuple(FEATURE_SETS)),
         ("inputs", INPUTS),
     )
@@ -98,7 +99,7 @@ def check_card(card: Any, card_path: Path) -> dict[str, Any]:
     cols = card["input_columns"]
     if not isinstance(cols, list) or not all(isinstance(c, str) for c in cols):
         raise InvalidModel(f"{card_path}: input_columns must be a list of column names, got {cols!r}")
-    expected = list(input_columns(card["feature_set"], card["inputs"]))
+    expected = list(input_columns(card["feature_set"], card["inputs"], card_joints(cols)))
     stored = card.get("input_columns_sha256")
     if stored is not None and stored != input_columns_sha256(cols):
         raise InvalidModel(
@@ -352,7 +353,7 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
         )
     cols = tuple(card["input_columns"])
     n_in = len(cols)
-    n = n_model_features(n_in, card["inputs"])
+    n = n_model_features(n_in, card["inputs"], card_joints(cols))
     if physics:
         phys = steps["physics"]
         if not isinstance(phys, PhysicsFeatures) or not hasattr(phys, "index_"):

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from joulepath.description import DEFAULT_ROBOT
 from joulepath.dynamics import Robot, load_robot
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize._run import ACCEL_TIME, OptimizeConfig, check_default_feasible, optimize_move
@@ -33,7 +34,7 @@ def random_tasks(
     done within the limits and every saving is measured against a feasible move.
     """
     rng = np.random.default_rng(seed)
-    lo, hi = robot.joint_ranges(range_set)
+    _, lo, hi = robot.ranges_for(range_set)
     tasks = []
     for k in range(n_tasks):
         for _ in range(MAX_DRAWS_PER_TASK):
@@ -108,7 +109,7 @@ def _run_one(
 
 def bench_optimizers(
     *,
-    robot: str = "irb120",
+    robot: str = DEFAULT_ROBOT,
     n_tasks: int = 500,
     generations: int = 250,
     population: int = 100,

@@ -33,7 +33,7 @@ def path_features(robot: Robot, traj: Trajectory, columns: tuple[str, ...]) -> F
     ----------
     robot : Robot
     traj : Trajectory
-        q, qd, qdd of shape (P, n_steps, 6).
+        q, qd, qdd of shape (P, n_steps, n).
     columns : tuple of str
         Input names in the model's order (see ``EnergyModel.input_columns``).
 
@@ -47,7 +47,7 @@ def path_features(robot: Robot, traj: Trajectory, columns: tuple[str, ...]) -> F
     P, n, _ = q.shape
     dt = traj.dt
     cols: dict[str, FloatArray] = {"dt": np.full((P, n), dt)}
-    for i in range(6):
+    for i in range(q.shape[-1]):
         cols[f"q{i + 1}"] = q[..., i]
         cols[f"dq{i + 1}"] = qd[..., i]
         cols[f"ddq{i + 1}"] = qdd[..., i]

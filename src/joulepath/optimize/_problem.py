@@ -3,8 +3,8 @@
 Fitness kinds (each one call for the whole population):
 
 * ``"surrogate"`` — a learned model of the total energy ``E`` summed over the path's rows;
-* ``"surrogate-joints"`` — the sum of six per-joint models ``E1..E6`` (the thesis'
-  multi-objective variant);
+* ``"surrogate-joints"`` — the sum of per-joint models ``E1..En``, one per joint (the
+  thesis' multi-objective variant);
 * ``"physics"`` — the dynamics model (nominal parameters and friction):
   ``Σ |tau_i qd_i| dt``.
 
@@ -25,11 +25,12 @@ from typing import Any
 import numpy as np
 
 from joulepath._typing import FloatArray
-from joulepath.dynamics import NOMINAL_FRICTION, Robot
+from joulepath.dynamics import Robot
 from joulepath.energy import path_energy
 from joulepath.errors import InvalidInput
 from joulepath.optimize._features import path_features
 from joulepath.trajectory import GRID_HIGH, GRID_LOW, Trajectory, rest_to_rest, thesis_quintic
+from joulepath.trajectory._polynomial import N_COEFFICIENTS
 
 PARAMETRIZATIONS = ("rest_to_rest", "thesis")
 FITNESS = ("surrogate", "surrogate-joints", "physics")
@@ -58,7 +59,7 @@ def limit_violation(
     *,
     acceleration_limit: FloatArray | None = None,
 ) -> Violation:
-    """Violations of paths q, qd (and torques tau) of shape (P, n, 6).
+    """Violations of paths q, qd (and torques tau) of shape (P, n_steps, n).
 
     With ``acceleration_limit`` (rad/s², one per joint) the relative over-acceleration
     counts with the overspeed.
@@ -87,10 +88,19 @@ def limit_violation(
     return Violation(range=rng_v, speed=spd_v, torque=trq_v)
 
 
+ROBOT_FRICTION = "robot"
+"""``friction=ROBOT_FRICTION``: the robot's own friction (:attr:`Robot.friction`)."""
+
+
 def physics_energy(
-    robot: Robot, traj: Trajectory, *, friction: Any = NOMINAL_FRICTION
+    robot: Robot, traj: Trajectory, *, friction: Any = ROBOT_FRICTION
 ) -> tuple[FloatArray, FloatArray]:
-    """Per-path energy ``Σ |tau qd| dt`` (J) and the torques, for paths (P, n, 6)."""
+    """Per-path energy ``Σ |tau qd| dt`` (J) and the torques, for paths (P, n_steps, n).
+
+    ``friction``: the robot's own by default; None for the rigid body only.
+    """
+    if isinstance(friction, str) and friction == ROBOT_FRICTION:
+        friction = robot.friction
     tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=friction)
     e = path_energy(tau, traj.qd, traj.dt).total
     return np.atleast_1d(e), tau
@@ -98,7 +108,7 @@ def physics_energy(
 
 @dataclass(eq=False)
 class TrajectoryProblem:
-    """Chromosomes (flattened (6, 6) coefficient matrices) to penalized path energy.
+    """Chromosomes (flattened (n, 6) coefficient matrices: 6 per joint) to penalized path energy.
 
     Implements :class:`joulepath.evolve.Problem`.
     """
@@ -121,7 +131,7 @@ class TrajectoryProblem:
             )
         if self.fitness not in FITNESS:
             raise InvalidInput(f"fitness must be one of {FITNESS}, got {self.fitness!r}")
-        need = {"surrogate": 1, "surrogate-joints": 6, "physics": 0}[self.fitness]
+        need = {"surrogate": 1, "surrogate-joints": self.robot.n_joints, "physics": 0}[self.fitness]
         if len(self.models) != need:
             raise InvalidInput(f"fitness {self.fitness!r} needs {need} model(s), got {len(self.models)}")
         self.q_start = np.asarray(self.q_start, dtype=float)
@@ -129,19 +139,20 @@ class TrajectoryProblem:
 
     @property
     def n_var(self) -> int:
-        return 36
+        """``6·n``: six polynomial coefficients per joint (36 for a 6-joint arm)."""
+        return N_COEFFICIENTS * self.robot.n_joints
 
     @property
     def xl(self) -> FloatArray:
-        return np.full(36, GRID_LOW)
+        return np.full(self.n_var, GRID_LOW)
 
     @property
     def xu(self) -> FloatArray:
-        return np.full(36, GRID_HIGH)
+        return np.full(self.n_var, GRID_HIGH)
 
     def trajectory(self, X: FloatArray) -> Trajectory:
-        """Paths of chromosomes X (P, 36) or (36,)."""
-        chrom = np.asarray(X, dtype=float).reshape(-1, 6, 6)
+        """Paths of chromosomes X (P, 6·n) or (6·n,)."""
+        chrom = np.asarray(X, dtype=float).reshape(-1, self.robot.n_joints, N_COEFFICIENTS)
         build = rest_to_rest if self.parametrization == "rest_to_rest" else thesis_quintic
         return build(chrom, self.q_start, self.q_end, self.duration, dt=self.dt)
 

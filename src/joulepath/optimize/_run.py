@@ -101,8 +101,8 @@ class OptimizeConfig:
             raise InvalidInput(
                 f"max_deviation_mm must be a positive number of mm, got {self.max_deviation_mm}"
             )
-        if any(not 1 <= j <= 6 for j in self.informed_joints):
-            raise InvalidInput(f"informed_joints are joint numbers 1..6, got {self.informed_joints}")
+        if any(not 1 <= j for j in self.informed_joints):
+            raise InvalidInput(f"informed_joints are joint numbers 1..n, got {self.informed_joints}")
 
     @property
     def search(self) -> AlgorithmSpec:
@@ -114,9 +114,9 @@ class OptimizeConfig:
 class MoveSummary:
     """Everything measured about one optimized move (``result.json``, one key per field).
 
-    Energies are ``Σ |tau qd| dt`` on the physics model (nominal rigid body and
-    ``NOMINAL_FRICTION``, or a twin's identified parameters and friction:
-    :attr:`Robot.friction`) at the 25 ms samples; ``*_fine_J`` is the same on a grid ten
+    Energies are ``Σ |tau qd| dt`` on the physics model (nominal rigid body and the
+    robot's friction, :attr:`Robot.friction`; ``physics_model`` says which) at the 25 ms
+    samples; ``*_fine_J`` is the same on a grid ten
     times finer (the integral the samples approximate). ``saved_pct`` compares the
     optimized path with the controller-like minimum-jerk move of the same duration.
     Limits are checked on the fine grid. ``saved_vs_initial_best_pct`` is the thesis'
@@ -153,6 +153,7 @@ class MoveSummary:
     wall_s: float
     physics_model: str
     config: dict[str, Any]
+    lab_plant: str = ""
 
     def to_json(self) -> dict[str, Any]:
         """Plain JSON types; non-finite numbers become ``null`` (strict JSON)."""
@@ -286,6 +287,11 @@ def optimize_move(
     sample_times(duration, SAMPLE_PERIOD)
     check_default_feasible(robot, q0, qf, duration, accel_time=config.accel_time)
     default = minimum_jerk(q0, qf, duration)
+    if any(j > robot.n_joints for j in config.informed_joints):
+        raise InvalidInput(
+            f"informed_joints are joint numbers 1..{robot.n_joints} for {robot.name}, "
+            f"got {config.informed_joints}"
+        )
     joints = tuple(config.informed_joints) or joints_ranked or rank_joints_by_energy(robot, default)
     amax = acceleration_limit(robot, config.accel_time)
     task = SearchTask(
@@ -315,12 +321,13 @@ def verify_move(
     """Measure a search's result: physics energy, fine-grid limits, lab plant, TCP deviation."""
     optimized = outcome.path
     amax = None if not np.all(np.isfinite(task.acceleration_limit)) else task.acceleration_limit
-    e_def = energy_on_samples(robot, default, friction=robot.friction)
-    e_opt = energy_on_samples(robot, optimized, friction=robot.friction)
+    friction = robot.friction
+    e_def = energy_on_samples(robot, default, friction=friction)
+    e_opt = energy_on_samples(robot, optimized, friction=friction)
     fine_def = default_fine(task.q_start, task.q_end, task.duration, task.dt)
-    e_def_fine = energy_on_samples(robot, fine_def, friction=robot.friction)
-    e_opt_fine = energy_on_samples(robot, outcome.fine_path, friction=robot.friction)
-    report = check_limits(robot, outcome.fine_path, friction=robot.friction, acceleration_limit=amax)
+    e_def_fine = energy_on_samples(robot, fine_def, friction=friction)
+    e_opt_fine = energy_on_samples(robot, outcome.fine_path, friction=friction)
+    report = check_limits(robot, outcome.fine_path, friction=friction, acceleration_limit=amax)
     e_sur_def = e_sur_opt = None
     if task.models:
         stack = Trajectory(
@@ -381,13 +388,9 @@ def verify_move(
         iterations=outcome.iterations,
         evaluations=outcome.evaluations,
         wall_s=wall,
-        physics_model=(
-            "nominal rigid body + NOMINAL_FRICTION; |tau*qd|*dt summed at dt = 0.025 s"
-            if robot.calibration is None
-            else f"identified twin of {robot.calibration.twin_of} (rigid body + identified friction, "
-            "joint side); |tau*qd|*dt summed at dt = 0.025 s"
-        ),
+        physics_model=_physics_model(robot),
         config=asdict(config),
+        lab_plant=lab.note,
     )
     return MoveResult(
         summary=summary,
@@ -396,6 +399,23 @@ def verify_move(
         history=np.asarray(outcome.history),
         parameters=np.asarray(outcome.parameters),
     )
+
+
+def _physics_model(robot: Robot) -> str:
+    """The physics model in words, for ``result.json``."""
+    if robot.calibration is not None:
+        return (
+            f"identified twin of {robot.calibration.twin_of} (rigid body + identified friction, "
+            "joint side); |tau*qd|*dt summed at dt = 0.025 s"
+        )
+    if robot.friction is None:
+        return (
+            f"nominal rigid body only, no friction (friction: {robot.friction_note}); "
+            "|tau*qd|*dt at dt = 0.025 s"
+        )
+    if robot.friction_note.startswith("NOMINAL_FRICTION"):
+        return "nominal rigid body + NOMINAL_FRICTION; |tau*qd|*dt summed at dt = 0.025 s"
+    return f"nominal rigid body + {robot.friction_note}; |tau*qd|*dt summed at dt = 0.025 s"
 
 
 def _path_csv(traj: Trajectory) -> str:
@@ -467,34 +487,60 @@ RUN_FILES = (
     "convergence.png",
     "path.mod",
 )
-"""What :func:`write_run` writes in a run folder (``path.mod`` only for a path within the limits)."""
+"""What :func:`write_run` writes in a run folder for the IRB 120 (``path.mod`` only for a path
+within the limits); another exporter writes its own program files instead of ``path.mod``."""
 
 
 def write_run(
-    result: MoveResult, robot: Robot, out_dir: str | os.PathLike[str], *, repeats: int = 5
+    result: MoveResult,
+    robot: Robot,
+    out_dir: str | os.PathLike[str],
+    *,
+    export: str | None = None,
 ) -> dict[str, Path]:
-    """Write result.json, path.csv, convergence.csv, plots and — only when limits hold — path.mod.
+    """Write result.json, path.csv, convergence.csv, plots and — only when limits hold — the program.
 
-    A refused path also removes a ``path.mod`` left in the folder by an earlier run,
-    so the folder never offers a program for a result that was refused.
+    The program is the exporter ``export`` renders (:data:`joulepath.export.EXPORTERS`;
+    None: the controller the robot declares, e.g. ``path.mod`` for the IRB 120).
+    ``result.json`` names the exporter and its files, or why none was written, and
+    any warning (another vendor's program). A refused path also removes program files
+    an earlier run left in the folder, so the folder never offers a program for a
+    result that was refused.
     """
-    from joulepath.export import path_module
+    from joulepath.export import EXPORTERS, select_exporter
 
+    exporter, warning = select_exporter(robot, export)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     files = {}
     s = result.summary
     summary = s.to_json()
-    if s.limits_ok:
-        text = path_module(robot, result.optimized.q, result.optimized.qd, s.duration_s, repeats=repeats)
-        files["path.mod"] = atomic_write_text(out / "path.mod", text)
-        summary["rapid"] = "path.mod"
+    summary["export"] = exporter.name
+    programs: dict[str, str] = {}
+    refused = None
+    if not s.limits_ok:
+        refused = "the optimized path violates a limit: " + "; ".join(s.limit_excess)
     else:
-        stale = out / "path.mod"
-        if stale.is_file() and not stale.is_symlink():
-            stale.unlink()
-        summary["rapid"] = None
-        summary["rapid_refused"] = "the optimized path violates a limit: " + "; ".join(s.limit_excess)
+        try:
+            programs = exporter.render(robot, result.optimized, s.duration_s)
+        except (LimitViolation, InvalidInput) as err:
+            refused = str(err)
+    if refused is None:
+        for name, text in programs.items():
+            files[name] = atomic_write_text(out / name, text)
+    else:
+        for name in sorted({f for e in EXPORTERS.values() for f in e.files}):
+            stale = out / name
+            if stale.is_file() and not stale.is_symlink():
+                stale.unlink()
+    summary["program"] = sorted(programs) if refused is None else None
+    summary["rapid"] = "path.mod" if "path.mod" in files else None
+    if refused is not None:
+        summary["program_refused"] = refused
+        if exporter.name == "rapid":
+            summary["rapid_refused"] = refused
+    if warning is not None:
+        summary["export_warning"] = warning
     files["result.json"] = atomic_write_text(
         out / "result.json", json.dumps(summary, indent=2, allow_nan=False)
     )

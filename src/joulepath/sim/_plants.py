@@ -14,10 +14,17 @@ single-precision ``num`` values (``NumToStr(value, 5)``).
 
 The friction values are assumptions (no identified friction of the IRB 120 is
 public); they are of the size reported for robots of this class.
+
+For any other arm the ``lab`` plant is a *generic perturbation* of its model (the
+same recipe: perturbed links, the flange adapter, the robot's own friction made
+stronger, gear losses, noise scaled to its torque limits, the tracking lag). It is
+a test of robustness to model error, not an estimate of what the real arm would
+measure: :attr:`Plant.note` says so, and the outputs repeat it.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Protocol
@@ -60,15 +67,18 @@ class Plant:
 
     name: str
     robot: Robot
-    friction: Friction
+    friction: Friction | None
     gear_efficiency: float = 1.0
-    torque_noise: tuple[float, ...] = (0.0,) * 6
+    torque_noise: tuple[float, ...] = ()
     speed_noise_deg_s: float = 0.0
     tracking_hz: float | None = None
+    note: str = ""
 
     def drive_torque(self, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
         """Noise-free motor torque (joint side, N·m) the plant needs for a motion."""
-        tau = self.robot.inverse_dynamics(q, qd, qdd) + self.friction.torque(qd)
+        tau = self.robot.inverse_dynamics(q, qd, qdd)
+        if self.friction is not None:
+            tau = tau + self.friction.torque(qd)
         if self.gear_efficiency != 1.0:
             driving = tau * qd > 0
             tau = np.where(driving, tau / self.gear_efficiency, tau * self.gear_efficiency)
@@ -88,6 +98,24 @@ def perturbed_robot(robot: Robot, rng: np.random.Generator) -> Robot:
     inertias = chain.inertias * scale[:, None, None]
     new = replace(chain, masses=masses, coms=coms, inertias=inertias)
     return Robot(new, description=None, source=f"{robot.source} (perturbed)")
+
+
+_IRB120 = re.compile(r"irb[ _-]?120", re.I)
+IRB120_TORQUE_NOISE = (0.15, 0.15, 0.10, 0.03, 0.03, 0.02)
+"""N·m, the IRB 120 lab plant's torque sensor noise per joint."""
+GENERIC_NOISE_SHARE = 1e-3
+"""Another arm's lab-plant torque noise: this share of each joint's torque limit (0.05 N·m where unknown)."""
+
+
+def is_irb120(robot: Robot) -> bool:
+    """Whether the lab plant of this robot is the emulated IRB 120 (else a generic perturbation)."""
+    return bool(_IRB120.search(robot.name)) and robot.n_joints == 6
+
+
+def _coulomb_viscous(friction: Friction | None, n: int) -> tuple[FloatArray, FloatArray]:
+    fc = np.broadcast_to(np.atleast_1d(np.asarray(getattr(friction, "coulomb", 0.0), float)), (n,))
+    fv = np.broadcast_to(np.atleast_1d(np.asarray(getattr(friction, "viscous", 0.0), float)), (n,))
+    return np.array(fc), np.array(fv)
 
 
 def twin_plant(folder: str, robot: Robot) -> Plant:
@@ -113,15 +141,22 @@ def twin_plant(folder: str, robot: Robot) -> Plant:
 def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
     """The ``sim`` or ``lab`` plant of a robot (``instance_seed`` fixes the lab robot), or a twin folder.
 
-    For a twin (``robot.calibration``), ``sim`` is the twin's own identified physics and
-    ``lab`` the lab plant of the robot it is a twin of.
+    ``sim`` uses the robot's own friction (:attr:`Robot.friction`, none: rigid body
+    only). ``lab`` is the emulated IRB 120 for the IRB 120, and the same recipe as a
+    generic perturbation for any other arm (see the module's description). For a twin
+    (``robot.calibration``), ``sim`` is the twin's own identified physics and ``lab``
+    the lab plant of the robot it is a twin of.
     """
     if name not in PLANTS and Path(name).is_dir():
         return twin_plant(name, robot)
     calibration = robot.calibration
     if calibration is not None and name == "sim":  # a twin's nominal physics are its identified ones
         return Plant(
-            name="sim", robot=robot, friction=robot.friction, gear_efficiency=calibration.gear_efficiency
+            name="sim",
+            robot=robot,
+            friction=robot.friction,
+            gear_efficiency=calibration.gear_efficiency,
+            note=f"identified twin {robot.source}",
         )
     if calibration is not None and calibration.twin_of is not None:
         # a twin is measured on the lab robot it is a twin of, never on a perturbed copy of itself
@@ -129,23 +164,36 @@ def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
 
         robot = load_robot(calibration.twin_of)
     if name == "sim":
-        return Plant(name="sim", robot=robot, friction=NOMINAL_FRICTION)
+        return Plant(name="sim", robot=robot, friction=robot.friction, note=f"nominal {robot.name} model")
     if name == "lab":
+        n = robot.n_joints
         rng = np.random.default_rng(instance_seed)
         real = perturbed_robot(robot, rng).with_payload(0.35, com=(0.0, 0.0, 0.025))
-        friction = LabFriction(
-            coulomb=1.35 * NOMINAL_COULOMB,
-            viscous=1.25 * NOMINAL_VISCOUS,
-            stribeck=0.4 * NOMINAL_COULOMB,
-        )
+        noise: tuple[float, ...]
+        if is_irb120(robot):
+            fc, fv = NOMINAL_COULOMB, NOMINAL_VISCOUS
+            noise = IRB120_TORQUE_NOISE
+            note = "emulated IRB 120 lab robot (assumed perturbations, friction and noise)"
+        else:
+            fc, fv = _coulomb_viscous(robot.friction, n)
+            effort = robot.effort_limit
+            noise = tuple(float(v) for v in np.where(np.isfinite(effort), GENERIC_NOISE_SHARE * effort, 0.05))
+            note = (
+                f"generic perturbation of the {robot.name} model (links, flange adapter, "
+                + ("its friction made stronger" if robot.friction is not None else "no friction: none known")
+                + ", "
+                "gear losses, noise, tracking lag); not an estimate of a real robot"
+            )
+        friction = LabFriction(coulomb=1.35 * fc, viscous=1.25 * fv, stribeck=0.4 * fc)
         return Plant(
             name="lab",
             robot=real,
             friction=friction,
             gear_efficiency=0.88,
-            torque_noise=(0.15, 0.15, 0.10, 0.03, 0.03, 0.02),
+            torque_noise=noise,
             speed_noise_deg_s=0.05,
             tracking_hz=12.0,
+            note=note,
         )
     raise InvalidInput(
         f"unknown plant {name!r}; use one of {', '.join(PLANTS)}, or a twin folder (`joulepath identify`)"

@@ -13,12 +13,14 @@ import numpy as np
 from joulepath._io import atomic_write_text, check_replaceable, make_folder
 from joulepath.data import (
     controller_log_text,
+    generic_log_text,
     ingest,
     moves_sidecar_path,
     save_table,
     write_controller_log,
 )
 from joulepath.data._schema import MOVES_SIDECAR_COLUMNS
+from joulepath.description import DEFAULT_ROBOT
 from joulepath.dynamics import Robot, load_robot
 from joulepath.export import Move, draw_moves
 from joulepath.sim._controller import ControllerConfig, MotionPlan, log_times, plan_moves
@@ -34,6 +36,8 @@ class SimulatedLog:
     n_rows: int
     n_moves: int
     duration_s: float
+    range_set: str = "collection"
+    plant_note: str = ""
 
 
 def measure(
@@ -56,7 +60,9 @@ def measure(
 
 
 def log_text(robot: Robot, m: Measured) -> str:
-    """The measurement as the controller's CSV text."""
+    """The measurement as the controller's CSV text (a generic joint log for an arm not of 6 joints)."""
+    if robot.n_joints != 6:
+        return generic_log_text(m.t, m.q, m.qd, m.tau)
     pose = robot.fk(m.q)
     quat = pose.quaternion
     euler = pose.euler_zyx_deg  # (z, y, x)
@@ -81,7 +87,7 @@ def simulate(
     plant: str = "lab",
     n_moves: int = 1000,
     seed: int | np.random.SeedSequence = 0,
-    robot: str = "irb120",
+    robot: str = DEFAULT_ROBOT,
     range_set: str = "collection",
     config: ControllerConfig | None = None,
 ) -> SimulatedLog:
@@ -94,6 +100,7 @@ def simulate(
     """
     r = load_robot(robot)
     rng = np.random.default_rng(seed)
+    used, _, _ = r.ranges_for(range_set)
     moves = draw_moves(r, n_moves, range_set=range_set, rng=rng)
     plan, measured = measure(r, plant, moves, rng=rng, config=config)
     path = Path(out)
@@ -102,7 +109,10 @@ def simulate(
     check_replaceable(side)
     write_controller_log(path, log_text(r, measured))
     atomic_write_text(side, moves_text(plan))
-    return SimulatedLog(path, side, int(measured.t.size), len(plan.segments), float(measured.t[-1]))
+    note = make_plant(plant, r).note
+    return SimulatedLog(
+        path, side, int(measured.t.size), len(plan.segments), float(measured.t[-1]), used, note
+    )
 
 
 THESIS_PLAN = (
@@ -136,7 +146,7 @@ def simulate_plan(
     out: str | os.PathLike[str],
     *,
     seed: int = 0,
-    robot: str = "irb120",
+    robot: str = DEFAULT_ROBOT,
     plan: Sequence[tuple[str, str, int]] = THESIS_PLAN,
     workers: int = 2,
     progress: Callable[[dict[str, object]], None] | None = None,

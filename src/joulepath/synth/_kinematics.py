@@ -36,6 +36,7 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.data import EnergyTable
+from joulepath.description import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput
 
 if TYPE_CHECKING:
@@ -44,7 +45,6 @@ if TYPE_CHECKING:
 TCP_TOLERANCE_M = 0.005
 """A row is kinematically consistent when its TCP position is within this distance of FK(q), m."""
 
-DEFAULT_ROBOT = "irb120"
 """Robot used when none is given."""
 
 LOCAL_STEP_S = 1e-3
