@@ -63,7 +63,9 @@ def test_panda_lagrange_euler_and_rnea_agree(panda):
 def test_panda_physics_optimization_stays_within_limits_and_exports_ros2(panda, tmp_path):
     q0 = np.array([0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0])
     qf = np.array([1.0, 0.5, 0.5, -1.0, 0.5, 2.0, 0.5])
-    result = optimize_move(panda, q0, qf, 2.0, OptimizeConfig(evaluations=400, seed=3))
+    # CMA-ES keeps this test short; the default gradient search needs minutes on this frictionless
+    # 7-joint move (README, "Other arms and controllers")
+    result = optimize_move(panda, q0, qf, 2.0, OptimizeConfig(algorithm="cmaes", evaluations=400, seed=3))
     s = result.summary
     assert s.limits_ok and s.algorithm == "cmaes" and s.energy_optimized_J <= s.energy_default_J
     files = write_run(result, panda, tmp_path)
