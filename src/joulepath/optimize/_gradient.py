@@ -74,7 +74,7 @@ class GradientSettings:
     max_rounds: int = 6
     start_scale: float = 0.15
     coarse_factor: int = 2
-    refine_stages: int = 2
+    refine_stages: int = 1
 
     def __post_init__(self) -> None:
         if self.n_starts < 1 or self.max_iter < 1 or self.max_rounds < 1:
