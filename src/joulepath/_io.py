@@ -13,6 +13,9 @@ import os
 import stat
 import tempfile
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from joulepath.errors import InvalidInput
 
@@ -108,3 +111,21 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
     """Text version of :func:`atomic_write_bytes` (UTF-8)."""
     return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def finite_json(value: Any) -> Any:
+    """``value`` with NumPy scalars and arrays as plain JSON types and NaN/infinities as ``None``.
+
+    For strict JSON (``json.dumps(..., allow_nan=False)``): results never carry ``NaN``.
+    """
+    if isinstance(value, dict):
+        return {k: finite_json(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [finite_json(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return finite_json(value.tolist())
+    if isinstance(value, float | np.floating):
+        return float(value) if np.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value

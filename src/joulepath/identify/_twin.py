@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from joulepath._io import atomic_write_text, check_replaceable, make_folder
+from joulepath._io import atomic_write_text, check_replaceable, finite_json, make_folder
 from joulepath.description import (
     PRESETS,
     Inertial,
@@ -126,19 +126,8 @@ def write_twin(
     card = {"format": CARD_FORMAT, "twin_of": robot.calibration.twin_of, **ident.card(), **(extra or {})}
     atomic_write_text(paths[0], irml_string(robot.description))
     atomic_write_text(paths[1], json.dumps(robot.calibration.to_json(), indent=2) + "\n")
-    atomic_write_text(paths[2], json.dumps(_finite(card), indent=2, default=_jsonable) + "\n")
+    atomic_write_text(paths[2], json.dumps(finite_json(card), indent=2, default=_jsonable) + "\n")
     return paths
-
-
-def _finite(value: Any) -> Any:
-    """NaN and infinities as null (strict JSON)."""
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_finite(v) for v in value]
-    if isinstance(value, float | np.floating) and not np.isfinite(value):
-        return None
-    return value
 
 
 def _jsonable(value: Any) -> Any:

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from joulepath._io import atomic_write_text
+from joulepath._io import atomic_write_text, finite_json
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.energy import joint_power, path_energy
@@ -157,20 +157,8 @@ class MoveSummary:
 
     def to_json(self) -> dict[str, Any]:
         """Plain JSON types; non-finite numbers become ``null`` (strict JSON)."""
-        out: dict[str, Any] = _finite(asdict(self))
+        out: dict[str, Any] = finite_json(asdict(self))
         return out
-
-
-def _finite(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_finite(v) for v in value]
-    if isinstance(value, float | np.floating):
-        return float(value) if np.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    return value
 
 
 @dataclass(frozen=True, slots=True)

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from joulepath import __version__
-from joulepath._io import atomic_write_text
+from joulepath._io import atomic_write_text, finite_json
 from joulepath.abb import EXTERNAL_AXES_UNUSED
 from joulepath.errors import LimitViolation
 from joulepath.program._cycle import CycleResult, ParetoPoint, Solved, via_points
@@ -240,18 +240,6 @@ def write_cycle_run(
     emulated = emulated_cycle_time(result, text) if text is not None else None
     data = cycle_json(result, pareto, "optimized.mod" if text is not None else None, refused, emulated)
     files["cycle.json"] = atomic_write_text(
-        out / "cycle.json", json.dumps(_finite(data), indent=2, allow_nan=False)
+        out / "cycle.json", json.dumps(finite_json(data), indent=2, allow_nan=False)
     )
     return files
-
-
-def _finite(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_finite(v) for v in value]
-    if isinstance(value, float | np.floating):
-        return float(value) if np.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    return value
