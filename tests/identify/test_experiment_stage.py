@@ -53,3 +53,8 @@ def test_identify_stage_writes_a_twin_scores_and_the_loop(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     r2 = scores.loc["twin", "energy_r2"]  # read back from CSV: equal to the last bits
     assert summary["stages"]["identify"]["twin_energy_r2"] == pytest.approx(r2, rel=1e-12)
+    # the report shows the stage: the scores and the loop, not the "not run" note
+    page = (out / "report.html").read_text()
+    section = page.split('data-section="identify"', 1)[1].split("</section>", 1)[0]
+    assert "nominal physics + nominal friction" in section and "realized_saved_lab_pct" in section
+    assert "was not run" not in section

@@ -27,6 +27,7 @@ SECTIONS = (
     ("importance", "Feature importance"),
     ("optimize", "Optimized moves"),
     ("bench", "Optimizer benchmark"),
+    ("identify", "Calibrated twin"),
     ("differences", "What differs from the thesis"),
     ("settings", "Settings and provenance"),
 )
@@ -689,6 +690,32 @@ def _bench(run: _Run) -> str:
     return out + _pair(fig, ("Figure 4.19",))
 
 
+def _identify(run: _Run) -> str:
+    if not run.ran("identify"):
+        return (
+            '<p class="note">Dynamic identification (a calibrated twin) was not run in this experiment. '
+            "Set [identify] enabled = true to run it.</p>"
+        )
+    scores = run.csv("identify/scores.csv")
+    loop = run.csv("identify/loop.csv")
+    st = (run.json("summary.json") or {}).get("stages", {}).get("identify", {})
+    out = (
+        "<p>The twin is identified from the training logs (base inertial parameters from Pinocchio's "
+        "joint torque regressor, per-joint friction, gear efficiency; physically consistent links) and "
+        "scored on the test logs against the nominal physics. Condition number of the stacked regressor "
+        f"{_fmt(st.get('condition_number'), 3)}, gear efficiency {_fmt(st.get('gear_efficiency'), 3)}. "
+        "The twin folder is <code>identify/twin/</code> (<code>--robot</code> accepts it).</p>"
+    )
+    if scores is not None:
+        out += _table(scores)
+    if loop is not None and len(loop):
+        out += (
+            "<p>Closing the loop: moves optimized on the twin, the saving it predicts against the saving "
+            "realized on the emulated lab robot.</p>" + _table(loop)
+        )
+    return out
+
+
 def _differences(run: _Run) -> str:
     rows = "".join(
         f"<tr><td>{_e(a)}</td><td style='text-align:left'>{_e(b)}</td></tr>" for a, b in DIFFERENCES
@@ -721,6 +748,7 @@ _RENDERERS: dict[str, Callable[[_Run], str]] = {
     "importance": _importance,
     "optimize": _optimize,
     "bench": _bench,
+    "identify": _identify,
     "differences": _differences,
     "settings": _settings,
 }
