@@ -19,8 +19,10 @@ def _models(
 ) -> tuple[tuple[object, ...], tuple[int, ...] | None]:
     from joulepath.errors import InvalidModel
     from joulepath.learn import best_model, read_joints_json
+    from joulepath.optimize import fitness_kind
 
-    if fitness == "physics":
+    targets = fitness_kind(fitness).model_targets(n_joints)
+    if not targets:
         if model_dir is not None:
             raise typer.BadParameter(
                 "--fitness physics does not use a learned model; drop --model, or add --fitness surrogate",
@@ -31,7 +33,6 @@ def _models(
         raise typer.BadParameter(
             f"--fitness {fitness} needs --model (a `joulepath train` output folder)", param_hint="--model"
         )
-    targets = ("E",) if fitness == "surrogate" else tuple(f"E{i}" for i in range(1, n_joints + 1))
     models = tuple(best_model(model_dir, t, family=family or None) for t in targets)
     for m in models:
         on_card, source = m.card.get("robot"), m.card.get("robot_source")

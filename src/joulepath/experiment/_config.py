@@ -58,7 +58,7 @@ from typing import Any
 from joulepath.description import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput
 from joulepath.export import EXPORTERS
-from joulepath.optimize import ALGORITHMS, AUTO, resolve_algorithm
+from joulepath.optimize import ALGORITHMS, AUTO, FITNESS, fitness_kind, resolve_algorithm
 
 ALL_TARGETS = ("E", "E1", "E2", "E3", "E4", "E5", "E6")
 
@@ -192,7 +192,7 @@ _ALLOWED: dict[str, tuple[str, ...]] = {
     "grid": ("quick", "thesis"),
     "inputs": ("physics", "thesis"),
     "algorithm": (AUTO, *ALGORITHMS),
-    "fitness": ("surrogate", "surrogate-joints", "physics"),
+    "fitness": FITNESS,
     "source": ("micro", "train"),
     "configurations": ("thesis", "compact"),
     "methods": ("copula", "copulagan", "ctgan", "tvae"),
@@ -326,15 +326,15 @@ def _check_together(exp: Experiment, source: str) -> None:
         raise InvalidInput(
             f"{source}: [optimize] reference = true needs fitness = 'physics' (a physics optimum)"
         )
-    needs = {"surrogate": ("E",), "surrogate-joints": ALL_TARGETS[1:]}
     for where, fitness in (("[optimize]", o.fitness), ("[bench]", exp.bench.fitness)):
         if where == "[bench]" and exp.bench.tasks == 0:
             continue
-        missing = [x for x in needs.get(fitness, ()) if x not in t.targets]
-        if missing or (fitness in needs and not t.families):
+        needs = fitness_kind(fitness).model_targets(len(ALL_TARGETS) - 1)  # the study's arm: E1..E6
+        missing = [x for x in needs if x not in t.targets]
+        if missing or (needs and not t.families):
             raise InvalidInput(
                 f"{source}: {where} fitness = {fitness!r} needs models of "
-                f"{', '.join(needs[fitness])}; add them to [train] targets (and a family), "
+                f"{', '.join(needs)}; add them to [train] targets (and a family), "
                 "or use fitness = 'physics'"
             )
 

@@ -11,12 +11,16 @@ from joulepath.optimize._features import path_features
 from joulepath.optimize._gradient import GradientResult, GradientSettings, SplineProblem, optimize_spline
 from joulepath.optimize._problem import (
     FITNESS,
+    FITNESS_KINDS,
     PARAMETRIZATIONS,
     PENALTY,
+    FitnessKind,
     TrajectoryProblem,
     Violation,
+    fitness_kind,
     limit_violation,
     physics_energy,
+    register_fitness,
 )
 from joulepath.optimize._run import (
     ACCEL_TIME,
@@ -48,6 +52,10 @@ __all__ = [
     "AlgorithmSpec",
     "FINE_FACTOR",
     "FITNESS",
+    "FITNESS_KINDS",
+    "FitnessKind",
+    "fitness_kind",
+    "register_fitness",
     "GradientResult",
     "GradientSettings",
     "LimitExcess",

@@ -19,6 +19,7 @@ worse than every feasible path of reasonable energy, and less violation ranks be
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -33,7 +34,58 @@ from joulepath.trajectory import GRID_HIGH, GRID_LOW, Trajectory, rest_to_rest, 
 from joulepath.trajectory._polynomial import N_COEFFICIENTS
 
 PARAMETRIZATIONS = ("rest_to_rest", "thesis")
-FITNESS = ("surrogate", "surrogate-joints", "physics")
+
+
+@dataclass(frozen=True, slots=True)
+class FitnessKind:
+    """What a ``--fitness`` name means: the learned models it needs (none: the physics model)."""
+
+    name: str
+    description: str
+    targets: Callable[[int], tuple[str, ...]]
+    """Model targets for an arm of ``n`` joints (``()``: no learned model)."""
+
+    def model_targets(self, n_joints: int) -> tuple[str, ...]:
+        return self.targets(n_joints)
+
+    @property
+    def needs_models(self) -> bool:
+        return bool(self.targets(1))
+
+
+FITNESS_KINDS: dict[str, FitnessKind] = {}
+"""The fitness registry; adding a kind is :func:`register_fitness` plus what evaluates it."""
+
+
+def register_fitness(kind: FitnessKind) -> FitnessKind:
+    FITNESS_KINDS[kind.name] = kind
+    return kind
+
+
+register_fitness(
+    FitnessKind("surrogate", "one learned model of the path energy (target E)", lambda n: ("E",))
+)
+register_fitness(
+    FitnessKind(
+        "surrogate-joints",
+        "one learned model per joint (targets E1..En), summed: the thesis' multi-objective fitness",
+        lambda n: tuple(f"E{i}" for i in range(1, n + 1)),
+    )
+)
+register_fitness(
+    FitnessKind("physics", "the physics model: rigid body and the robot's friction", lambda n: ())
+)
+FITNESS = tuple(FITNESS_KINDS)
+
+
+def fitness_kind(name: str) -> FitnessKind:
+    """The registered fitness ``name``; InvalidInput naming the choices otherwise."""
+    try:
+        return FITNESS_KINDS[name]
+    except KeyError:
+        raise InvalidInput(f"fitness must be one of {', '.join(FITNESS_KINDS)}, got {name!r}") from None
+
+
 PENALTY = 1000.0
 """J per unit of limit violation (see the module docstring)."""
 
@@ -129,9 +181,7 @@ class TrajectoryProblem:
             raise InvalidInput(
                 f"parametrization must be one of {PARAMETRIZATIONS}, got {self.parametrization!r}"
             )
-        if self.fitness not in FITNESS:
-            raise InvalidInput(f"fitness must be one of {FITNESS}, got {self.fitness!r}")
-        need = {"surrogate": 1, "surrogate-joints": self.robot.n_joints, "physics": 0}[self.fitness]
+        need = len(fitness_kind(self.fitness).model_targets(self.robot.n_joints))
         if len(self.models) != need:
             raise InvalidInput(f"fitness {self.fitness!r} needs {need} model(s), got {len(self.models)}")
         self.q_start = np.asarray(self.q_start, dtype=float)
@@ -158,7 +208,7 @@ class TrajectoryProblem:
 
     def energy(self, traj: Trajectory) -> tuple[FloatArray, FloatArray | None]:
         """Unpenalized fitness energy of paths (J) and torques where computed."""
-        if self.fitness == "physics":
+        if not fitness_kind(self.fitness).needs_models:
             return physics_energy(self.robot, traj, friction=self.robot.friction)
         P, n = traj.q.shape[0], traj.q.shape[1]
         total = np.zeros(P)

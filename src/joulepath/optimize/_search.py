@@ -27,7 +27,7 @@ from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.evolve import DE, GA, MA, Termination, minimize
 from joulepath.optimize._gradient import GradientSettings, solve_move
-from joulepath.optimize._problem import PENALTY, TrajectoryProblem, limit_violation
+from joulepath.optimize._problem import FITNESS, PENALTY, TrajectoryProblem, limit_violation
 from joulepath.optimize._verify import FINE_FACTOR
 from joulepath.trajectory import SplineBasis, Trajectory, rest_to_rest, thesis_quintic
 
@@ -235,7 +235,7 @@ def _evolutionary(name: str) -> Search:
     return run
 
 
-ALL_FITNESS = ("surrogate", "surrogate-joints", "physics")
+ALL_FITNESS = FITNESS
 
 ALGORITHMS: dict[str, AlgorithmSpec] = {
     spec.name: spec
