@@ -7,7 +7,8 @@ import numpy as np
 from joulepath import __version__
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
-from joulepath.errors import InvalidInput, LimitViolation
+from joulepath.errors import InvalidInput
+from joulepath.export._base import check_path
 from joulepath.export._rapid import _array, _jt, _num
 
 
@@ -39,21 +40,7 @@ def excitation_module(
         raise InvalidInput(f"path must have shape (n_steps >= 2, {robot.n_joints}), got {q.shape}")
     if every < 1 or repeats < 1 or not duration > 0:
         raise InvalidInput("every and repeats must be ≥ 1 and the duration positive")
-    lo, hi = robot.joint_ranges()
-    bad = np.nonzero((q < lo - 1e-9) | (q > hi + 1e-9))
-    if bad[0].size:
-        k, j = int(bad[0][0]), int(bad[1][0])
-        raise LimitViolation(
-            f"sample {k}: joint {j + 1} at {np.degrees(q[k, j]):.2f} deg leaves its range "
-            f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg; the program is not written"
-        )
-    over = np.nonzero(np.abs(qd) > robot.velocity_limit * (1 + 1e-9))
-    if over[0].size:
-        k, j = int(over[0][0]), int(over[1][0])
-        raise LimitViolation(
-            f"sample {k}: joint {j + 1} speed {np.degrees(abs(qd[k, j])):.1f} deg/s exceeds its limit "
-            f"{np.degrees(robot.velocity_limit[j]):.1f} deg/s; the program is not written"
-        )
+    check_path(robot, q, qd, what="the program")
     n = q.shape[0]
     idx = list(range(every, n - 1, every)) + [n - 1]
     seg_times = np.diff([0, *idx]) * (duration / (n - 1))
