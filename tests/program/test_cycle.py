@@ -190,3 +190,65 @@ def test_warm_start_solves_within_limits(spec):
     second = opt.solve(i, opt.t_lo[i])  # warm-started from the first
     assert second.usable and second.corridor_dev_mm <= 100.0 + 1e-6
     assert opt.n_solves == 2
+
+
+CHAIN = """MODULE Chain
+    CONST jointtarget j0 := [[0, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+{decls}
+    PROC main()
+        WHILE TRUE DO
+            MoveAbsJ j0, v1000, fine, tool0;
+{moves}
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+
+
+def _chain(zone: str, n: int = 8, step_deg: float = 3.0, T: float = 0.1) -> str:
+    decls, moves = [], []
+    for k in range(1, n + 1):
+        decls.append(
+            f"    CONST jointtarget j{k} := [[{k * step_deg}, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];"
+        )
+        z = "fine" if k == n else zone
+        moves.append(f"            MoveAbsJ j{k}, v7000 \\T:={T}, {z}, tool0;")
+    return CHAIN.format(decls="\n".join(decls), moves="\n".join(moves))
+
+
+def test_timed_fly_by_chain_keeps_speed(robot):
+    """Timed fly-by points in a large zone: the chain takes the sum of its \\T and the joint speed is
+    continuous and constant between the start and end ramps."""
+    cfg = ControllerConfig()
+    n, T = 8, 0.2
+    plan = plan_cycle(resolve_module(parse_module(_chain("z200", n, T=T), path="c.mod"), robot), cfg)
+    chain = [m for m in plan.moves if m.step.time_s is not None]
+    start, end = chain[0].t0, chain[-1].t_end
+    assert end - start == pytest.approx(n * T, abs=1e-9)
+    t = np.linspace(start, end, 4001)
+    traj = evaluate_cycle(plan, t)
+    v = np.radians(3.0) / T
+    mid = (t > start + 1.5 * T) & (t < end - 1.5 * T)  # beyond the first and last corner paths
+    assert np.allclose(traj.qd[mid, 0], v, rtol=1e-9)
+    assert np.all(np.abs(traj.qd[:, 1:]) < 1e-12)
+    assert np.max(np.abs(np.diff(traj.qd[:, 0]))) < 0.05 * v  # no velocity jumps
+    assert traj.q[-1, 0] == pytest.approx(np.radians(3.0 * n), abs=1e-12)
+
+
+def test_written_program_check_is_reported(tmp_path, robot):
+    """cycle.json carries the written program run by the emulation beside the plan, with a verdict
+    consistent with its numbers and tolerances."""
+    from joulepath.program._output import check_written, optimized_module
+
+    spec = resolve_module(parse_module(SMALL, path="small.mod"), robot)
+    r, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, use_waits=True))
+    check = check_written(r, optimized_module(r, via_every=2))
+    tol = check["tolerances"]
+    expected = (
+        abs(check["cycle_diff_pct"]) <= tol["cycle_pct"]
+        and abs(check["energy_diff_pct"]) <= tol["energy_pct"]
+        and check["tcp_path_deviation_mm"] <= tol["path_mm"]
+    )
+    assert check["within_tolerances"] == expected
+    assert check["planned_cycle_s"] == r.optimized_cycle_s
+    assert check["emulated_cycle_s"] > 0 and check["emulated_energy_J"] > 0

@@ -13,10 +13,28 @@ zones), extended to what a program holds:
   ``ControllerConfig.fine_dwell``, then the next starts; in a zone the next move
   starts while the TCP is the zone radius from the corner (at most half of either move);
 * instructions kept verbatim take no modelled time.
+
+Timed fly-by corners (:func:`chain_corners`): between two joint-interpolated moves
+(``MoveJ``/``MoveAbsJ``) that both carry ``\\T``, the first ending in a zone, the
+emulation follows what ABB documents instead of superposing two rest-to-rest profiles:
+``\\T`` is substituted for the speed data (the segment between the two programmed
+points runs at the constant joint velocity ``dq / T``); the zone is reduced to half the
+distance to the nearest programmed point, forwards or backwards; the corner path is a
+parabola that starts when the TCP enters the zone and ends when it leaves it, so the
+joint velocity changes linearly from one segment's to the next's within the zone,
+centred on the programmed point, and the robot keeps speed through the point (a chain
+of timed fly-by points takes the sum of its ``\\T``). A chain starts and ends at rest
+with the jerk-limited sin² ramp at the acceleration limit, inside its first and last
+``\\T``. A corner is timed only if the controller can keep it: every joint within its
+speed limit on both segments and within its acceleration limit in the corner path,
+and the chain's first and last ``\\T`` long enough to reach and leave the segment
+speed; else that corner is run as any other (superposition). Nothing else changes: a
+program without such corners is timed exactly as before.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -77,6 +95,69 @@ def _slerp(r0: FloatArray, r1: FloatArray, s: FloatArray) -> FloatArray:
 
     out: FloatArray = Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([r0, r1])))(s).as_matrix()
     return out
+
+
+@dataclass(frozen=True, slots=True)
+class ChainProfile:
+    """A move inside a chain of timed fly-by points (unit path parameter s: 0 -> 1).
+
+    ``ds/dt = v (R_in(tau) - R_out(tau - b))``: a ramp in of ``w_in`` s, a ramp out of
+    ``w_out`` s starting at ``b``; a ramp is ``"lin"`` (a corner path: velocity linear in
+    time) or ``"sin2"`` (from or to rest, jerk-limited). ``rest`` is the move's own
+    rest-to-rest profile (what :func:`standalone` runs).
+    """
+
+    w_in: float
+    kind_in: str
+    b: float
+    w_out: float
+    kind_out: str
+    v: float
+    rest: Profile
+
+    @property
+    def duration(self) -> float:
+        return self.b + self.w_out
+
+
+AnyProfile = Profile | ChainProfile
+
+
+def _ramp(kind: str, w: float, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Integral, value and slope of a 0 -> 1 ramp of width ``w`` at ``x`` (0 before, 1 after)."""
+    xc = np.clip(x, 0.0, w)
+    after = np.maximum(x - w, 0.0)
+    inside = (x > 0.0) & (x < w)
+    if kind == "lin":
+        integral = xc * xc / (2.0 * w) + after
+        value = xc / w
+        slope = np.where(inside, 1.0 / w, 0.0)
+    else:
+        integral = xc / 2.0 - w / (2.0 * np.pi) * np.sin(np.pi * xc / w) + after
+        value = np.sin(np.pi * xc / (2.0 * w)) ** 2
+        slope = np.where(inside, np.pi / (2.0 * w) * np.sin(np.pi * xc / w), 0.0)
+    return integral, value, slope
+
+
+def evaluate_any(p: AnyProfile, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``s, ds/dt, d²s/dt²`` of either profile at ``tau`` (clipped to [0, T])."""
+    if isinstance(p, Profile):
+        return evaluate_profile(p, tau)
+    tau = np.clip(np.asarray(tau, dtype=float), 0.0, p.duration)
+    i_in, r_in, d_in = _ramp(p.kind_in, p.w_in, tau)
+    i_out, r_out, d_out = _ramp(p.kind_out, p.w_out, tau - p.b)
+    return p.v * (i_in - i_out), p.v * (r_in - r_out), p.v * (d_in - d_out)
+
+
+def _time_at_fraction(p: AnyProfile, fraction: float) -> float:
+    if isinstance(p, Profile):
+        return time_at_fraction(p, fraction)
+    lo, hi = 0.0, p.duration
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        s, _, _ = evaluate_any(p, np.array([mid]))
+        lo, hi = (mid, hi) if s[0] < fraction else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:
@@ -143,7 +224,7 @@ class PlannedMove:
     index: int  # position in CycleSpec.steps
     step: Step
     path: SegmentPath
-    profile: Profile
+    profile: AnyProfile
     t0: float
     stops: bool
 
@@ -179,6 +260,105 @@ def stops_after(spec: CycleSpec, i: int) -> bool:
     return True
 
 
+def _rest_ramp(T: float, m: float) -> float | None:
+    """The sin² ramp (s) from rest to the speed that, with the ramp, covers the segment in ``T``.
+
+    ``m`` = max over joints of |dq| / a_max; the ramp is at the acceleration limit:
+    ``r = (pi/2) v m`` with ``v = 1 / (T - r/2)``. None: ``T`` is too short.
+    """
+    disc = T * T - np.pi * m
+    return None if disc < 0 else T - float(np.sqrt(disc))
+
+
+def chain_corners(
+    plans: Sequence[tuple[int, Step, SegmentPath, Profile, float, bool]], config: ControllerConfig
+) -> dict[int, tuple[AnyProfile, float]]:
+    """Timed fly-by corners (see the module docstring): the moves they touch, by position in
+    ``plans``, with their chain profiles and the overlap (s) with the next move (its ramp out)."""
+    n = len(plans)
+
+    def candidate(k: int) -> bool:
+        _, a, pa, fa, _, stop = plans[k]
+        _, b, pb, fb, _, _ = plans[k + 1]
+        return (
+            not stop
+            and a.zone_mm is not None
+            and a.time_s is not None
+            and b.time_s is not None
+            and pa.spline is None
+            and pb.spline is None
+            and fa.duration > 0
+            and fb.duration > 0
+        )
+
+    active = {k for k in range(n - 1) if candidate(k)}
+    while True:
+        out, bad = _chain_profiles(plans, active, config)
+        if bad is None:
+            return out
+        active.discard(bad)
+
+
+def _chain_profiles(
+    plans: Sequence[tuple[int, Step, SegmentPath, Profile, float, bool]],
+    active: set[int],
+    config: ControllerConfig,
+) -> tuple[dict[int, tuple[AnyProfile, float]], int | None]:
+    """Profiles of the moves at the active corners, or the first corner the controller cannot keep."""
+    if not active:
+        return {}, None
+    robot = plans[0][1].robot
+    assert robot is not None
+    vmax = np.asarray(robot.velocity_limit, dtype=float)
+    amax = vmax / config.accel_time
+    width: dict[int, float] = {}
+    for k in sorted(active):
+        (_, a, pa, _, _, _), (_, b, pb, _, _, _) = plans[k], plans[k + 1]
+        assert a.time_s is not None and b.time_s is not None and a.zone_mm is not None
+        La, Lb = pa.length_mm, pb.length_mm
+        if La > 1e-9 and Lb > 1e-9:
+            R = min(a.zone_mm, 0.5 * La, 0.5 * Lb)  # reduced to half the distance to the nearest point
+            width[k] = 2.0 * min(R / La * a.time_s, R / Lb * b.time_s)
+        else:
+            width[k] = min(a.time_s, b.time_s)
+        if width[k] <= 0.0:
+            return {}, k
+    profiles: dict[int, tuple[AnyProfile, float]] = {}
+    speed: dict[int, FloatArray] = {}  # joint velocity on the segment (rad/s)
+    for j in sorted({k for c in active for k in (c, c + 1)}):
+        _, step, path, rest, _, _ = plans[j]
+        assert step.time_s is not None
+        T = step.time_s
+        dq = path.q1 - path.q0
+        m = float(np.max(np.abs(dq) / amax))
+        w_in = width.get(j - 1) if (j - 1) in active else None
+        w_out = width.get(j) if j in active else None
+        if w_in is not None and w_out is not None:
+            v = 1.0 / T
+            prof = ChainProfile(w_in, "lin", T + 0.5 * w_in - 0.5 * w_out, w_out, "lin", v, rest)
+        elif w_out is not None:  # the chain starts at rest
+            r = _rest_ramp(T, m)
+            if r is None or T - 0.5 * w_out - r < -1e-12:
+                return {}, j
+            v = 1.0 / (T - 0.5 * r)
+            prof = ChainProfile(r, "sin2", T - 0.5 * w_out, w_out, "lin", v, rest)
+        else:  # the chain ends at rest
+            assert w_in is not None
+            r = _rest_ramp(T, m)
+            if r is None or T - 0.5 * w_in - r < -1e-12:
+                return {}, j - 1
+            v = 1.0 / (T - 0.5 * r)
+            prof = ChainProfile(w_in, "lin", 0.5 * w_in + T - r, r, "sin2", v, rest)
+        if np.any(np.abs(v * dq) > vmax * (1 + 1e-9)):
+            return {}, (j if j in active else j - 1)
+        speed[j] = v * dq
+        profiles[j] = (prof, prof.w_out if j in active else 0.0)
+    for k in sorted(active):
+        if np.any(np.abs(speed[k + 1] - speed[k]) / width[k] > amax * (1 + 1e-9)):
+            return {}, k
+    return profiles, None
+
+
 def plan_cycle(spec: CycleSpec, config: ControllerConfig) -> PlannedCycle:
     """The controller's timing of one cycle (it starts at rest at ``spec.start``)."""
     q = spec.start
@@ -196,6 +376,7 @@ def plan_cycle(spec: CycleSpec, config: ControllerConfig) -> PlannedCycle:
         frac = 0.0 if stop or radius is None or path.length_mm <= 0 else min(radius / path.length_mm, 0.5)
         plans.append((i, step, path, profile, frac, stop))
         q = step.q
+    chained = chain_corners(plans, config)
     t = 0.0
     out: list[PlannedMove] = []
     waits: list[tuple[int, float, float]] = []
@@ -206,14 +387,18 @@ def plan_cycle(spec: CycleSpec, config: ControllerConfig) -> PlannedCycle:
             t += step.seconds
         if step.kind != "move":
             continue
-        _, _, path, profile, frac, stop = plans[k]
+        _, _, path, rest, frac, stop = plans[k]
+        profile: AnyProfile = chained[k][0] if k in chained else rest
         out.append(PlannedMove(i, step, path, profile, t, stop))
         end = t + profile.duration
-        if profile.duration == 0.0:
+        nxt = (chained[k + 1][0] if k + 1 in chained else plans[k + 1][3]) if k + 1 < len(plans) else None
+        if k in chained and chained[k][1] > 0.0:
+            t = end - chained[k][1]
+        elif profile.duration == 0.0:
             t = end
-        elif frac > 0.0 and k + 1 < len(plans) and plans[k + 1][3].duration > 0:
-            blend = profile.duration - time_at_fraction(profile, 1.0 - frac)
-            blend = min(blend, 0.5 * profile.duration, 0.5 * plans[k + 1][3].duration)
+        elif frac > 0.0 and nxt is not None and nxt.duration > 0:
+            blend = profile.duration - _time_at_fraction(profile, 1.0 - frac)
+            blend = min(blend, 0.5 * profile.duration, 0.5 * nxt.duration)
             t = end - blend
         else:
             t = end + config.fine_dwell
@@ -234,7 +419,7 @@ def evaluate_cycle(plan: PlannedCycle, t: FloatArray) -> Trajectory:
         q[after] += end[0] - base[0]
         inside = (t >= m.t0) & ~after
         if m.profile.duration > 0 and inside.any():
-            s, sd, sdd = evaluate_profile(m.profile, t[inside] - m.t0)
+            s, sd, sdd = evaluate_any(m.profile, t[inside] - m.t0)
             pq, pd, pdd = m.path.at(s)
             q[inside] += pq - base[0]
             qd[inside] += pd * sd[:, None]
@@ -244,9 +429,10 @@ def evaluate_cycle(plan: PlannedCycle, t: FloatArray) -> Trajectory:
 
 def standalone(move: PlannedMove, *, dt: float = FINE_DT) -> Trajectory:
     """One move on its own, rest to rest, on a grid of ``dt`` (its end sample at its end)."""
-    T = move.profile.duration
+    profile = move.profile.rest if isinstance(move.profile, ChainProfile) else move.profile
+    T = profile.duration
     n = max(2, int(np.ceil(T / dt)) + 1)
     t = np.linspace(0.0, T, n)
-    s, sd, sdd = evaluate_profile(move.profile, t)
+    s, sd, sdd = evaluate_profile(profile, t)
     pq, pd, pdd = move.path.at(s)
     return Trajectory(t=t, q=pq, qd=pd * sd[:, None], qdd=pdd * (sd * sd)[:, None] + pd * sdd[:, None])
