@@ -2,7 +2,7 @@
 
 Stages, each in its own folder of the run: ``data`` (simulate on a plant or ingest
 logs), ``synth`` (optional), ``models`` (train), ``importance``, ``optimize``,
-``bench`` (optional); then ``report.html`` is rendered from what they wrote.
+``bench`` (optional), ``identify`` (optional); then ``report.html`` is rendered from what they wrote.
 
 Each stage writes its outputs, then a ``stage.json`` holding a hash of its settings,
 of the stages it reads (so a stage whose inputs changed runs again, and so do the
