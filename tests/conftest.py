@@ -49,6 +49,7 @@ TINY_DEMO = {
     "tasks": "2",
     "generations": "5",
     "population": "12",
+    "loop_tasks": "1",
     "reference": "false",  # the reference solver has its own tests (tests/optimize/test_reference.py)
 }
 

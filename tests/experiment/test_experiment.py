@@ -111,8 +111,16 @@ def test_bundled_thesis_experiment_is_the_full_plan():
 
 def test_tiny_demo_run_writes_every_stage(tiny_run):
     summary = json.loads((tiny_run / "summary.json").read_text())
-    assert list(summary["stages"]) == ["data", "synth", "train", "importance", "optimize", "bench"]
-    for folder in ("data", "synth", "models", "importance", "optimize", "bench"):
+    assert list(summary["stages"]) == [
+        "data",
+        "synth",
+        "train",
+        "importance",
+        "optimize",
+        "bench",
+        "identify",
+    ]
+    for folder in ("data", "synth", "models", "importance", "optimize", "bench", "identify"):
         assert (tiny_run / folder / "stage.json").exists(), folder
     assert set(summary["stages"]["data"]["datasets"]) == {"train", "test", "micro", "sim"}
     assert (tiny_run / "synth" / "copula.parquet").exists()
@@ -126,6 +134,11 @@ def test_tiny_demo_run_writes_every_stage(tiny_run):
     assert len(tasks) == 2 and np.isfinite(tasks["saved_pct"]).all()
     for row in tasks.itertuples():
         assert (tiny_run / "optimize" / f"task-{row.task:03d}" / "path.mod").exists() == bool(row.limits_ok)
+    # the identify stage reuses the train stage's best model of E and the synth stage's rows
+    assert "the train stage's best model of E" in summary["stages"]["identify"]["learned_model"]
+    compared = pd.read_csv(tiny_run / "identify" / "scores.csv")
+    sdv_rows = len(pd.read_parquet(tiny_run / "synth" / "copula.parquet"))
+    assert compared["trained_on"].str.startswith(f"{sdv_rows:,} rows, copula from the synth stage").any()
     bench = pd.read_csv(tiny_run / "bench" / "table.csv")
     assert len(bench) == 7 and bench["configuration"].str.startswith("MA").sum() == 2
     assert bench["configuration"].iloc[0] == "joulepath default (gradient)"
@@ -147,7 +160,15 @@ def test_run_experiment_skips_unchanged_stages_and_reruns_interrupted_ones(
     said: list[str] = []
     run_experiment(load_experiment(toml), run, say=said.append)
     skipped = [s for s in said if s.endswith("unchanged, skipped")]
-    assert [s.split(":")[0] for s in skipped] == ["data", "synth", "train", "importance", "optimize", "bench"]
+    assert [s.split(":")[0] for s in skipped] == [
+        "data",
+        "synth",
+        "train",
+        "importance",
+        "optimize",
+        "bench",
+        "identify",
+    ]
     # a change in [optimize] reruns optimize only
     changed = tiny_demo_toml(tmp_path, **{"train.targets": '["E", "E1"]', "optimize.generations": "6"})
     said.clear()

@@ -10,7 +10,7 @@ import pytest
 from joulepath.experiment import load_experiment, run_experiment
 from joulepath.experiment._run import _Context, _robot_key, _stage
 
-STAGES = ("data", "synth", "train", "importance", "optimize", "bench")
+STAGES = ("data", "synth", "train", "importance", "optimize", "bench", "identify")
 
 
 def _ctx(root: Path, said: list[str]) -> _Context:
@@ -103,7 +103,8 @@ def test_run_experiment_dropped_family_and_stage_leave_nothing_behind(tiny_run, 
     assert not (run / "synth").exists() and not (run / "bench").exists()
     assert any(s.startswith("synth: no longer in the experiment") for s in said)
     ran = [s.split(":")[0] for s in said if s.split(":")[0] in STAGES and "done in" in s]
-    # data and importance did not change; optimize uses physics fitness, so no model change reaches it
-    assert ran == ["train"]
-    assert list(summary["stages"]) == ["data", "train", "importance", "optimize"]
+    # data and importance did not change; optimize uses physics fitness, so no model change reaches it;
+    # identify compares the train stage's model and the synth stage's rows, so it runs again
+    assert ran == ["train", "identify"]
+    assert list(summary["stages"]) == ["data", "train", "importance", "optimize", "identify"]
     assert not [p for p in run.iterdir() if p.name.endswith((".partial", ".old", ".stale"))]

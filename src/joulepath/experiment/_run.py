@@ -2,7 +2,7 @@
 
 Stages, each in its own folder of the run: ``data`` (simulate on a plant or ingest
 logs), ``synth`` (optional), ``models`` (train), ``importance``, ``optimize``,
-``bench`` (optional); then ``report.html`` is rendered from what they wrote.
+``bench`` (optional), ``identify`` (optional); then ``report.html`` is rendered from what they wrote.
 
 Each stage writes its outputs, then a ``stage.json`` holding a hash of its settings,
 of the stages it reads (so a stage whose inputs changed runs again, and so do the
@@ -227,7 +227,8 @@ def run_experiment(
     else:
         _drop_stage(ctx, "bench", "bench")
     if exp.identify.enabled:
-        stages["identify"] = _identify_stage(ctx, keys["data"])
+        synth_key = stages["synth"]["key"] if "synth" in stages else ""
+        stages["identify"] = _identify_stage(ctx, keys["data"], synth_key, model_key)
     else:
         _drop_stage(ctx, "identify", "identify")
     tasks = pd.read_csv(root / "optimize" / "tasks.csv")
@@ -871,10 +872,18 @@ def _bench_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[str
 
 
 # ----------------------------------------------------------------------------- identify
-def _identify_stage(ctx: _Context, data_key: str) -> dict[str, Any]:
-    """A twin from the training logs; twin and nominal physics on the test logs; the loop closed."""
+def _identify_stage(ctx: _Context, data_key: str, synth_key: str, model_key: str) -> dict[str, Any]:
+    """A twin from the training logs, the loop closed on it, and five models side by side.
+
+    The work is :func:`joulepath.experiment._identify.run_identify`; it reads the synth
+    stage's rows and the train stage's best model of E when they exist (their keys are
+    in this stage's key).
+    """
+    from joulepath._runfolder import IDENTIFY_STAGE
+    from joulepath.experiment._identify import HELD_OUT, NOMINAL, TWIN, run_identify, write_identify
+
     exp, st = ctx.exp, ctx.exp.identify
-    key = _hash("identify", data_key, _robot_key(exp.robot), asdict(st), exp.seed)
+    key = _hash("identify", data_key, synth_key, model_key, _robot_key(exp.robot), asdict(st), exp.seed)
 
     def logs(name: str, given: tuple[str, ...]) -> list[str]:
         paths = resolve_logs(exp, given) or [str(ctx.root / "data" / "logs" / f"{name}.csv")]
@@ -886,79 +895,27 @@ def _identify_stage(ctx: _Context, data_key: str) -> dict[str, Any]:
         return paths
 
     def body(folder: Path) -> dict[str, Any]:
-        from joulepath.dynamics import NOMINAL_FRICTION, load_robot
-        from joulepath.energy import path_energy
-        from joulepath.identify import (
-            IdentifyOptions,
-            data_from_logs,
-            identify,
-            score_prediction,
-            twin_robot,
-            write_twin,
+        result = run_identify(
+            exp,
+            ctx.root,
+            folder,
+            train_logs=logs("train", exp.data.train_logs),
+            test_logs=logs("test", exp.data.test_logs),
+            progress=lambda done, total: ctx.progress("identify", done, total),
         )
-        from joulepath.optimize import OptimizeConfig, optimize_move, random_tasks
-
-        robot = load_robot(exp.robot)
-        ctx.progress("identify", 0, 2 + st.loop_tasks)
-        ident = identify(data_from_logs(logs("train", exp.data.train_logs), robot), robot, IdentifyOptions())
-        write_twin(ident, robot, folder / "twin")
-        twin = twin_robot(robot, ident)
-        test = data_from_logs(logs("test", exp.data.test_logs), robot)
-        nominal = robot.inverse_dynamics(test.q, test.qd, test.qdd, friction=NOMINAL_FRICTION)
-        rows = []
-        for label, pred in (
-            ("twin", ident.motor_torque(robot, test.q, test.qd, test.qdd)),
-            ("nominal physics + nominal friction", nominal),
-        ):
-            sc = score_prediction(pred, test)
-            rows.append(
-                {
-                    "model": label,
-                    "samples": sc.n_samples,
-                    "torque_r2_worst_joint": min(sc.torque_r2),
-                    "energy_r2": sc.energy_r2,
-                    "energy_error_pct": sc.energy_error_pct,
-                }
-            )
-        atomic_write_text(folder / "scores.csv", pd.DataFrame(rows).to_csv(index=False))
-        ctx.progress("identify", 2, 2 + st.loop_tasks)
-        assert twin.calibration is not None
-        cal = twin.calibration
-
-        def predicted(path: Any) -> float:
-            tau = twin.inverse_dynamics(path.q, path.qd, path.qdd, friction=twin.friction)
-            return float(path_energy(cal.motor_torque(tau, path.qd), path.qd, path.dt).total)
-
-        seed = int(np.random.SeedSequence(exp.seed).spawn(6)[5].generate_state(1)[0])
-        loop = []
-        for k, (q0, qf, T) in enumerate(
-            random_tasks(robot, st.loop_tasks, seed=seed, range_set=st.range_set)
-        ):
-            res = optimize_move(twin, q0, qf, T, OptimizeConfig(seed=exp.seed))
-            e_def, e_opt = predicted(res.default), predicted(res.optimized)
-            s = res.summary
-            loop.append(
-                {
-                    "task": k,
-                    "duration_s": T,
-                    "limits_ok": s.limits_ok,
-                    "predicted_saved_pct": 100 * (e_def - e_opt) / e_def,
-                    "realized_saved_lab_pct": s.saved_lab_pct,
-                    "energy_default_lab_J": s.energy_default_lab_J,
-                    "energy_optimized_lab_J": s.energy_optimized_lab_J,
-                }
-            )
-            ctx.progress("identify", 3 + k, 2 + st.loop_tasks)
-        frame = pd.DataFrame(loop)
-        atomic_write_text(folder / "loop.csv", frame.to_csv(index=False))
+        write_identify(result, folder)
+        twin, nominal = result.score(TWIN, HELD_OUT), result.score(NOMINAL, HELD_OUT)
+        frame = result.loop_frame()
         gap = (
             float((frame["predicted_saved_pct"] - frame["realized_saved_lab_pct"]).abs().median())
             if len(frame)
             else None
         )
+        for note in result.notes:
+            ctx.tell(f"identify: {note}")
         ctx.tell(
-            f"identify: twin energy R² {rows[0]['energy_r2']:.4f} on the test logs (nominal physics "
-            f"{rows[1]['energy_r2']:.4f}); gear efficiency {ident.gear_efficiency:.3f}"
+            f"identify: twin energy R² {twin.energy_r2:.4f} on the held-out moves (nominal physics "
+            f"{nominal.energy_r2:.4f}); gear efficiency {result.gear_efficiency:.3f}"
             + (
                 f"; predicted vs realized saving: median gap {gap:.2f} pp over {len(frame)} tasks"
                 if gap is not None
@@ -966,14 +923,15 @@ def _identify_stage(ctx: _Context, data_key: str) -> dict[str, Any]:
             )
         )
         return {
-            "condition_number": ident.condition_number,
-            "gear_efficiency": ident.gear_efficiency,
-            "twin_energy_r2": rows[0]["energy_r2"],
-            "nominal_energy_r2": rows[1]["energy_r2"],
+            "condition_number": result.condition_number,
+            "gear_efficiency": result.gear_efficiency,
+            "twin_energy_r2": twin.energy_r2,
+            "nominal_energy_r2": nominal.energy_r2,
             "loop_median_gap_pp": gap,
+            "learned_model": result.learned,
         }
 
-    return _stage(ctx, "identify", "identify", key, body)
+    return _stage(ctx, "identify", IDENTIFY_STAGE, key, body)
 
 
 def _plot_bench(table: pd.DataFrame, path: Path) -> None:

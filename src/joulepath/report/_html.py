@@ -16,6 +16,7 @@ from typing import Any
 import pandas as pd
 
 from joulepath._io import atomic_write_text
+from joulepath._runfolder import IDENTIFY_LOOP, IDENTIFY_SCORES, IDENTIFY_STAGE, IDENTIFY_TWIN
 from joulepath.report._thesis import HYPOTHESES, ThesisItem, items_for_stage, thesis_item
 
 SECTIONS = (
@@ -691,23 +692,32 @@ def _bench(run: _Run) -> str:
 
 
 def _identify(run: _Run) -> str:
-    if not run.ran("identify"):
+    if not run.ran(IDENTIFY_STAGE):
         return (
             '<p class="note">Dynamic identification (a calibrated twin) was not run in this experiment. '
             "Set [identify] enabled = true to run it.</p>"
         )
-    scores = run.csv("identify/scores.csv")
-    loop = run.csv("identify/loop.csv")
-    st = (run.json("summary.json") or {}).get("stages", {}).get("identify", {})
+    scores = run.csv(f"{IDENTIFY_STAGE}/{IDENTIFY_SCORES}")
+    loop = run.csv(f"{IDENTIFY_STAGE}/{IDENTIFY_LOOP}")
+    st = (run.json("summary.json") or {}).get("stages", {}).get(IDENTIFY_STAGE, {})
     out = (
         "<p>The twin is identified from the training logs (base inertial parameters from Pinocchio's "
-        "joint torque regressor, per-joint friction, gear efficiency; physically consistent links) and "
-        "scored on the test logs against the nominal physics. Condition number of the stacked regressor "
+        "joint torque regressor, per-joint friction, gear efficiency; physically consistent links). "
+        "Condition number of the stacked regressor "
         f"{_fmt(st.get('condition_number'), 3)}, gear efficiency {_fmt(st.get('gear_efficiency'), 3)}. "
-        "The twin folder is <code>identify/twin/</code> (<code>--robot</code> accepts it).</p>"
+        f"The twin folder is <code>{IDENTIFY_STAGE}/{IDENTIFY_TWIN}/</code> "
+        "(<code>--robot</code> accepts it).</p>"
     )
     if scores is not None:
-        out += _table(scores)
+        out += (
+            "<p>Five models side by side on the same test sets: the twin and the nominal physics predict "
+            "torque (R² of the worst joint) and energy; the learned model of E "
+            f"({_e(st.get('learned_model', '?'))}) predicts energy only (–), and is refitted with the "
+            "same hyperparameters on rows simulated on the twin and on SDV rows. Test sets: the held-out "
+            "moves, moves of another kind (other joint ranges) and the loop's optimized paths, each run "
+            "on the data's plant. Row energy R² on the test rows; path error: median over the moves of "
+            "|ΣE predicted − ΣE measured| / ΣE measured.</p>" + _table(scores)
+        )
     if loop is not None and len(loop):
         out += (
             "<p>Closing the loop: moves optimized on the twin, the saving it predicts against the saving "

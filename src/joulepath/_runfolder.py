@@ -1,0 +1,33 @@
+"""The run folder's declared files (foundation): what ``experiment`` writes and ``report`` reads.
+
+A stage's files are named relative to its folder. Only the ``[identify]`` stage's files are
+declared here so far; the other stages' names are still spelled where they are used.
+"""
+
+from __future__ import annotations
+
+IDENTIFY_STAGE = "identify"
+"""The ``[identify]`` stage's folder in the run folder."""
+
+IDENTIFY_TWIN = "twin"
+"""The calibrated twin folder (``--robot`` accepts it)."""
+
+IDENTIFY_SCORES = "scores.csv"
+"""One row per model and test set; columns :data:`IDENTIFY_SCORE_COLUMNS`."""
+
+IDENTIFY_SCORE_COLUMNS = (
+    "model",
+    "trained_on",
+    "test_set",
+    "moves",
+    "rows",
+    "torque_r2_worst_joint",
+    "energy_r2",
+    "path_error_median_pct",
+)
+"""``torque_r2_worst_joint`` is empty for a model that predicts energy only."""
+
+IDENTIFY_LOOP = "loop.csv"
+"""Tasks optimized on the twin: the saving it predicts against the one realized on the plant."""
+
+__all__ = ["IDENTIFY_LOOP", "IDENTIFY_SCORES", "IDENTIFY_SCORE_COLUMNS", "IDENTIFY_STAGE", "IDENTIFY_TWIN"]
