@@ -209,7 +209,8 @@ def _chain(zone: str, n: int = 8, step_deg: float = 3.0, T: float = 0.1) -> str:
     decls, moves = [], []
     for k in range(1, n + 1):
         decls.append(
-            f"    CONST jointtarget j{k} := [[{k * step_deg}, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];"
+            f"    CONST jointtarget j{k} := [[{k * step_deg}, 0, 0, 0, 30, 0], "
+            "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];"
         )
         z = "fine" if k == n else zone
         moves.append(f"            MoveAbsJ j{k}, v7000 \\T:={T}, {z}, tool0;")

@@ -368,13 +368,13 @@ def plan_cycle(spec: CycleSpec, config: ControllerConfig) -> PlannedCycle:
         assert step.q is not None
         path = segment_path(step, q, spec.source)
         if np.abs(step.q - q).max() <= 1e-9:
-            profile = Profile(ta=0.0, tc=0.0, v=0.0)
+            fastest = Profile(ta=0.0, tc=0.0, v=0.0)
         else:
-            profile = fastest_profile(step, path, config)
+            fastest = fastest_profile(step, path, config)
         radius = step.zone_mm
         stop = stops_after(spec, i)
         frac = 0.0 if stop or radius is None or path.length_mm <= 0 else min(radius / path.length_mm, 0.5)
-        plans.append((i, step, path, profile, frac, stop))
+        plans.append((i, step, path, fastest, frac, stop))
         q = step.q
     chained = chain_corners(plans, config)
     t = 0.0
