@@ -11,6 +11,7 @@ import joulepath
 from joulepath.description import preset_path
 
 FIXTURES = Path(__file__).parent / "fixtures"
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 @pytest.fixture(scope="session")
@@ -91,8 +92,13 @@ def tiny_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The tiny demo run through the CLI (``joulepath run FILE --out DIR --quiet``); its folder."""
     from joulepath.cli import main
 
+    import shutil
+
     base = tmp_path_factory.mktemp("tiny-demo")
     toml = _tiny_demo_toml(base, **{"train.targets": '["E", "E1"]'})
+    # the bundled example program's whole cycle, as the [cycle] stage runs it
+    shutil.copy(EXAMPLES / "pick_and_place.mod", base / "cell.mod")
+    toml.write_text(toml.read_text() + '\n[cycle]\nprogram = "cell.mod"\n')
     assert main(["run", str(toml), "--out", str(base / "run"), "--quiet"]) == 0
     return base / "run"
 

@@ -1,7 +1,7 @@
 """The run folder's declared files (foundation): what ``experiment`` writes and ``report`` reads.
 
-A stage's files are named relative to its folder. Only the ``[identify]`` stage's files are
-declared here so far; the other stages' names are still spelled where they are used.
+A stage's files are named relative to its folder. Only the ``[identify]`` and ``[cycle]`` stages'
+files are declared here so far; the other stages' names are still spelled where they are used.
 """
 
 from __future__ import annotations
@@ -30,4 +30,22 @@ IDENTIFY_SCORE_COLUMNS = (
 IDENTIFY_LOOP = "loop.csv"
 """Tasks optimized on the twin: the saving it predicts against the one realized on the plant."""
 
-__all__ = ["IDENTIFY_LOOP", "IDENTIFY_SCORES", "IDENTIFY_SCORE_COLUMNS", "IDENTIFY_STAGE", "IDENTIFY_TWIN"]
+CYCLE_STAGE = "cycle"
+"""The ``[cycle]`` stage's folder: the files of ``joulepath cycle`` (``joulepath.program.CYCLE_FILES``)."""
+
+CYCLE_JSON = "cycle.json"
+"""Per move: default and optimized duration and energy; the cycle's totals and the written program's check."""
+
+CYCLE_PARETO_PNG = "pareto.png"
+"""Energy against cycle time (only when ``[cycle] pareto_points`` ≥ 3)."""
+
+__all__ = [
+    "CYCLE_JSON",
+    "CYCLE_PARETO_PNG",
+    "CYCLE_STAGE",
+    "IDENTIFY_LOOP",
+    "IDENTIFY_SCORES",
+    "IDENTIFY_SCORE_COLUMNS",
+    "IDENTIFY_STAGE",
+    "IDENTIFY_TWIN",
+]

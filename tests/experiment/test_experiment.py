@@ -119,8 +119,9 @@ def test_tiny_demo_run_writes_every_stage(tiny_run):
         "optimize",
         "bench",
         "identify",
+        "cycle",
     ]
-    for folder in ("data", "synth", "models", "importance", "optimize", "bench", "identify"):
+    for folder in ("data", "synth", "models", "importance", "optimize", "bench", "identify", "cycle"):
         assert (tiny_run / folder / "stage.json").exists(), folder
     assert set(summary["stages"]["data"]["datasets"]) == {"train", "test", "micro", "sim"}
     assert (tiny_run / "synth" / "copula.parquet").exists()
@@ -255,3 +256,51 @@ def test_run_on_a_dask_scheduler_gives_the_local_results(tmp_path, dask_schedule
         b = pd.read_csv(tmp_path / "dask" / name).drop(columns=["search_s", "wall_s_mean"], errors="ignore")
         pd.testing.assert_frame_equal(a, b)
     assert remote["mean_saved_pct"] == pytest.approx(local["mean_saved_pct"])
+
+
+def test_cycle_stage_matches_its_files_and_the_report(tiny_run):
+    """The [cycle] stage's record, its cycle.json and the report's section tell the same numbers."""
+    import html as html_mod
+    import re
+
+    record = json.loads((tiny_run / "summary.json").read_text())["stages"]["cycle"]
+    data = json.loads((tiny_run / "cycle" / "cycle.json").read_text())
+    assert record["default_cycle_s"] == pytest.approx(data["default_cycle_s"])
+    assert record["limits_ok"] == data["limits_ok"]
+    if data["limits_ok"]:
+        assert record["saved_pct"] == pytest.approx(data["saved_pct"])
+        assert (tiny_run / "cycle" / "optimized.mod").is_file()
+        # the per-move energies add up to the cycle's totals on physics
+        moves = data["moves"]
+        assert sum(m["optimized_energy_J"] for m in moves) <= data["energy_optimized_J"] + 1e-6
+        # same cycle time (the default program's), never longer
+        assert data["optimized_cycle_s"] <= data["default_cycle_s"] + 1e-6
+    page = (tiny_run / "report.html").read_text()
+    section = re.search(r'<section id="cycle".*?</section>', page, re.S)
+    assert section is not None
+    text = html_mod.unescape(section.group(0))
+    assert f"{data['default_cycle_s']:.4g} s" in text
+    assert ("REFUSED" in text) != data["limits_ok"]
+    assert len(re.findall(r"<tr>", section.group(0))) >= len(data["moves"]) + 1
+
+
+def test_cycle_section_is_checked_before_running(tmp_path, tiny_demo_toml):
+    from joulepath.experiment import load_experiment
+
+    toml = tiny_demo_toml(tmp_path)
+    base = toml.read_text()
+    (tmp_path / "p.mod").write_text("MODULE M\nENDMODULE\n")
+    cases = {
+        '[cycle]\nprogram = "missing.mod"\n': "does not exist",
+        '[cycle]\nprogram = "p.mod"\npareto_points = 2\n': "pareto_points",
+        '[cycle]\nprogram = "p.mod"\ncycle_time = -1.0\n': "cycle_time",
+        '[cycle]\nprogram = "p.mod"\ncorridor_mm = nan\n': "corridor_mm",
+        '[cycle]\ncell = "p.mod"\n': "program is not",
+        '[cycle]\nprogram = "p.mod"\nspeed = 3\n': "unknown key",
+    }
+    for extra, words in cases.items():
+        toml.write_text(base + "\n" + extra)
+        with pytest.raises(InvalidInput, match=words):
+            load_experiment(toml)
+    toml.write_text(base + '\n[cycle]\nprogram = "p.mod"\ncycle_time = 5\n')
+    assert load_experiment(toml).cycle.cycle_time == 5.0

@@ -40,8 +40,15 @@ Example (``joulepath/experiment/presets/demo.toml``, abridged)::
     enabled = true
     loop_tasks = 3        # tasks optimized on the twin: predicted against realized saving
 
-Sections left out take their defaults; ``[synth]``, ``[bench]`` and ``[identify]`` are
-skipped unless they are given (``methods`` non-empty, ``tasks`` ≥ 1, ``enabled = true``).
+    [cycle]               # optional: a robot program's whole cycle (joulepath cycle)
+    program = "pick_and_place.mod"   # RAPID module or plain cycle TOML, relative to this file
+    cell = ""             # cell file (obstacles) the moves must clear; "" for the TCP corridor
+    cycle_time = 0.0      # s; 0: the default program's cycle time
+    pareto_points = 0     # ≥ 3: also energy against cycle time
+
+Sections left out take their defaults; ``[synth]``, ``[bench]``, ``[identify]`` and ``[cycle]``
+are skipped unless they are given (``methods`` non-empty, ``tasks`` ≥ 1, ``enabled = true``,
+``program`` non-empty).
 A wrong key or value stops the run at once with the file, the section and key, and the
 allowed keys or values. Every
 count, ``jobs`` and ``seed`` has a range (:data:`BOUNDS`), checked before anything runs.
@@ -159,6 +166,25 @@ class IdentifyStage:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class CycleStage:
+    """A robot program's whole cycle optimized at the same or a given cycle time (off while program is "").
+
+    The stage runs what ``joulepath cycle`` runs: ``program`` (a RAPID module, or a plain
+    cycle TOML for arms without RAPID) and ``cell`` (a cell TOML; "" keeps the TCP within
+    ``corridor_mm`` of the taught path instead, 0: no corridor) are paths relative to the
+    experiment file; ``cycle_time`` 0 keeps the default program's; ``use_waits`` spends
+    WaitTime slack on the moves; ``pareto_points`` ≥ 3 also computes energy against cycle time.
+    """
+
+    program: str = ""
+    cell: str = ""
+    cycle_time: float = 0.0
+    use_waits: bool = False
+    pareto_points: int = 0
+    corridor_mm: float = 100.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Experiment:
     """A whole study: data -> synthetic data -> models -> importance -> optimized moves -> benchmark."""
 
@@ -174,6 +200,7 @@ class Experiment:
     optimize: OptimizeStage = field(default_factory=OptimizeStage)
     bench: BenchStage = field(default_factory=BenchStage)
     identify: IdentifyStage = field(default_factory=IdentifyStage)
+    cycle: CycleStage = field(default_factory=CycleStage)
     source: str = ""
 
 
@@ -185,6 +212,7 @@ SECTIONS: dict[str, type] = {
     "optimize": OptimizeStage,
     "bench": BenchStage,
     "identify": IdentifyStage,
+    "cycle": CycleStage,
 }
 
 _ALLOWED: dict[str, tuple[str, ...]] = {
@@ -214,6 +242,7 @@ BOUNDS: dict[str, dict[str, tuple[int, int]]] = {
     "optimize": {"tasks": (0, 1_000), "generations": (1, 10_000), "population": (4, 10_000)},
     "bench": {"tasks": (0, 10_000), "generations": (1, 10_000), "population": (4, 10_000)},
     "identify": {"loop_tasks": (0, 1_000)},
+    "cycle": {"pareto_points": (0, 30)},
 }
 """Allowed range (inclusive) of every integer setting, by section (``""``: top level).
 
@@ -276,6 +305,10 @@ def _section(cls: Any, raw: dict[str, Any], where: str, source: str) -> Any:
                     "give plain names or paths"
                 )
             value = tuple(value)
+        elif isinstance(default, float) and type(value) is int:
+            value = float(value)
+            kwargs[key] = value
+            continue
         elif type(value) is not type(default):
             raise InvalidInput(
                 f"{source}: {where}{key} must be {_TYPE_NAMES.get(type(default), type(default).__name__)}, "
@@ -318,6 +351,22 @@ def _check_together(exp: Experiment, source: str) -> None:
         raise InvalidInput(f"{source}: [synth] source = 'micro' simulates its sample; with logs use 'train'")
     if s.methods and s.rows < 20:
         raise InvalidInput(f"{source}: [synth] rows must be ≥ 20 to score the rows, got {s.rows}")
+    c = exp.cycle
+    if not (0.0 <= c.cycle_time < 3600.0):
+        raise InvalidInput(
+            f"{source}: [cycle] cycle_time must be 0 (the program's own) or seconds below 3600, "
+            f"got {c.cycle_time}"
+        )
+    if not (0.0 <= c.corridor_mm <= 10_000.0):
+        raise InvalidInput(f"{source}: [cycle] corridor_mm must be 0..10000 mm, got {c.corridor_mm}")
+    if c.pareto_points in (1, 2):
+        raise InvalidInput(f"{source}: [cycle] pareto_points must be 0 (off) or ≥ 3, got {c.pareto_points}")
+    if c.cell and not c.program:
+        raise InvalidInput(f'{source}: [cycle] cell is given but program is not; add program = "….mod"')
+    if c.program and Path(c.program).suffix.lower() not in (".mod", ".toml"):
+        raise InvalidInput(
+            f"{source}: [cycle] program {c.program!r} must be a RAPID module (.mod) or a cycle file (.toml)"
+        )
     try:
         resolve_algorithm(o.algorithm, o.fitness)
     except InvalidInput as err:
@@ -410,6 +459,14 @@ def load_experiment(path: str | os.PathLike[str]) -> Experiment:
     )
     base = p.resolve().parent
     data = exp.data
+    for key, given in (("program", (exp.cycle.program,)), ("cell", (exp.cycle.cell,))):
+        for item in filter(None, given):
+            item_path = Path(item) if Path(item).is_absolute() else base / item
+            if not item_path.is_file():
+                raise InvalidInput(
+                    f"{source}: [cycle] {key} names {item!r}, which does not exist "
+                    f"(paths are relative to the experiment file's folder)"
+                )
     for key in ("train_logs", "test_logs"):
         for log in getattr(data, key):
             log_path = Path(log) if Path(log).is_absolute() else base / log

@@ -2,7 +2,8 @@
 
 Stages, each in its own folder of the run: ``data`` (simulate on a plant or ingest
 logs), ``synth`` (optional), ``models`` (train), ``importance``, ``optimize``,
-``bench`` (optional), ``identify`` (optional); then ``report.html`` is rendered from what they wrote.
+``bench`` (optional), ``identify`` (optional), ``cycle`` (optional); then
+``report.html`` is rendered from what they wrote.
 
 Each stage writes its outputs, then a ``stage.json`` holding a hash of its settings,
 of the stages it reads (so a stage whose inputs changed runs again, and so do the
@@ -231,6 +232,10 @@ def run_experiment(
         stages["identify"] = _identify_stage(ctx, keys["data"], synth_key, model_key)
     else:
         _drop_stage(ctx, "identify", "identify")
+    if exp.cycle.program:
+        stages["cycle"] = _cycle_stage(ctx)
+    else:
+        _drop_stage(ctx, "cycle", "cycle")
     tasks = pd.read_csv(root / "optimize" / "tasks.csv")
     ok = tasks[tasks["limits_ok"].astype(bool)] if len(tasks) else tasks
     summary: dict[str, Any] = {
@@ -962,3 +967,71 @@ def _plot_bench(table: pd.DataFrame, path: Path) -> None:
     ax.legend(fontsize="small")
     fig.tight_layout()
     _save(fig, path)
+
+
+# ----------------------------------------------------------------------------- cycle
+def _cycle_stage(ctx: _Context) -> dict[str, Any]:
+    """A robot program's whole cycle, as ``joulepath cycle`` runs it, into the ``cycle`` folder.
+
+    Its key holds the program's and the cell file's content, so editing either runs it again.
+    """
+    from joulepath._runfolder import CYCLE_JSON, CYCLE_STAGE
+    from joulepath.dynamics import load_robot
+    from joulepath.program import (
+        CycleSettings,
+        optimize_cycle,
+        read_cycle_toml,
+        read_module,
+        resolve_module,
+        write_cycle_run,
+    )
+    from joulepath.program import pareto as run_pareto
+    from joulepath.program._cell import read_cell
+
+    exp, st = ctx.exp, ctx.exp.cycle
+    program = Path(resolve_logs(exp, (st.program,))[0])
+    cell = Path(resolve_logs(exp, (st.cell,))[0]) if st.cell else None
+    key = _hash(
+        "cycle",
+        _robot_key(exp.robot),
+        asdict(st),
+        exp.seed,
+        _file_hash(str(program)),
+        _file_hash(str(cell)) if cell is not None else "",
+    )
+
+    def body(folder: Path) -> dict[str, Any]:
+        robot = load_robot(exp.robot)
+        rapid = program.suffix.lower() != ".toml"
+        spec = resolve_module(read_module(program), robot) if rapid else read_cycle_toml(program, robot)
+        settings = CycleSettings(
+            cell=read_cell(cell) if cell is not None else None,
+            cycle_time=st.cycle_time or None,
+            use_waits=st.use_waits,
+            corridor_mm=st.corridor_mm or None,
+            seed=exp.seed,
+        )
+        ctx.progress("cycle", 0, 1)
+        result, opt = optimize_cycle(spec, settings)
+        front = run_pareto(opt, points=st.pareto_points, use_waits=st.use_waits) if st.pareto_points else None
+        files = write_cycle_run(folder, result, via_every=settings.via_every, pareto=front, write_rapid=rapid)
+        ctx.progress("cycle", 1, 1)
+        check = json.loads((folder / CYCLE_JSON).read_text(encoding="utf-8")).get("written_program_check")
+        written = "optimized.mod" in files or not rapid
+        ctx.tell(
+            f"{CYCLE_STAGE}: cycle {result.default_cycle_s:.3f} s -> {result.optimized_cycle_s:.3f} s, "
+            f"{result.saved_pct:.1f} % saved on physics ({result.saved_lab_pct:.1f} % on the lab plant)"
+            + ("" if result.limits_ok else "; REFUSED: a result breaks a limit, no program written")
+        )
+        return {
+            "program": st.program,
+            "default_cycle_s": result.default_cycle_s,
+            "optimized_cycle_s": result.optimized_cycle_s,
+            "saved_pct": result.saved_pct if result.limits_ok else 0.0,
+            "saved_lab_pct": result.saved_lab_pct if result.limits_ok else 0.0,
+            "limits_ok": bool(result.limits_ok),
+            "program_written": bool(written and result.limits_ok),
+            "written_program_matches_plan": None if check is None else bool(check["within_tolerances"]),
+        }
+
+    return _stage(ctx, "cycle", CYCLE_STAGE, key, body)

@@ -29,6 +29,7 @@ SECTIONS = (
     ("optimize", "Optimized moves"),
     ("bench", "Optimizer benchmark"),
     ("identify", "Calibrated twin"),
+    ("cycle", "Whole cycle"),
     ("differences", "What differs from the thesis"),
     ("settings", "Settings and provenance"),
 )
@@ -726,6 +727,80 @@ def _identify(run: _Run) -> str:
     return out
 
 
+def _cycle(run: _Run) -> str:
+    from joulepath._runfolder import CYCLE_JSON, CYCLE_PARETO_PNG, CYCLE_STAGE
+
+    data = run.json(f"{CYCLE_STAGE}/{CYCLE_JSON}") if run.ran(CYCLE_STAGE) else None
+    if not data:
+        return (
+            '<p class="note">No robot program was optimized in this experiment. Set [cycle] program = '
+            '"….mod" (a RAPID module, or a plain cycle TOML) to run what <code>joulepath cycle</code> '
+            "runs.</p>"
+        )
+    b = data.get("breakdown") or {}
+    ok = bool(data.get("limits_ok"))
+    out = (
+        f'<p class="headline">Cycle {_fmt(data.get("default_cycle_s"), 4)} s → '
+        f"{_fmt(data.get('optimized_cycle_s'), 4)} s; energy on physics "
+        f"{_fmt(data.get('energy_default_J'), 4)} → {_fmt(data.get('energy_optimized_J'), 4)} J "
+        f"(<b>{_fmt(data.get('saved_pct'), 3)} %</b> saved), on the emulated lab robot "
+        f"{_fmt(data.get('saved_lab_pct'), 3)} % saved.</p>"
+        if ok
+        else '<p class="headline">REFUSED: the optimized cycle breaks a limit or the cell\'s margin; no '
+        "program was written and no saving is claimed.</p>"
+    )
+    waits = b.get("saved_by_waits_pct")
+    out += (
+        f"<p>Breakdown of the saving: shape {_fmt(b.get('saved_by_shape_pct'), 3)} %, time allocation "
+        f"{_fmt(b.get('saved_by_time_allocation_pct'), 3)} %"
+        + ("" if waits is None else f", waits spent {_fmt(waits, 3)} %")
+        + ". The default is the program as the emulated controller runs it; MoveL moves are kept as "
+        "written (path and timing).</p>"
+    )
+    moves = pd.DataFrame(data.get("moves") or [])
+    if len(moves):
+        cols = [
+            c
+            for c in (
+                "line",
+                "label",
+                "optimized",
+                "default_duration_s",
+                "optimized_duration_s",
+                "default_energy_J",
+                "optimized_energy_J",
+                "default_lab_J",
+                "optimized_lab_J",
+                "limits_ok",
+                "note",
+            )
+            if c in moves
+        ]
+        out += _table(moves[cols])
+    check = data.get("written_program_check")
+    if check:
+        verdict = "within" if check.get("within_tolerances") else "<b>outside</b>"
+        tol = check.get("tolerances") or {}
+        out += (
+            "<p>The written module (<code>optimized.mod</code>) run by the controller emulation: cycle "
+            f"{_fmt(check.get('emulated_cycle_s'), 4)} s against the planned "
+            f"{_fmt(check.get('planned_cycle_s'), 4)} s ({_fmt(check.get('cycle_diff_pct'), 3)} %), energy "
+            f"{_fmt(check.get('emulated_energy_J'), 4)} J against {_fmt(check.get('planned_energy_J'), 4)} J "
+            f"({_fmt(check.get('energy_diff_pct'), 3)} %), "
+            f"TCP path within {_fmt(check.get('tcp_path_deviation_mm'), 3)} mm: {verdict} the tolerances "
+            f"({_e(tol.get('cycle_pct'))} % cycle, {_e(tol.get('energy_pct'))} % energy, "
+            f"{_e(tol.get('path_mm'))} mm). The savings above are those of the planned motion.</p>"
+        )
+    if data.get("pareto"):
+        out += _image(run.path(f"{CYCLE_STAGE}/{CYCLE_PARETO_PNG}"), "Energy against cycle time")
+    if data.get("kept_verbatim_lines"):
+        out += (
+            f'<p class="note">Kept verbatim, run time treated as fixed: line(s) '
+            f"{_e(', '.join(map(str, data['kept_verbatim_lines'])))}.</p>"
+        )
+    return out
+
+
 def _differences(run: _Run) -> str:
     rows = "".join(
         f"<tr><td>{_e(a)}</td><td style='text-align:left'>{_e(b)}</td></tr>" for a, b in DIFFERENCES
@@ -759,6 +834,7 @@ _RENDERERS: dict[str, Callable[[_Run], str]] = {
     "optimize": _optimize,
     "bench": _bench,
     "identify": _identify,
+    "cycle": _cycle,
     "differences": _differences,
     "settings": _settings,
 }
