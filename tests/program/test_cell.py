@@ -343,3 +343,17 @@ def test_rpy_matrix_is_urdfs_convention():
 
     for rpy in ([0.1, -0.4, 2.0], [1.2, 0.3, -0.7], [0.0, 1.5, 0.0]):
         np.testing.assert_allclose(rpy_matrix(rpy), pin.rpy.rpyToMatrix(*rpy), atol=1e-12)
+
+
+def test_read_cell_refuses_a_mesh_over_the_limits(tmp_path, monkeypatch):
+    from joulepath.program import _cell
+
+    _cube_obj(tmp_path / "cube.obj")
+    f = _bad(tmp_path, "a.toml", '[[mesh]]\nname = "m"\nfile = "cube.obj"\ncenter_mm = [0, 0, 0]\n')
+    assert read_cell(f).obstacles[0].mesh.num_tris == 12
+    monkeypatch.setattr(_cell, "MAX_MESH_TRIANGLES", 11)
+    with pytest.raises(InvalidInput, match="12 triangles, over 11; simplify it"):
+        read_cell(f)
+    monkeypatch.setattr(_cell, "MAX_MESH_BYTES", 100)
+    with pytest.raises(InvalidInput, match=r"cube\.obj has .* MiB, over"):
+        read_cell(f)

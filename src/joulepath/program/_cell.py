@@ -185,7 +185,7 @@ def load_mesh(path: Path, scale: tuple[float, float, float], where: str) -> Any:
         raise InvalidInput(f"{where}: mesh {path} is empty")
     if n_bytes > MAX_MESH_BYTES:
         raise InvalidInput(
-            f"{where}: mesh {path} has {n_bytes / 2**20:.0f} MiB, over {MAX_MESH_BYTES >> 20} MiB; "
+            f"{where}: mesh {path} has {n_bytes / 2**20:.1f} MiB, over {MAX_MESH_BYTES / 2**20:g} MiB; "
             "simplify it (a cell needs a coarse hull)"
         )
     coal = _coal()
