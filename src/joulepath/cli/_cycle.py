@@ -48,7 +48,10 @@ def cycle(
         help="mm: keep tool0 this close to the taught move's path (joint-interpolated); 0: no corridor.",
     ),
     cell: Path = typer.Option(
-        None, "--cell", help="Cell file (TOML: boxes, cylinders, margin): every move must clear it."
+        None,
+        "--cell",
+        help="Cell file (TOML: boxes, cylinders, spheres, STL/OBJ meshes, margin; or a URDF of the cell): "
+        "every move must clear it.",
     ),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     unchecked: bool = unchecked_option(),

@@ -973,7 +973,8 @@ def _plot_bench(table: pd.DataFrame, path: Path) -> None:
 def _cycle_stage(ctx: _Context) -> dict[str, Any]:
     """A robot program's whole cycle, as ``joulepath cycle`` runs it, into the ``cycle`` folder.
 
-    Its key holds the program's and the cell file's content, so editing either runs it again.
+    Its key holds the program's and the cell file's content (and its meshes'), so editing any
+    runs it again.
     """
     from joulepath._runfolder import CYCLE_JSON, CYCLE_STAGE
     from joulepath.dynamics import load_robot
@@ -991,6 +992,7 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
     exp, st = ctx.exp, ctx.exp.cycle
     program = Path(resolve_logs(exp, (st.program,))[0])
     cell = Path(resolve_logs(exp, (st.cell,))[0]) if st.cell else None
+    cell_data = read_cell(cell) if cell is not None else None
     key = _hash(
         "cycle",
         _robot_key(exp.robot),
@@ -998,6 +1000,7 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
         exp.seed,
         _file_hash(str(program)),
         _file_hash(str(cell)) if cell is not None else "",
+        *(_file_hash(f) for f in (cell_data.files if cell_data is not None else ())),
     )
 
     def body(folder: Path) -> dict[str, Any]:
@@ -1005,7 +1008,7 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
         rapid = program.suffix.lower() != ".toml"
         spec = resolve_module(read_module(program), robot) if rapid else read_cycle_toml(program, robot)
         settings = CycleSettings(
-            cell=read_cell(cell) if cell is not None else None,
+            cell=cell_data,
             cycle_time=st.cycle_time or None,
             use_waits=st.use_waits,
             corridor_mm=st.corridor_mm or None,
