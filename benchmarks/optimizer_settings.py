@@ -10,7 +10,7 @@ the optimum's saving on the 10x finer grid, limits on that grid, and the median 
 CPU time per move on one thread. The first variant is the baseline of the ratios.
 
 Usage:
-    python benchmarks/optimizer_settings.py                       # the shipped default vs. refine_stages=2
+    python benchmarks/optimizer_settings.py     # the shipped default vs. coarse_stages=3 (all stages wide first)
     python benchmarks/optimizer_settings.py --variant "n_starts=2" --variant "coarse_factor=4"
 """
 
@@ -71,7 +71,7 @@ def main() -> None:
     parser.add_argument("--variant", action="append", default=[], help="GradientSettings overrides, k=v,...")
     parser.add_argument("--no-report", action="store_true")
     args = parser.parse_args()
-    variants = ["", "refine_stages=2"] if not args.variant else args.variant
+    variants = ["", "coarse_stages=3"] if not args.variant else args.variant
     robot = joulepath.load_robot("irb120")
     optima = stored_optima(ROOT / "benchmarks" / "results")
     numbered = [k for k in optima if k.isdigit()]

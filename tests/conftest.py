@@ -90,9 +90,9 @@ def tiny_demo_toml():
 @pytest.fixture(scope="session")
 def tiny_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The tiny demo run through the CLI (``joulepath run FILE --out DIR --quiet``); its folder."""
-    from joulepath.cli import main
-
     import shutil
+
+    from joulepath.cli import main
 
     base = tmp_path_factory.mktemp("tiny-demo")
     toml = _tiny_demo_toml(base, **{"train.targets": '["E", "E1"]'})
