@@ -29,7 +29,7 @@ from joulepath.evolve import DE, GA, MA, Termination, minimize
 from joulepath.optimize._gradient import GradientSettings, solve_move
 from joulepath.optimize._problem import FITNESS, PENALTY, TrajectoryProblem, limit_violation
 from joulepath.optimize._verify import FINE_FACTOR
-from joulepath.trajectory import SplineBasis, Trajectory, rest_to_rest, thesis_quintic
+from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk, rest_to_rest, thesis_quintic
 
 if TYPE_CHECKING:
     from joulepath.optimize._run import OptimizeConfig
@@ -136,11 +136,22 @@ def _cmaes(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -
     sigma0 = max(0.02, 0.05 * travel)
     history: list[float] = []
 
+    # ranges, speeds and accelerations are linear in the coefficients: penalize them on the
+    # grid the result is checked on (FINE_FACTOR x finer than the samples), not only on the
+    # samples, so that a path cannot pass between samples over a limit
+    fine = basis.grid(task.dt / FINE_FACTOR)
+    base = minimum_jerk(task.q_start, task.q_end, task.duration, dt=task.dt / FINE_FACTOR)
+
     def evaluate(X: FloatArray) -> FloatArray:
-        traj = basis.trajectory(X.reshape(-1, m, n), task.q_start, task.q_end)
+        C = X.reshape(-1, m, n)
+        traj = basis.trajectory(C, task.q_start, task.q_end)
         energy, tau = fit.energy(traj)
         viol = limit_violation(task.robot, traj, tau, acceleration_limit=task.acceleration_limit)
-        out: FloatArray = energy + PENALTY * viol.total
+        kin = Trajectory(
+            t=fine.t, q=base.q + fine.B @ C, qd=base.qd + fine.Bd @ C, qdd=base.qdd + fine.Bdd @ C
+        )
+        between = limit_violation(task.robot, kin, None, acceleration_limit=task.acceleration_limit)
+        out: FloatArray = energy + PENALTY * (viol.total + between.total)
         return out
 
     f0 = float(evaluate(np.zeros((1, m * n)))[0])
