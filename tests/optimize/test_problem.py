@@ -58,3 +58,25 @@ def test_problem_validation(irb120):
         TrajectoryProblem(robot=irb120, q_start=Q0, q_end=QF, duration=1.0, fitness="surrogate")
     with pytest.raises(InvalidInput, match="parametrization must be one of"):
         TrajectoryProblem(robot=irb120, q_start=Q0, q_end=QF, duration=1.0, parametrization="spline")
+
+
+def test_cmaes_fine_grid_penalty_agrees_with_limit_violation(irb120):
+    """CMA-ES's fast fine-grid check equals limit_violation on the same 10x grid, violations included."""
+    from joulepath.optimize._problem import limit_violation
+    from joulepath.optimize._run import ACCEL_TIME, acceleration_limit
+    from joulepath.optimize._search import SearchTask, _FineKinematics
+    from joulepath.optimize._verify import FINE_FACTOR
+    from joulepath.trajectory import SplineBasis
+    from joulepath.units import SAMPLE_PERIOD
+
+    q0, qf, T = np.array([0.3, 0.2, -0.4, 0.5, -0.6, 1.0]), np.array([-0.9, 0.6, 0.3, -1.2, 0.8, -1.5]), 1.6
+    amax = acceleration_limit(irb120, ACCEL_TIME)
+    task = SearchTask(irb120, q0, qf, T, amax, (), (), SAMPLE_PERIOD)
+    basis = SplineBasis(T, knot_spacing=0.2)
+    scales = np.array([0.01, 0.3, 2.0])[:, None, None]  # three shapes, from gentle to wild
+    C = scales * np.random.default_rng(4).standard_normal((3, basis.n_free, 6))
+    fast = _FineKinematics(task, basis)(C)
+    fine = basis.trajectory(C, q0, qf, dt=SAMPLE_PERIOD / FINE_FACTOR)
+    slow = limit_violation(irb120, fine, None, acceleration_limit=amax).total
+    assert fast[0] < fast[-1] and fast[-1] > 0.1  # small shapes pass, large ones break limits
+    np.testing.assert_allclose(fast, slow, rtol=1e-12, atol=1e-12)
