@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import os
 import statistics
 import sys
 import time
@@ -80,6 +81,7 @@ def main() -> None:
     tasks += [(k, *draw[int(k)]) for k in sorted(numbered, key=int)]
     amax = acceleration_limit(robot, ACCEL_TIME)
     results = []
+    load_start = os.getloadavg()[0]
     for text in variants:
         settings = replace(GradientSettings(), **parse_variant(text))  # type: ignore[arg-type]
         shares, walls, cpus, ok = [], [], [], 0
@@ -115,7 +117,10 @@ def main() -> None:
     lines = [
         f"Machine: {machine()}; one BLAS thread; run {time.strftime('%Y-%m-%d')}. "
         f"{len(tasks)} tasks with a stored reference optimum (the issue's fixed task and random tasks of "
-        f"`optimizer_peers.py`, seed {SEED}, nominal friction); each variant run once per task, in one process.",
+        f"`optimizer_peers.py`, seed {SEED}, nominal friction); each variant run once per task, in one process. "
+        f"1-minute load average {load_start:.1f} at the start and {os.getloadavg()[0]:.1f} at the end on "
+        f"{os.cpu_count()} cores (other work shares the machine when it is above 1; the CPU column is the "
+        "process's own time).",
         "",
         "| settings | mean share of the optimum | min share | within limits (10x grid) "
         "| median wall s/move | median CPU s/move | wall vs first |",

@@ -506,8 +506,8 @@ def solve_move(
         return optimize_spline(fine, settings, rng=rng), fine
     coarse = make(coarse_spacing)
     # the continuation runs coarse to fine: the wide knots take the stages before the last
-    # `refine_stages`, the fine knots those (measured: same shares, 10 % less CPU than
-    # running every stage on the wide knots first; BENCHMARKS.md, optimizer_settings)
+    # `refine_stages`, the fine knots those (measured against every stage on the wide knots
+    # first, coarse_stages=3: the same shares, CPU time within noise; BENCHMARKS.md)
     head = (
         settings.continuation[: settings.coarse_stages]
         if settings.coarse_stages
