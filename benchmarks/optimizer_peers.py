@@ -882,10 +882,10 @@ def report(out: Path, unmeasured: str = "") -> str:
         tl = [r["load1"] for r in timing]
         lines += [
             "",
-            f"**Speed of the default on a quieter machine** (a second pass of the default alone over {len(timing)} "
-            "of the moves above, in its own single-threaded process, with at most one other single-threaded "
-            f"benchmark on the second core; 1-minute load {min(tl):.1f} to {max(tl):.1f} on 2 cores): "
-            "median wall per move {statistics.median(wall):.2f} s "
+            f"**Speed of the default on a quiet machine** (a second pass of the default alone over {len(timing)} "
+            "of the moves above, in its own single-threaded process, nothing else running; 1-minute load "
+            f"{min(tl):.1f} to {max(tl):.1f} on 2 logical CPUs): "
+            f"median wall per move {statistics.median(wall):.2f} s "
             f"(min {min(wall):.2f}, max {max(wall):.2f}), median CPU {statistics.median(cpu):.2f} s "
             f"(max {max(cpu):.2f}); goal: median <= 2 s on one core. Energies identical to the first pass "
             "(same seed): " + ("yes." if _same_energies(timing, rows) else "NO, see the CSVs."),
