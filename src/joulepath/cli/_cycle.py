@@ -66,9 +66,7 @@ def cycle(
         CYCLE_FILES,
         CycleSettings,
         optimize_cycle,
-        read_cycle_toml,
-        read_module,
-        resolve_module,
+        read_cycle_program,
         write_cycle_run,
     )
     from joulepath.program import pareto as run_pareto
@@ -78,8 +76,7 @@ def cycle(
     if not program.is_file():
         raise typer.BadParameter(f"{program}: no such file", param_hint="PROGRAM")
     r = load_robot_for_cli(robot, unchecked=unchecked)
-    rapid = program.suffix.lower() != ".toml"
-    spec = resolve_module(read_module(program), r) if rapid else read_cycle_toml(program, r)
+    spec, rapid = read_cycle_program(program, r)
     from joulepath.program._cell import read_cell
 
     cell_data = read_cell(cell) if cell is not None else None

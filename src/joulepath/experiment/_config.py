@@ -459,20 +459,18 @@ def load_experiment(path: str | os.PathLike[str]) -> Experiment:
     )
     base = p.resolve().parent
     data = exp.data
-    for key, given in (("program", (exp.cycle.program,)), ("cell", (exp.cycle.cell,))):
+    named = (
+        ("[cycle]", "program", (exp.cycle.program,)),
+        ("[cycle]", "cell", (exp.cycle.cell,)),
+        ("[data]", "train_logs", data.train_logs),
+        ("[data]", "test_logs", data.test_logs),
+    )
+    for section, key, given in named:
         for item in filter(None, given):
             item_path = Path(item) if Path(item).is_absolute() else base / item
             if not item_path.is_file():
                 raise InvalidInput(
-                    f"{source}: [cycle] {key} names {item!r}, which does not exist "
-                    f"(paths are relative to the experiment file's folder)"
-                )
-    for key in ("train_logs", "test_logs"):
-        for log in getattr(data, key):
-            log_path = Path(log) if Path(log).is_absolute() else base / log
-            if not log_path.is_file():
-                raise InvalidInput(
-                    f"{source}: [data] {key} names {log!r}, which does not exist "
+                    f"{source}: {section} {key} names {item!r}, which does not exist "
                     f"(paths are relative to the experiment file's folder)"
                 )
     _check_together(exp, source)

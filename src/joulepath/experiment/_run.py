@@ -981,9 +981,7 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
     from joulepath.program import (
         CycleSettings,
         optimize_cycle,
-        read_cycle_toml,
-        read_module,
-        resolve_module,
+        read_cycle_program,
         write_cycle_run,
     )
     from joulepath.program import pareto as run_pareto
@@ -1005,8 +1003,7 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
 
     def body(folder: Path) -> dict[str, Any]:
         robot = load_robot(exp.robot)
-        rapid = program.suffix.lower() != ".toml"
-        spec = resolve_module(read_module(program), robot) if rapid else read_cycle_toml(program, robot)
+        spec, rapid = read_cycle_program(program, robot)
         settings = CycleSettings(
             cell=cell_data,
             cycle_time=st.cycle_time or None,

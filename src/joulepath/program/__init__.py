@@ -14,7 +14,7 @@ from joulepath.program._cycle import (
 from joulepath.program._model import Module, RapidError
 from joulepath.program._output import CYCLE_FILES, optimized_module, write_cycle_run
 from joulepath.program._parse import parse_module, read_module
-from joulepath.program._resolve import CycleSpec, read_cycle_toml, resolve_module
+from joulepath.program._resolve import CycleSpec, read_cycle_program, read_cycle_toml, resolve_module
 from joulepath.program._timing import plan_cycle
 from joulepath.program._write import format_move, write_module
 
@@ -35,6 +35,7 @@ __all__ = [
     "pareto",
     "parse_module",
     "plan_cycle",
+    "read_cycle_program",
     "read_cycle_toml",
     "read_module",
     "resolve_module",

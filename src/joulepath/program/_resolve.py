@@ -36,7 +36,7 @@ from joulepath.program._model import (
     WhileTrue,
     ZoneData,
 )
-from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES, TOOL0
+from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES, TOOL0, read_module
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -334,3 +334,10 @@ def _joints(value: object, n: int, where: str) -> FloatArray:
 
 
 __all__ = ["CycleSpec", "RapidError", "Step", "read_cycle_toml", "resolve_module"]
+
+
+def read_cycle_program(path: str | Path, robot: Robot) -> tuple[CycleSpec, bool]:
+    """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID module."""
+    p = Path(path)
+    rapid = p.suffix.lower() != ".toml"
+    return (resolve_module(read_module(p), robot) if rapid else read_cycle_toml(p, robot)), rapid
