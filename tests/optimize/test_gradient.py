@@ -186,3 +186,50 @@ def test_random_tasks_are_feasible(irb120):
     for q0, qf, T in tasks:
         fine = minimum_jerk(q0, qf, T, dt=0.0025)
         assert check_limits(irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok
+
+
+QW = np.array([-0.2, 0.1, 0.1, -0.3, 0.2, -0.2])
+
+
+def test_waypoint_rows_agree_with_the_path_and_the_start_meets_them(irb120, rng):
+    """The equality rows are the path's distance from the waypoint at its time (evaluated
+    independently from the path samples); the start path meets them and rests at both ends."""
+    basis = SplineBasis(1.2, knot_spacing=0.1)
+    problem = SplineProblem(irb120, Q0, QF, 1.2, NOMINAL_FRICTION, basis, waypoints=((0.5, QW),))
+    k = int(round(0.5 / basis.dt))
+    for x in (problem.origin, problem.origin + rng.standard_normal(problem.n_var) * 0.05):
+        residual = problem.way_A @ x - problem.way_b
+        np.testing.assert_allclose(residual, problem.path(x).q[k] - QW, atol=1e-12)
+    start = problem.path(problem.origin)
+    np.testing.assert_allclose(start.q[k], QW, atol=1e-12)
+    np.testing.assert_allclose(start.q[[0, -1]], [Q0, QF], atol=1e-12)
+    np.testing.assert_allclose(start.qd[[0, -1]], 0.0, atol=1e-10)
+    assert problem.waypoint_error(problem.origin) < 1e-12
+    assert problem.violation(problem.origin + 0.01) > 0.0  # missing the waypoint counts as a violation
+
+
+def test_a_move_through_a_waypoint_passes_it_at_speed_within_every_limit(irb120):
+    from joulepath.optimize._gradient import GradientSettings, solve_move
+
+    amax = acceleration_limit(irb120, 0.25)
+    res, problem = solve_move(
+        irb120,
+        Q0,
+        QF,
+        1.2,
+        friction=NOMINAL_FRICTION,
+        settings=GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), coarse_factor=1),
+        rng=np.random.default_rng(0),
+        acceleration_limit=amax,
+        waypoints=((0.5, QW),),
+    )
+    assert res.feasible
+    k = int(round(0.5 / problem.dt))
+    np.testing.assert_allclose(res.path.q[k], QW, atol=2e-6)
+    assert np.abs(res.path.qd[k]).max() > 0.1  # it does not stop there
+    fine = problem.path(res.coefficients.ravel(), fine=True)
+    assert check_limits(irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok
+    assert res.energy_J <= problem.true_energy(problem.origin) + 1e-9
+    with pytest.raises(Exception, match="waypoint times"):
+        SplineProblem(irb120, Q0, QF, 1.2, NOMINAL_FRICTION, SplineBasis(1.2, knot_spacing=0.1),
+                      waypoints=((1.2, QW),))

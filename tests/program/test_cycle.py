@@ -103,8 +103,9 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
     # the reported total is the sum over the moves, on both plants
     assert result.optimized_energy_J == pytest.approx(sum(m.optimized_energy_J for m in result.moves))
     assert result.default_energy_J == pytest.approx(sum(m.default_energy_J for m in result.moves))
-    # an optimized move's energy recomputed independently from its path
-    i, s = next(iter(result.paths.items()))
+    # an optimized move's energy recomputed independently from its path (a move on its own)
+    in_chain = {j for c in result.chains.values() for j in c}
+    i, s = next((j, p) for j, p in result.paths.items() if j not in in_chain)
     r = spec.steps[i].robot
     tau = r.inverse_dynamics(s.fine.q, s.fine.qd, s.fine.qdd, friction=NOMINAL_FRICTION)
     assert s.energy_J == pytest.approx(float(path_energy(tau, s.fine.qd, s.fine.dt).total))
@@ -253,3 +254,36 @@ def test_written_program_check_is_reported(tmp_path, robot):
     assert check["within_tolerances"] == expected
     assert check["planned_cycle_s"] == r.optimized_cycle_s
     assert check["emulated_cycle_s"] > 0 and check["emulated_energy_J"] > 0
+
+
+def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):
+    """MoveAbsJ jA (z20) then MoveJ pUp: one chain that passes jA exactly, at speed; written with
+    the target as a timed fly-by point; with --stop-at-targets each move runs rest to rest."""
+    from joulepath.program import optimized_module
+
+    result, opt = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True))
+    assert result.limits_ok
+    labels = {tuple(spec.steps[j].label for j in c) for c in result.chains.values()}
+    assert ("MoveAbsJ jA", "MoveJ pUp") in labels
+    first, second = next(c for c in result.chains.values() if spec.steps[c[0]].label == "MoveAbsJ jA")
+    a, b = result.paths[first], result.paths[second]
+    np.testing.assert_allclose(a.fine.q[-1], spec.steps[first].q, atol=2e-6)  # the taught target
+    np.testing.assert_allclose(a.fine.q[-1], b.fine.q[0], atol=1e-12)
+    np.testing.assert_allclose(a.fine.qd[-1], b.fine.qd[0], atol=1e-12)
+    assert np.abs(a.fine.qd[-1]).max() > 0.05  # not a stop
+    # the pieces' energies add up to the chain's, recomputed on the joined path
+    joined = [np.vstack([a.fine.q, b.fine.q[1:]]), np.vstack([a.fine.qd, b.fine.qd[1:]])]
+    joined.append(np.vstack([a.fine.qdd, b.fine.qdd[1:]]))
+    tau = robot.inverse_dynamics(*joined, friction=NOMINAL_FRICTION)
+    whole = float(path_energy(tau, joined[1], a.fine.dt).total)
+    assert a.energy_J + b.energy_J == pytest.approx(whole, rel=1e-9)
+    np.testing.assert_allclose(a.fine.qd[0], 0.0, atol=1e-9)  # the chain starts and ends at rest
+    np.testing.assert_allclose(b.fine.qd[-1], 0.0, atol=1e-9)
+    text = optimized_module(result, via_every=2)
+    line = spec.steps[first].line
+    via = [ln for ln in text.splitlines() if f"jpL{line}_" in ln and "MoveAbsJ" in ln]
+    assert via and via[-1].rstrip().endswith("z200, tool0;")
+    resolve_module(parse_module(text, path="o.mod"), robot)  # reads back
+    rest, opt_rest = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, fly_by=False))
+    assert rest.chains == {}
+    assert opt.shortest_cycle <= opt_rest.shortest_cycle + 1e-9

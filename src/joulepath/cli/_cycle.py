@@ -33,6 +33,12 @@ def cycle(
     use_waits: bool = typer.Option(
         False, "--use-waits", help="Spend WaitTime slack on the moves (waits set to 0)."
     ),
+    stop_at_targets: bool = typer.Option(
+        False,
+        "--stop-at-targets",
+        help="Run every optimized move rest to rest; default: consecutive MoveJ/MoveAbsJ joined by a zone "
+        "form one fly-by chain that passes their targets exactly without stopping.",
+    ),
     pareto: bool = typer.Option(False, "--pareto", help="Also energy against cycle time (CSV + plot)."),
     points: int = typer.Option(10, "--points", min=3, max=30, help="Points of --pareto."),
     knot_spacing: float = typer.Option(
@@ -84,6 +90,7 @@ def cycle(
         cell=cell_data,
         cycle_time=target,
         use_waits=use_waits,
+        fly_by=not stop_at_targets,
         seed=seed,
         table_points=table_points,
         corridor_mm=corridor or None,

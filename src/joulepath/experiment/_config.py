@@ -45,6 +45,7 @@ Example (``joulepath/experiment/presets/demo.toml``, abridged)::
     cell = ""             # cell file (obstacles) the moves must clear; "" for the TCP corridor
     cycle_time = 0.0      # s; 0: the default program's cycle time
     pareto_points = 0     # ≥ 3: also energy against cycle time
+    fly_by = true         # false: every optimized move rest to rest (no chains through zones)
 
 Sections left out take their defaults; ``[synth]``, ``[bench]``, ``[identify]`` and ``[cycle]``
 are skipped unless they are given (``methods`` non-empty, ``tasks`` ≥ 1, ``enabled = true``,
@@ -173,7 +174,9 @@ class CycleStage:
     cycle TOML for arms without RAPID) and ``cell`` (a cell TOML; "" keeps the TCP within
     ``corridor_mm`` of the taught path instead, 0: no corridor) are paths relative to the
     experiment file; ``cycle_time`` 0 keeps the default program's; ``use_waits`` spends
-    WaitTime slack on the moves; ``pareto_points`` ≥ 3 also computes energy against cycle time.
+    WaitTime slack on the moves; ``pareto_points`` ≥ 3 also computes energy against cycle time;
+    ``fly_by`` false runs every optimized move rest to rest instead of chaining moves joined
+    by a zone through their targets.
     """
 
     program: str = ""
@@ -182,6 +185,7 @@ class CycleStage:
     use_waits: bool = False
     pareto_points: int = 0
     corridor_mm: float = 100.0
+    fly_by: bool = True
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -1008,6 +1008,7 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
             cell=cell_data,
             cycle_time=st.cycle_time or None,
             use_waits=st.use_waits,
+            fly_by=st.fly_by,
             corridor_mm=st.corridor_mm or None,
             seed=exp.seed,
         )

@@ -16,7 +16,10 @@ Constraints (not penalties), solved by SLSQP:
   times finer than the samples, so they also hold between samples;
 * effort limits (where the robot states them) on the same fine grid;
 * optionally a corridor: the TCP stays within ``max_deviation_m`` of the default
-  move's TCP at every sample.
+  move's TCP at every sample;
+* optionally waypoints (equalities, linear in ``x``): the path passes through given
+  joint positions at given interior times with whatever velocity the search finds
+  best — a chain of fly-by targets solved as one move.
 
 Fine-grid constraints are generated lazily (active-set style): each solve includes
 the grid points whose value is within ``SCREEN_BAND`` of its limit at the start
@@ -46,6 +49,8 @@ RANGE_MARGIN = 1e-6
 """rad kept from each range end inside the solve (solver tolerance)."""
 RATE_MARGIN = 1e-6
 """Share of the speed and effort limits kept free inside the solve (solver tolerance)."""
+WAYPOINT_TOLERANCE = 1e-6
+"""rad a path may miss a waypoint by (solver tolerance)."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -128,6 +133,7 @@ class SplineProblem:
     check_factor: int = 10
     max_deviation_m: float | None = None
     acceleration_limit: FloatArray | None = None
+    waypoints: tuple[tuple[float, FloatArray], ...] = ()
     n_evaluations: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -150,9 +156,50 @@ class SplineProblem:
         self.emax = np.asarray(self.robot.effort_limit, dtype=float)
         self.has_effort = bool(np.any(np.isfinite(self.emax)))
         self.dt = self.basis.dt
+        self.origin = np.zeros(self.n_var)
+        self._waypoint_rows()
         if self.max_deviation_m is not None:
-            self.tcp_default = self.robot.fk(self.default.q).position_m
+            self.tcp_default = self.robot.fk(self.path(self.origin).q).position_m
         self.hull = self._hull()
+
+    def _waypoint_rows(self) -> None:
+        """``A_w x = b_w``: the path through each waypoint; ``origin``: the smoothest such ``x``.
+
+        ``origin`` minimizes the squared acceleration of the shape on the samples among the
+        coefficient vectors that meet the waypoints (the minimum-jerk move when there are
+        none); the search starts there, and the corridor is measured from its path.
+        """
+        if not self.waypoints:
+            self.way_A, self.way_b = np.zeros((0, self.n_var)), np.zeros(0)
+            return
+        times = np.array([float(t) for t, _ in self.waypoints])
+        if np.any(times <= 0.0) or np.any(times >= self.duration) or np.any(np.diff(times) <= 0.0):
+            raise InvalidInput(
+                f"waypoint times must increase strictly inside (0, {self.duration:g}) s, got {times.tolist()}"
+            )
+        q_way = np.stack([np.asarray(q, dtype=float) for _, q in self.waypoints])
+        if q_way.shape[1] != self.n or not np.all(np.isfinite(q_way)):
+            raise InvalidInput(f"waypoints must be finite joint vectors of {self.n} joints")
+        Bw = self.basis.free_basis(times)  # (w, m)
+        s = times / self.duration  # the minimum-jerk move at the waypoint times
+        blend = 10 * s**3 - 15 * s**4 + 6 * s**5
+        base_at = self.q_start + blend[:, None] * (self.q_end - self.q_start)
+        d = q_way - base_at  # (w, n)
+        self.way_A = np.kron(Bw, np.eye(self.n))  # rows w * n + i
+        self.way_b = d.ravel()
+        # the smoothest shape through the waypoints: min |Bdd C|² + ridge s.t. Bw C = d
+        H = self.samples.Bdd.T @ self.samples.Bdd
+        H = H + 1e-9 * np.trace(H) / H.shape[0] * np.eye(self.m)
+        K = np.block([[H, Bw.T], [Bw, np.zeros((Bw.shape[0], Bw.shape[0]))]])
+        rhs = np.vstack([np.zeros((self.m, self.n)), d])
+        sol = np.linalg.solve(K, rhs)
+        self.origin = sol[: self.m].ravel()
+
+    def waypoint_error(self, x: FloatArray) -> float:
+        """Largest distance (rad) of the path from a waypoint at its time (0 without waypoints)."""
+        if not self.way_b.size:
+            return 0.0
+        return float(np.abs(self.way_A @ np.asarray(x, dtype=float) - self.way_b).max())
 
     @property
     def n_var(self) -> int:
@@ -253,6 +300,9 @@ class SplineProblem:
     def constraints(self, active: dict[str, np.ndarray]) -> list[dict[str, Any]]:
         """SLSQP constraint dicts for the active fine-grid points ``active[kind]`` (flat indices)."""
         cons: list[dict[str, Any]] = []
+        if self.way_b.size:
+            Aw, bw = self.way_A, self.way_b
+            cons.append({"type": "eq", "fun": lambda x: Aw @ x - bw, "jac": lambda x: Aw})
         rows = active.get("hull")
         if rows is not None and rows.size:
             A, b = self.hull[0][rows], self.hull[1][rows]
@@ -340,6 +390,7 @@ class SplineProblem:
             worst = max(worst, float(-self.effort_slack(x).min()))
         if self.max_deviation_m is not None:
             worst = max(worst, float(self.deviation(x).max() - self.max_deviation_m) - 1e-9)
+        worst = max(worst, self.waypoint_error(x) - WAYPOINT_TOLERANCE)
         return max(worst, 0.0)
 
 
@@ -431,7 +482,7 @@ def _optimize_spline(
     known: dict[str, np.ndarray] | None = None,
 ) -> GradientResult:
     t0 = time.perf_counter()
-    zero = np.zeros(problem.n_var)
+    zero = problem.origin.copy()  # the minimum-jerk move, or the smoothest path through the waypoints
     e_default = problem.true_energy(zero)
     p0 = problem.path(zero)
     tau0 = problem.robot.inverse_dynamics(p0.q, p0.qd, p0.qdd, friction=problem.friction)
@@ -441,7 +492,7 @@ def _optimize_spline(
     starts = [zero] if initial is None else [np.asarray(initial, dtype=float).ravel()]
     for _ in range(settings.n_starts - 1):
         bump = rng.standard_normal((problem.m, problem.n)) * settings.start_scale * travel
-        starts.append(bump.ravel())
+        starts.append(zero + bump.ravel())
     history: list[float] = [e_default]
     best_x, best_e, best_ok = zero, e_default, problem.violation(zero) == 0.0
     best_active: dict[str, np.ndarray] = {}
@@ -483,8 +534,13 @@ def solve_move(
     acceleration_limit: FloatArray | None = None,
     max_deviation_m: float | None = None,
     dt: float = SAMPLE_PERIOD,
+    waypoints: tuple[tuple[float, FloatArray], ...] = (),
 ) -> tuple[GradientResult, SplineProblem]:
-    """Coarse-to-fine gradient search of one move; the result and the problem it lives in."""
+    """Coarse-to-fine gradient search of one move; the result and the problem it lives in.
+
+    ``waypoints``: (time s, joint vector) pairs inside the move that the path passes
+    through exactly, at any speed (a chain of fly-by targets solved as one move).
+    """
 
     def make(spacing: float) -> SplineProblem:
         basis = SplineBasis(duration, knot_spacing=spacing, degree=settings.degree, dt=dt)
@@ -498,6 +554,7 @@ def solve_move(
             check_factor=settings.check_factor,
             max_deviation_m=max_deviation_m,
             acceleration_limit=acceleration_limit,
+            waypoints=waypoints,
         )
 
     fine = make(settings.knot_spacing)

@@ -36,7 +36,7 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Robot
-from joulepath.energy import path_energy
+from joulepath.energy import joint_energy, path_energy
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize import ACCEL_TIME, GradientSettings, acceleration_limit, check_limits
 from joulepath.optimize._gradient import SplineProblem, optimize_spline, solve_move
@@ -52,7 +52,7 @@ from joulepath.program._timing import (
     standalone,
 )
 from joulepath.sim import ControllerConfig, Plant, make_plant
-from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk
+from joulepath.trajectory import SplineBasis, Trajectory
 from joulepath.units import SAMPLE_PERIOD
 
 STEP = SAMPLE_PERIOD
@@ -72,7 +72,10 @@ class CycleSettings:
     again in corridors of 1/2, 1/4, 1/8 of ``corridor_mm``, else not used).
     ``warm_start``: start each solve of a move from its nearest solved duration
     (time-scaled) and run only the last continuation stages; measured not faster and
-    slightly worse (BENCHMARKS.md), so off by default.
+    slightly worse (BENCHMARKS.md), so off by default. ``fly_by``: consecutive
+    optimizable moves joined by a zone (a fly-by target) are solved as one chain that
+    passes each such target exactly, at whatever speed saves most, instead of stopping
+    there; False: every optimized move runs rest to rest.
     """
 
     cycle_time: float | None = None
@@ -83,6 +86,7 @@ class CycleSettings:
     corridor_mm: float | None = 100.0
     cell: Cell | None = None
     warm_start: bool = False
+    fly_by: bool = True
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     seed: int = 0
@@ -200,6 +204,7 @@ class CycleResult:
     n_solves: int
     paths: dict[int, Solved]  # by step index: the optimized moves
     spec: CycleSpec
+    chains: dict[int, tuple[int, ...]] = field(default_factory=dict)  # fly-by chains (step indices)
 
     @property
     def saved_pct(self) -> float:
@@ -257,29 +262,135 @@ class CycleOptimizer:
             and self.default_clearance.get(m.index, np.inf) >= 0.0
         ]
         self.kept = [m.index for m in moves if m.index not in self.optimizable]
+        self.chains = self._chains() if settings.fly_by else {i: (i,) for i in self.optimizable}
+        self.optimizable = list(self.chains)  # one unit per chain, keyed by its first move
         self.dwell = settings.controller.fine_dwell
         self.wait_total = float(sum(s for _, _, s in self.plan.waits))
         self.kept_time = float(sum(self.by_index[i].profile.duration for i in self.kept))
         self.n_stops = sum(1 for m in moves if m.stops)
         self.fixed_time = self.n_stops * self.dwell + self.kept_time
         self.t_lo: dict[int, float] = {}
-        for i in self.optimizable:
-            m = self.by_index[i]
-            robot = self._robot(m)
-            shortest = shortest_feasible_duration(
-                robot,
-                m.path.q0,
-                m.path.q1,
-                dt=STEP,
-                friction=NOMINAL_FRICTION,
-                acceleration_limit=self._amax(robot),
-            )
-            if shortest is None:
-                raise LimitViolation(
-                    f"{spec.source}:{m.step.line}: {m.step.label}: no feasible duration found"
+        self.leg_lo: dict[int, tuple[float, ...]] = {}  # each move's shortest rest-to-rest duration
+        for i, members in self.chains.items():
+            single: list[float] = []
+            for j in members:
+                m = self.by_index[j]
+                robot = self._robot(m)
+                shortest = shortest_feasible_duration(
+                    robot,
+                    m.path.q0,
+                    m.path.q1,
+                    dt=STEP,
+                    friction=NOMINAL_FRICTION,
+                    acceleration_limit=self._amax(robot),
                 )
-            self.t_lo[i] = shortest
+                if shortest is None:
+                    raise LimitViolation(
+                        f"{spec.source}:{m.step.line}: {m.step.label}: no feasible duration found"
+                    )
+                single.append(shortest)
+            self.leg_lo[i] = tuple(single)
+            self.t_lo[i] = single[0] if len(members) == 1 else self._chain_shortest(i, sum(single))
         self.shortest_cycle = self.fixed_time + sum(self.t_lo.values())
+
+    # ------------------------------------------------------------ chains
+    def _chains(self) -> dict[int, tuple[int, ...]]:
+        """Runs of consecutive optimizable moves joined by fly-by targets (zones), by first move."""
+        ok = set(self.optimizable)
+        out: dict[int, tuple[int, ...]] = {}
+        run: list[int] = []
+        for m in self.plan.moves:
+            if m.index in ok and run and not self.by_index[run[-1]].stops:
+                run.append(m.index)
+                continue
+            if run:
+                out[run[0]] = tuple(run)
+            run = [m.index] if m.index in ok else []
+        if run:
+            out[run[0]] = tuple(run)
+        return out
+
+    def waypoints(self, i: int, T: float) -> tuple[tuple[float, FloatArray], ...]:
+        """The chain's inner targets and when it passes them: ``T`` shared in proportion to each
+        move's shortest rest-to-rest duration, in whole 25 ms samples, each leg at least two
+        samples long (at the sum of those durations, each leg gets its own)."""
+        members = self.chains[i]
+        if len(members) == 1:
+            return ()
+        base = np.array(self.leg_lo[i])
+        units = int(round(T / STEP))
+        edges = np.round(np.cumsum(base)[:-1] / base.sum() * units).astype(int)
+        for k in range(edges.size):  # at least 2 samples per leg
+            edges[k] = max(edges[k], (edges[k - 1] if k else 0) + 2)
+        for k in range(edges.size - 1, -1, -1):
+            edges[k] = min(edges[k], (edges[k + 1] if k + 1 < edges.size else units) - 2)
+        return tuple(
+            (float(e * STEP), self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
+        )
+
+    def _chain_problem(self, i: int, T: float, corridor: float | None, knot_spacing: float) -> SplineProblem:
+        m0, m1 = self.by_index[i], self.by_index[self.chains[i][-1]]
+        robot = self._robot(m0)
+        g = self.settings.gradient
+        return SplineProblem(
+            robot,
+            m0.path.q0,
+            m1.path.q1,
+            T,
+            NOMINAL_FRICTION,
+            SplineBasis(T, knot_spacing=knot_spacing, degree=g.degree, dt=STEP),
+            check_factor=g.check_factor,
+            max_deviation_m=None if corridor is None else corridor / 1000,
+            acceleration_limit=self._amax(robot),
+            waypoints=self.waypoints(i, T),
+        )
+
+    def _chain_shortest(self, i: int, upper: float) -> float:
+        """Shortest whole-sample chain duration: the first from half the sum of its moves' shortest
+        rest-to-rest durations (``upper``) whose smoothest path through the targets keeps every limit,
+        else ``upper`` (the moves back to back, each from rest to rest, are feasible there)."""
+        robot = self._robot(self.by_index[i])
+        amax = self._amax(robot)
+        n_legs = len(self.chains[i])
+        units = max(2 * n_legs + 2, int(np.floor(0.5 * upper / STEP)))
+        while units * STEP < upper - 1e-9:
+            T = units * STEP
+            problem = self._chain_problem(i, T, None, self.settings.gradient.knot_spacing)
+            fine = problem.path(problem.origin, fine=True)
+            if check_limits(robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok:
+                return round(T, 9)
+            units += 1
+        return round(upper, 9)
+
+    def split(self, i: int, s: Solved) -> dict[int, Solved]:
+        """A chain's solve cut at its targets into one piece per move (times from 0 in each piece;
+        neighbouring pieces share their boundary sample)."""
+        members = self.chains[i]
+        if len(members) == 1:
+            return {i: s}
+        cuts = [0.0, *(t for t, _ in self.waypoints(i, s.duration)), s.duration]
+        robot = self._robot(self.by_index[i])
+        plant = self.plant(robot)
+        out: dict[int, Solved] = {}
+        for k, (j, a, b) in enumerate(zip(members, cuts[:-1], cuts[1:], strict=True)):
+            pieces = []
+            for tr in (s.samples, s.fine):
+                sel = (tr.t >= a - 1e-9) & (tr.t <= b + 1e-9)
+                pieces.append(Trajectory(t=tr.t[sel] - a, q=tr.q[sel], qd=tr.qd[sel], qdd=tr.qdd[sel]))
+            f = pieces[1]
+            # the shared sample at a target counts half in each piece: the pieces sum to the chain
+            w = np.ones((f.t.size, 1))
+            if k > 0:
+                w[0] = 0.5
+            if k < len(members) - 1:
+                w[-1] = 0.5
+            tau = robot.inverse_dynamics(f.q, f.qd, f.qdd, friction=NOMINAL_FRICTION)
+            e = float((w * joint_energy(tau, f.qd, s.fine.dt)).sum())
+            e_lab = float((w * joint_energy(plant.drive_torque(f.q, f.qd, f.qdd), f.qd, s.fine.dt)).sum())
+            out[j] = replace(
+                s, duration=round(b - a, 9), energy_J=e, energy_lab_J=e_lab, samples=pieces[0], fine=f
+            )
+        return out
 
     # ------------------------------------------------------------ helpers
     def _clearance_mm(self, m: PlannedMove, q: FloatArray) -> float:
@@ -322,7 +433,7 @@ class CycleOptimizer:
         if self.settings.cell is not None:  # tighter corridors around the (clear) taught move
             first = self.settings.corridor_mm or 100.0
             corridors += [first / 2, first / 4, first / 8]
-        warm = self._neighbour(i, T) if self.settings.warm_start else None
+        warm = self._neighbour(i, T) if self.settings.warm_start and len(self.chains[i]) == 1 else None
         out: Solved | None = None
         for corridor in corridors:
             out = self._solve_once(m, T, units, corridor, warm)
@@ -378,13 +489,14 @@ class CycleOptimizer:
             res, problem = solve_move(
                 robot,
                 m.path.q0,
-                m.path.q1,
+                self.by_index[self.chains[m.index][-1]].path.q1,
                 T,
                 friction=NOMINAL_FRICTION,
                 settings=self.settings.gradient,
                 rng=rng,
                 acceleration_limit=amax,
                 max_deviation_m=None if corridor is None else corridor / 1000,
+                waypoints=self.waypoints(m.index, T),
             )
         self.n_solves += 1
         x = res.coefficients.ravel()
@@ -392,7 +504,8 @@ class CycleOptimizer:
         report = check_limits(robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax)
         e, e_lab = _energy(robot, self.plant(robot), fine)
         samples = problem.path(x)
-        taught = minimum_jerk(m.path.q0, m.path.q1, T, dt=STEP)
+        # the taught move: the joint-interpolated move, or through a chain's targets the smoothest path
+        taught = problem.path(problem.origin)
         return Solved(
             T,
             e,
@@ -553,7 +666,7 @@ class CycleOptimizer:
 
     def proportional(self, budget: float) -> dict[int, float]:
         """The default's durations scaled by one factor to fill the budget (never below the shortest)."""
-        base = {i: self.by_index[i].profile.duration for i in self.optimizable}
+        base = {i: sum(self.by_index[j].profile.duration for j in self.chains[i]) for i in self.optimizable}
 
         def total(k: float) -> float:
             return sum(max(self.t_lo[i], k * base[i]) for i in base)
@@ -610,8 +723,8 @@ def optimize_cycle(
     if target < shortest - 1e-9:
         raise LimitViolation(
             f"{spec.source}: cycle time {target:.3f} s is shorter than the shortest this program "
-            "reaches with "
-            f"moves that stop at every target ({shortest:.3f} s; the default runs {plan.cycle_time:.3f} s); "
+            "reaches with its optimized moves at their shortest "
+            f"({shortest:.3f} s; the default runs {plan.cycle_time:.3f} s); "
             f"give --cycle-time {np.ceil(shortest * 1000) / 1000:.3f} or more"
             + ("" if settings.use_waits else ", or allow --use-waits")
         )
@@ -643,19 +756,33 @@ def optimize_cycle(
     outcomes: list[MoveOutcome] = []
     paths: dict[int, Solved] = {}
     ok = True
+    pieces: dict[int, Solved] = {}
+    notes: dict[int, str] = {}
+    for i, T in final.durations.items():
+        whole = opt.solve(i, T)
+        ok = ok and whole.usable
+        pieces.update(opt.split(i, whole))
+        members = opt.chains[i]
+        for j in members:
+            notes[j] = (
+                "reshaped and re-timed"
+                if len(members) == 1
+                else "reshaped and re-timed in one fly-by chain with lines "
+                + ", ".join(str(opt.by_index[k].step.line) for k in members)
+                + " (passes the zone targets exactly, without stopping)"
+            )
     for m in plan.moves:
         d_T, d_e, d_lab = default[m.index]
-        if m.index in final.durations:
-            s = opt.solve(m.index, final.durations[m.index])
+        if m.index in pieces:
+            s = pieces[m.index]
             paths[m.index] = s
             n_via, dev_q, dev_mm = via_deviation(m.step, s, settings.via_every)
-            ok = ok and s.usable
             outcomes.append(
                 MoveOutcome(
                     m.step.line,
                     m.step.label,
                     True,
-                    "reshaped and re-timed",
+                    notes[m.index],
                     d_T,
                     s.duration,
                     d_e,
@@ -731,6 +858,7 @@ def optimize_cycle(
         n_solves=opt.n_solves,
         paths=paths,
         spec=spec,
+        chains={i: c for i, c in opt.chains.items() if len(c) > 1 and i in final.durations},
     )
     return result, opt
 

@@ -26,8 +26,10 @@ ASSUMPTIONS = (
     "tool's load and NOMINAL_FRICTION; lab = the emulated lab robot's drive torque on the same motion",
     "default: the emulated controller (jerk-limited profile, speeddata, joint limits, accel = vmax/0.25 s, "
     "zones blended by superposition, 48 ms dwell at stop points; a move before WaitTime stops)",
-    "optimized MoveJ/MoveAbsJ: rest to rest (the single-move gradient optimizer), written as MoveAbsJ via "
-    "points with \\T and z1 zones; the last via point keeps the original move's stop (fine) or ends in z1",
+    "optimized MoveJ/MoveAbsJ: the single-move gradient optimizer; consecutive ones joined by a zone form "
+    "one fly-by chain through their targets (passed exactly, at speed), other moves run rest to rest; "
+    "written as MoveAbsJ via points with \\T in z200 zones; the last via point of a move keeps its stop "
+    "(fine), ends in z1 (rest), or stays z200 inside a chain",
     "MoveL: kept unchanged (straight line, controller timing); moves that occur more than once: kept",
     "corridor: tool0 (the flange) stays within corridor_mm of the joint-interpolated taught move at every "
     "25 ms sample of an optimized move (corridor_dev_mm per move)",
@@ -53,11 +55,13 @@ def optimized_module(result: CycleResult, *, via_every: int) -> str:
         )
     replace: dict[int, list[str]] = {}
     decls: list[str] = []
+    through = {j for chain in result.chains.values() for j in chain[:-1]}  # passed at speed
     for i, solved in result.paths.items():
         step = spec.steps[i]
         move = step.statement
         assert isinstance(move, Move) and step.robot is not None
-        lines, names = _via_lines(move, solved, via_every, step.zone_mm is None, step.robot)
+        end = VIA_ZONE if i in through else "fine" if step.zone_mm is None else "z1"
+        lines, names = _via_lines(move, solved, via_every, end, step.robot)
         replace[move.line] = lines
         decls.extend(names)
     for wline, before, after in result.waits:
@@ -80,7 +84,7 @@ def optimized_module(result: CycleResult, *, via_every: int) -> str:
     return write_module(module, replace=replace, declarations=decls, header=header)
 
 
-def _via_lines(move: Move, solved: Solved, every: int, fine: bool, robot: Any) -> tuple[list[str], list[str]]:
+def _via_lines(move: Move, solved: Solved, every: int, end: str, robot: Any) -> tuple[list[str], list[str]]:
     samples = solved.samples
     idx = via_points(samples, every)
     lo, hi = robot.joint_ranges()
@@ -99,7 +103,7 @@ def _via_lines(move: Move, solved: Solved, every: int, fine: bool, robot: Any) -
     for k, (qk, tk) in enumerate(zip(q, times, strict=True), start=1):
         name = f"jpL{move.line}_{k}"
         names.append(f"CONST jointtarget {name} := {_jt(np.degrees(qk))};")
-        zone = ("fine" if fine else "z1") if k == len(idx) else VIA_ZONE
+        zone = end if k == len(idx) else VIA_ZONE
         lines.append(f"MoveAbsJ {name}, v7000 \\T:={_num(float(tk))}, {zone}, {move.tool};")
     return lines, names
 

@@ -116,6 +116,16 @@ class SplineBasis:
             mats.append(np.ascontiguousarray(m[:, 3 : n_ctrl - 3]))
         return GridBasis(t=t, B=mats[0], Bd=mats[1], Bdd=mats[2])
 
+    def free_basis(self, times: ArrayLike, order: int = 0) -> FloatArray:
+        """Rows of the shape term's ``order``-th derivative at arbitrary ``times`` in [0, T]: (k, n_free)."""
+        t = np.asarray(times, dtype=float).ravel()
+        if np.any(~np.isfinite(t)) or np.any(t < 0.0) or np.any(t > self.duration):
+            raise InvalidInput(f"times must lie in [0, {self.duration:g}] s")
+        n_ctrl = self.knots.size - self.degree - 1
+        spline = BSpline(self.knots, np.eye(n_ctrl), self.degree, extrapolate=False)
+        sp = spline if order == 0 else spline.derivative(order)
+        return np.ascontiguousarray(np.nan_to_num(sp(t))[:, 3 : n_ctrl - 3])
+
     @cached_property
     def control_maps(self) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Linear maps from the free coefficients to the control points of q, qd and qdd.
