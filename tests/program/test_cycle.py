@@ -254,6 +254,14 @@ def test_written_program_check_is_reported(tmp_path, robot):
     assert check["within_tolerances"] == expected
     assert check["planned_cycle_s"] == r.optimized_cycle_s
     assert check["emulated_cycle_s"] > 0 and check["emulated_energy_J"] > 0
+    # the module written to the run folder says so in its header when it does not reproduce the plan
+    from joulepath.program import write_cycle_run
+
+    files = write_cycle_run(tmp_path, r, via_every=2, pareto=None, write_rapid=True)
+    text = files["optimized.mod"].read_text()
+    assert ("WARNING: run by joulepath's controller emulation" in text) == (not expected)
+    assert json.loads(files["cycle.json"].read_text())["written_program_check"]["within_tolerances"] == expected
+    resolve_module(parse_module(text, path="w.mod"), robot)  # the warning is a comment: it reads back
 
 
 def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):

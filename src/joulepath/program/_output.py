@@ -165,6 +165,20 @@ def check_written(result: CycleResult, text: str) -> dict[str, Any]:
     }
 
 
+def _mark_unfaithful(text: str, check: dict[str, Any]) -> str:
+    """The module with a warning under its header: what the controller emulation measured instead."""
+    warning = (
+        f"! WARNING: run by joulepath's controller emulation this module takes {check['emulated_cycle_s']:.3f} s "
+        f"per cycle (planned {check['planned_cycle_s']:.3f} s) and {check['emulated_energy_J']:.2f} J (planned "
+        f"{check['planned_energy_J']:.2f} J): the via points do not reproduce the plan. See cycle.json."
+    )
+    lines = text.splitlines(keepends=True)
+    at = next((k for k, ln in enumerate(lines) if "! Optimized by joulepath" in ln), 0)
+    indent = lines[at][: len(lines[at]) - len(lines[at].lstrip())]
+    lines.insert(at + 1, indent + warning + "\n")
+    return "".join(lines)
+
+
 def emulated_cycle_time(result: CycleResult, text: str) -> float:
     """The written module's cycle time as the controller emulation runs it."""
     return float(check_written(result, text)["emulated_cycle_s"])
@@ -277,6 +291,9 @@ def write_cycle_run(
             text = optimized_module(result, via_every=via_every)
         except LimitViolation as err:
             refused = str(err)
+    check = check_written(result, text) if text is not None else None
+    if text is not None and check is not None and not check["within_tolerances"]:
+        text = _mark_unfaithful(text, check)
     out.mkdir(parents=True, exist_ok=True)
     stale = out / "optimized.mod"
     if text is not None:
@@ -288,7 +305,6 @@ def write_cycle_run(
         default = (result.default_cycle_s, result.default_energy_J, result.default_lab_J)
         files["pareto.csv"] = atomic_write_text(out / "pareto.csv", pareto_csv(pareto, default))
         files["pareto.png"] = pareto_plot(pareto, default, out / "pareto.png")
-    check = check_written(result, text) if text is not None else None
     data = cycle_json(result, pareto, "optimized.mod" if text is not None else None, refused, check)
     files["cycle.json"] = atomic_write_text(
         out / "cycle.json", json.dumps(finite_json(data), indent=2, allow_nan=False)
