@@ -32,7 +32,10 @@ ASSUMPTIONS = (
     "(fine), ends in z1 (rest), or stays z200 inside a chain",
     "MoveL: kept unchanged (straight line, controller timing); moves that occur more than once: kept",
     "corridor: tool0 (the flange) stays within corridor_mm of the joint-interpolated taught move at every "
-    "25 ms sample of an optimized move (corridor_dev_mm per move)",
+    "25 ms sample of an optimized move (corridor_dev_mm per move; for a fly-by chain, of the smoothest path "
+    "through its targets at the same times, and the value is the chain's)",
+    "speeddata of an optimized move is not a bound: its TCP may move faster than programmed (joint speed, "
+    "acceleration and effort limits hold)",
     "instructions kept verbatim (I/O, assignments, ...): their run time is not modelled (treated as fixed)",
 )
 
