@@ -231,5 +231,6 @@ def test_a_move_through_a_waypoint_passes_it_at_speed_within_every_limit(irb120)
     assert check_limits(irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok
     assert res.energy_J <= problem.true_energy(problem.origin) + 1e-9
     with pytest.raises(Exception, match="waypoint times"):
-        SplineProblem(irb120, Q0, QF, 1.2, NOMINAL_FRICTION, SplineBasis(1.2, knot_spacing=0.1),
-                      waypoints=((1.2, QW),))
+        SplineProblem(
+            irb120, Q0, QF, 1.2, NOMINAL_FRICTION, SplineBasis(1.2, knot_spacing=0.1), waypoints=((1.2, QW),)
+        )

@@ -260,7 +260,9 @@ def test_written_program_check_is_reported(tmp_path, robot):
     files = write_cycle_run(tmp_path, r, via_every=2, pareto=None, write_rapid=True)
     text = files["optimized.mod"].read_text()
     assert ("WARNING: run by joulepath's controller emulation" in text) == (not expected)
-    assert json.loads(files["cycle.json"].read_text())["written_program_check"]["within_tolerances"] == expected
+    assert (
+        json.loads(files["cycle.json"].read_text())["written_program_check"]["within_tolerances"] == expected
+    )
     resolve_module(parse_module(text, path="w.mod"), robot)  # the warning is a comment: it reads back
 
 
@@ -292,6 +294,8 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):
     via = [ln for ln in text.splitlines() if f"jpL{line}_" in ln and "MoveAbsJ" in ln]
     assert via and via[-1].rstrip().endswith("z200, tool0;")
     resolve_module(parse_module(text, path="o.mod"), robot)  # reads back
-    rest, opt_rest = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, fly_by=False))
+    rest, opt_rest = optimize_cycle(
+        spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, fly_by=False)
+    )
     assert rest.chains == {}
     assert opt.shortest_cycle <= opt_rest.shortest_cycle + 1e-9

@@ -169,8 +169,9 @@ class SplineProblem:
         coefficient vectors that meet the waypoints (the minimum-jerk move when there are
         none); the search starts there, and the corridor is measured from its path.
         """
+        self.way_A: FloatArray = np.zeros((0, self.n_var))
+        self.way_b: FloatArray = np.zeros(0)
         if not self.waypoints:
-            self.way_A, self.way_b = np.zeros((0, self.n_var)), np.zeros(0)
             return
         times = np.array([float(t) for t, _ in self.waypoints])
         if np.any(times <= 0.0) or np.any(times >= self.duration) or np.any(np.diff(times) <= 0.0):
@@ -185,7 +186,7 @@ class SplineProblem:
         blend = 10 * s**3 - 15 * s**4 + 6 * s**5
         base_at = self.q_start + blend[:, None] * (self.q_end - self.q_start)
         d = q_way - base_at  # (w, n)
-        self.way_A = np.kron(Bw, np.eye(self.n))  # rows w * n + i
+        self.way_A = np.asarray(np.kron(Bw, np.eye(self.n)), dtype=float)  # rows w * n + i
         self.way_b = d.ravel()
         # the smoothest shape through the waypoints: min |Bdd C|² + ridge s.t. Bw C = d
         H = self.samples.Bdd.T @ self.samples.Bdd

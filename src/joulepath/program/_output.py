@@ -170,10 +170,12 @@ def check_written(result: CycleResult, text: str) -> dict[str, Any]:
 
 def _mark_unfaithful(text: str, check: dict[str, Any]) -> str:
     """The module with a warning under its header: what the controller emulation measured instead."""
+    cyc, plan_cyc = check["emulated_cycle_s"], check["planned_cycle_s"]
+    e, plan_e = check["emulated_energy_J"], check["planned_energy_J"]
     warning = (
-        f"! WARNING: run by joulepath's controller emulation this module takes {check['emulated_cycle_s']:.3f} s "
-        f"per cycle (planned {check['planned_cycle_s']:.3f} s) and {check['emulated_energy_J']:.2f} J (planned "
-        f"{check['planned_energy_J']:.2f} J): the via points do not reproduce the plan. See cycle.json."
+        f"! WARNING: run by joulepath's controller emulation this module takes {cyc:.3f} s per cycle "
+        f"(planned {plan_cyc:.3f} s) and {e:.2f} J (planned {plan_e:.2f} J): the via points do not "
+        "reproduce the plan. See cycle.json."
     )
     lines = text.splitlines(keepends=True)
     at = next((k for k, ln in enumerate(lines) if "! Optimized by joulepath" in ln), 0)
