@@ -269,7 +269,10 @@ def test_cycle_stage_matches_its_files_and_the_report(tiny_run):
     assert record["limits_ok"] == data["limits_ok"]
     if data["limits_ok"]:
         assert record["saved_pct"] == pytest.approx(data["saved_pct"])
-        assert (tiny_run / "cycle" / "optimized.mod").is_file()
+        # the module is written exactly when the controller emulation runs it as planned
+        matches = data["written_program_check"]["within_tolerances"]
+        assert (tiny_run / "cycle" / "optimized.mod").is_file() == matches == record["program_written"]
+        assert (data["rapid_refused"] is None) == matches
         # the per-move energies add up to the cycle's totals on physics
         moves = data["moves"]
         assert sum(m["optimized_energy_J"] for m in moves) <= data["energy_optimized_J"] + 1e-6

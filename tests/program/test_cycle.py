@@ -143,8 +143,16 @@ def test_cli_writes_a_program_that_reads_back(tmp_path, robot):
     prog.write_text(SMALL.replace("MoveAbsJ jB, v800", "MoveAbsJ jB, v300"))
     out = tmp_path / "run"
     args = ["--use-waits", "--knot-spacing", "0.1", "--table-points", "2", "--pareto", "--points", "3"]
-    assert main(["cycle", str(prog), "--out", str(out), *args]) == 0
+    rc = main(["cycle", str(prog), "--out", str(tmp_path / "strict"), *args])
+    strict = json.loads((tmp_path / "strict" / "cycle.json").read_text())
+    if strict["written_program_matches_plan"]:
+        assert rc == 0 and (tmp_path / "strict" / "optimized.mod").is_file()
+    else:  # not written unless asked: the reason, with the emulated numbers, in cycle.json
+        assert rc == 1 and not (tmp_path / "strict" / "optimized.mod").exists()
+        assert "do not reproduce the plan" in strict["rapid_refused"] and strict["rapid"] is None
+    assert main(["cycle", str(prog), "--out", str(out), *args, "--write-anyway"]) == 0
     data = json.loads((out / "cycle.json").read_text())
+    assert data["saved_pct"] == pytest.approx(strict["saved_pct"])  # same plan either way
     assert data["limits_ok"] and data["optimized_cycle_s"] <= data["target_cycle_s"] + 1e-9
     assert data["waits"] == [{"line": 11, "default_s": 0.2, "optimized_s": 0.0}]
     assert data["kept_verbatim_lines"] == [14]
@@ -257,7 +265,7 @@ def test_written_program_check_is_reported(tmp_path, robot):
     # the module written to the run folder says so in its header when it does not reproduce the plan
     from joulepath.program import write_cycle_run
 
-    files = write_cycle_run(tmp_path, r, via_every=2, pareto=None, write_rapid=True)
+    files = write_cycle_run(tmp_path, r, via_every=2, pareto=None, write_rapid=True, write_anyway=True)
     text = files["optimized.mod"].read_text()
     assert ("WARNING: run by joulepath's controller emulation" in text) == (not expected)
     assert (
@@ -292,10 +300,49 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):
     text = optimized_module(result, via_every=2)
     line = spec.steps[first].line
     via = [ln for ln in text.splitlines() if f"jpL{line}_" in ln and "MoveAbsJ" in ln]
-    assert via and via[-1].rstrip().endswith("z200, tool0;")
+    assert via and via[-1].rstrip().endswith("z20, tool0;")  # the program's own zone at the target
     resolve_module(parse_module(text, path="o.mod"), robot)  # reads back
     rest, opt_rest = optimize_cycle(
         spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, fly_by=False)
     )
     assert rest.chains == {}
     assert opt.shortest_cycle <= opt_rest.shortest_cycle + 1e-9
+
+
+def test_via_layout_of_a_gentle_move_is_run_as_planned(robot):
+    """A minimum-jerk move (gentle at both ends) written as via points: the emulated controller keeps
+    every corner, takes the planned time and stays on the path; the target is always a via point."""
+    from joulepath.program._cycle import _energy
+    from joulepath.program._timing import _chain_profiles
+    from joulepath.program._via import _segment, layout
+    from joulepath.sim import make_plant
+    from joulepath.trajectory import minimum_jerk
+
+    tool = np.eye(4)
+    tool[2, 3] = 0.09
+    q0 = np.radians([-60.0, 10.0, 10.0, 0.0, 40.0, 0.0])
+    q1 = np.radians([40.0, 25.0, -5.0, 20.0, 50.0, 30.0])
+    plan = minimum_jerk(q0, q1, 1.2, dt=FINE_DT)
+    config = ControllerConfig()
+    (idx,) = layout(robot, tool, [plan], spacing=0.05, config=config)
+    assert idx[-1] == plan.t.size - 1 and len(idx) >= 10
+    points = [(0, i) for i in idx]
+    segments = [_segment(robot, tool, [plan], points, n, config, [None]) for n in range(len(points))]
+    chained, bad = _chain_profiles(segments, set(range(len(segments) - 1)), config)
+    assert bad is None and len(chained) == len(segments)
+    # run by the emulation: same duration, the same TCP path (as a set of points, as check_written
+    # measures it) within the 5 mm tolerance, the energy within 5 % (the controller's sin² ramps from and
+    # to rest run at the acceleration limit, harder than the minimum-jerk move's ends)
+    from joulepath.program._resolve import CycleSpec
+
+    steps = tuple(s[1] for s in segments)
+    emu_plan = plan_cycle(CycleSpec(steps, q0, "via", None, (), robot), config)
+    assert emu_plan.cycle_time - config.fine_dwell == pytest.approx(1.2, abs=1e-9)
+    emu = evaluate_cycle(emu_plan, plan.t)
+    tcp = lambda q: robot.fk(q).position_m + np.einsum("kij,j->ki", robot.fk(q).rotation, tool[:3, 3])  # noqa: E731
+    from scipy.spatial import cKDTree
+
+    a, b = tcp(emu.q), tcp(plan.q)
+    assert 1000 * max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max()) < 5.0
+    plant = make_plant("lab", robot)
+    assert _energy(robot, plant, emu)[0] == pytest.approx(_energy(robot, plant, plan)[0], rel=0.05)

@@ -39,6 +39,20 @@ def cycle(
         help="Run every optimized move rest to rest; default: consecutive MoveJ/MoveAbsJ joined by a zone "
         "form one fly-by chain that passes their targets exactly without stopping.",
     ),
+    accel_time: float = typer.Option(
+        0.25,
+        "--accel-time",
+        min=0.05,
+        max=10.0,
+        help="s: each joint's acceleration limit is its speed limit divided by this (longer: gentler moves "
+        "that the controller can follow through via points, at a longer cycle time).",
+    ),
+    write_anyway: bool = typer.Option(
+        False,
+        "--write-anyway",
+        help="Write optimized.mod even when the controller emulation does not run it as planned "
+        "(a warning goes in its header).",
+    ),
     pareto: bool = typer.Option(False, "--pareto", help="Also energy against cycle time (CSV + plot)."),
     points: int = typer.Option(10, "--points", min=3, max=30, help="Points of --pareto."),
     knot_spacing: float = typer.Option(
@@ -64,8 +78,9 @@ def cycle(
 ) -> int:
     """Optimize a program's cycle for energy at the same (or a given) cycle time; verify; write RAPID.
 
-    Exit code 0: written within every limit; 1: a result breaks a limit, no program
-    written; 2: bad input (unreadable program, unreachable target, infeasible cycle time).
+    Exit code 0: written within every limit; 1: no program written (a result breaks a limit or
+    the cell's margin, or the controller emulation does not run the via points as planned; see
+    --write-anyway); 2: bad input (unreadable program, unreachable target, infeasible cycle time).
     """
     from joulepath.optimize import GradientSettings
     from joulepath.program import (
@@ -91,6 +106,7 @@ def cycle(
         cycle_time=target,
         use_waits=use_waits,
         fly_by=not stop_at_targets,
+        accel_time=accel_time,
         seed=seed,
         table_points=table_points,
         corridor_mm=corridor or None,
@@ -102,8 +118,19 @@ def cycle(
         if pareto:
             status.update("energy against cycle time...")
             front = run_pareto(opt, points=points, use_waits=use_waits)
-    files = write_cycle_run(out, result, via_every=settings.via_every, pareto=front, write_rapid=rapid)
-    if not result.limits_ok or (rapid and "optimized.mod" not in files):
+    files = write_cycle_run(
+        out,
+        result,
+        via_every=settings.via_every,
+        pareto=front,
+        write_rapid=rapid,
+        cell=cell_data,
+        write_anyway=write_anyway,
+    )
+    saved = json.loads(files["cycle.json"].read_text())
+    if not result.limits_ok or (
+        rapid and "optimized.mod" not in files and saved["written_program_check"] is None
+    ):
         console.print(
             "REFUSED: the optimized cycle breaks a limit or the cell's margin; no program was written "
             f"and no saving is claimed (default {result.default_energy_J:.2f} J; see cycle.json)"
@@ -131,7 +158,11 @@ def cycle(
         console.print(
             f"kept verbatim, run time treated as fixed: line(s) {', '.join(map(str, result.fixed_lines))}"
         )
-    check = json.loads(files["cycle.json"].read_text()).get("written_program_check")
+    check = saved.get("written_program_check")
+    if rapid and "optimized.mod" not in files:
+        console.print(f"NOT WRITTEN: optimized.mod: {saved['rapid_refused']}")
+        console.print(f"wrote {', '.join(sorted(files))} in {out}")
+        return 1
     if check is not None and not check["within_tolerances"]:
         console.print(
             f"WARNING: the written program, run by the controller emulation, does not reproduce the plan: "

@@ -46,6 +46,7 @@ Example (``joulepath/experiment/presets/demo.toml``, abridged)::
     cycle_time = 0.0      # s; 0: the default program's cycle time
     pareto_points = 0     # ≥ 3: also energy against cycle time
     fly_by = true         # false: every optimized move rest to rest (no chains through zones)
+    write_anyway = false  # true: write optimized.mod even if the controller would not run it as planned
 
 Sections left out take their defaults; ``[synth]``, ``[bench]``, ``[identify]`` and ``[cycle]``
 are skipped unless they are given (``methods`` non-empty, ``tasks`` ≥ 1, ``enabled = true``,
@@ -176,7 +177,8 @@ class CycleStage:
     experiment file; ``cycle_time`` 0 keeps the default program's; ``use_waits`` spends
     WaitTime slack on the moves; ``pareto_points`` ≥ 3 also computes energy against cycle time;
     ``fly_by`` false runs every optimized move rest to rest instead of chaining moves joined
-    by a zone through their targets.
+    by a zone through their targets; ``write_anyway`` writes the RAPID module even when the
+    controller emulation does not run it as planned.
     """
 
     program: str = ""
@@ -186,6 +188,7 @@ class CycleStage:
     pareto_points: int = 0
     corridor_mm: float = 100.0
     fly_by: bool = True
+    write_anyway: bool = False
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -1015,7 +1015,15 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
         ctx.progress("cycle", 0, 1)
         result, opt = optimize_cycle(spec, settings)
         front = run_pareto(opt, points=st.pareto_points, use_waits=st.use_waits) if st.pareto_points else None
-        files = write_cycle_run(folder, result, via_every=settings.via_every, pareto=front, write_rapid=rapid)
+        files = write_cycle_run(
+            folder,
+            result,
+            via_every=settings.via_every,
+            pareto=front,
+            write_rapid=rapid,
+            cell=cell_data,
+            write_anyway=st.write_anyway,
+        )
         ctx.progress("cycle", 1, 1)
         check = json.loads((folder / CYCLE_JSON).read_text(encoding="utf-8")).get("written_program_check")
         written = "optimized.mod" in files or not rapid
@@ -1023,6 +1031,7 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
             f"{CYCLE_STAGE}: cycle {result.default_cycle_s:.3f} s -> {result.optimized_cycle_s:.3f} s, "
             f"{result.saved_pct:.1f} % saved on physics ({result.saved_lab_pct:.1f} % on the lab plant)"
             + ("" if result.limits_ok else "; REFUSED: a result breaks a limit, no program written")
+            + ("" if written or not result.limits_ok else "; optimized.mod not written (see cycle.json)")
         )
         return {
             "program": st.program,

@@ -28,7 +28,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -51,6 +51,7 @@ from joulepath.program._timing import (
     plan_cycle,
     standalone,
 )
+from joulepath.program._via import layout as via_layout
 from joulepath.sim import ControllerConfig, Plant, make_plant
 from joulepath.trajectory import SplineBasis, Trajectory
 from joulepath.units import SAMPLE_PERIOD
@@ -205,6 +206,7 @@ class CycleResult:
     paths: dict[int, Solved]  # by step index: the optimized moves
     spec: CycleSpec
     chains: dict[int, tuple[int, ...]] = field(default_factory=dict)  # fly-by chains (step indices)
+    vias: dict[int, tuple[int, ...]] = field(default_factory=dict)  # per optimized move: indices into .fine
 
     @property
     def saved_pct(self) -> float:
@@ -771,12 +773,27 @@ def optimize_cycle(
                 + ", ".join(str(opt.by_index[k].step.line) for k in members)
                 + " (passes the zone targets exactly, without stopping)"
             )
+    vias: dict[int, tuple[int, ...]] = {}
+    for i in final.durations:
+        members = opt.chains[i]
+        step = spec.steps[i]
+        assert step.robot is not None and step.tcp is not None
+        legs = [pieces[j].fine for j in members]
+        placed = via_layout(
+            step.robot,
+            step.tcp,
+            legs,
+            spacing=settings.via_every * STEP,
+            config=settings.controller,
+            target_zones=[*(spec.steps[j].zone_mm for j in members[:-1]), None],
+        )
+        vias.update({j: tuple(idx) for j, idx in zip(members, placed, strict=True)})
     for m in plan.moves:
         d_T, d_e, d_lab = default[m.index]
         if m.index in pieces:
             s = pieces[m.index]
             paths[m.index] = s
-            n_via, dev_q, dev_mm = via_deviation(m.step, s, settings.via_every)
+            n_via, dev_q, dev_mm = via_deviation(m.step, s, vias[m.index])
             outcomes.append(
                 MoveOutcome(
                     m.step.line,
@@ -859,32 +876,26 @@ def optimize_cycle(
         paths=paths,
         spec=spec,
         chains={i: c for i, c in opt.chains.items() if len(c) > 1 and i in final.durations},
+        vias=vias,
     )
     return result, opt
 
 
-def via_points(samples: Trajectory, every: int) -> list[int]:
-    """Sample indices written as via points (every ``every`` samples and the last)."""
-    n = samples.t.size
-    return list(range(every, n - 1, every)) + [n - 1]
-
-
-def via_deviation(step: Step, solved: Solved, every: int) -> tuple[int, float, float]:
-    """Via points, and the largest joint (deg) and TCP (mm) distance of their joint-linear
-    interpolation from the optimized path (what the controller's interpolation between
-    via points departs from it, before its zones round the corners)."""
+def via_deviation(step: Step, solved: Solved, idx: Sequence[int]) -> tuple[int, float, float]:
+    """Via points (indices into ``solved.fine``), and the largest joint (deg) and TCP (mm) distance
+    of their joint-linear interpolation from the optimized path (what the controller's
+    interpolation between via points departs from it, before its zones round the corners)."""
     assert step.robot is not None and step.tcp is not None
-    idx = [0, *via_points(solved.samples, every)]
-    tv = solved.samples.t[idx]
-    qv = solved.samples.q[idx]
     fine = solved.fine
+    at = [0, *idx]
+    tv, qv = fine.t[at], fine.q[at]
     lin = np.column_stack([np.interp(fine.t, tv, qv[:, j]) for j in range(qv.shape[1])])
     dev_q = float(np.degrees(np.abs(lin - fine.q).max()))
     a = step.robot.fk(lin)
     b = step.robot.fk(fine.q)
     pa = a.position_m + np.einsum("kij,j->ki", a.rotation, step.tcp[:3, 3])
     pb = b.position_m + np.einsum("kij,j->ki", b.rotation, step.tcp[:3, 3])
-    return len(idx) - 1, dev_q, float(1000 * np.linalg.norm(pa - pb, axis=1).max())
+    return len(idx), dev_q, float(1000 * np.linalg.norm(pa - pb, axis=1).max())
 
 
 def pareto(

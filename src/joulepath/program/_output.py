@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -14,8 +15,10 @@ from joulepath import __version__
 from joulepath._io import atomic_write_text, finite_json
 from joulepath.abb import EXTERNAL_AXES_UNUSED
 from joulepath.errors import LimitViolation
-from joulepath.program._cycle import CycleResult, ParetoPoint, Solved, via_points
+from joulepath.program._cell import Cell, clearance
+from joulepath.program._cycle import CycleResult, ParetoPoint, Solved
 from joulepath.program._model import Move, WaitTime
+from joulepath.program._via import VIA_ZONE_MM
 from joulepath.program._write import _num, format_move, write_module
 
 CYCLE_FILES = ("cycle.json", "optimized.mod", "pareto.csv", "pareto.png", "optimized_cycle.csv")
@@ -63,8 +66,10 @@ def optimized_module(result: CycleResult, *, via_every: int) -> str:
         step = spec.steps[i]
         move = step.statement
         assert isinstance(move, Move) and step.robot is not None
-        end = VIA_ZONE if i in through else "fine" if step.zone_mm is None else "z1"
-        lines, names = _via_lines(move, solved, via_every, end, step.robot)
+        # a target inside a fly-by chain keeps the program's own zone; a move's last point stops
+        own = move.zone + ("" if move.z_tcp is None else f" \\Z:={_num(move.z_tcp)}")
+        end = own if i in through else "fine" if step.zone_mm is None else "z1"
+        lines, names = _via_lines(move, solved, result.vias[i], end, step.robot)
         replace[move.line] = lines
         decls.extend(names)
     for wline, before, after in result.waits:
@@ -87,16 +92,17 @@ def optimized_module(result: CycleResult, *, via_every: int) -> str:
     return write_module(module, replace=replace, declarations=decls, header=header)
 
 
-def _via_lines(move: Move, solved: Solved, every: int, end: str, robot: Any) -> tuple[list[str], list[str]]:
-    samples = solved.samples
-    idx = via_points(samples, every)
+def _via_lines(
+    move: Move, solved: Solved, idx: Sequence[int], end: str, robot: Any
+) -> tuple[list[str], list[str]]:
+    samples = solved.fine
     lo, hi = robot.joint_ranges()
-    q = samples.q[idx]
+    q = samples.q[list(idx)]
     if np.any(q < lo - 1e-9) or np.any(q > hi + 1e-9):
         raise LimitViolation(
             f"line {move.line}: a via point leaves a joint range; the program is not written"
         )
-    times = np.diff([0.0, *samples.t[idx]])
+    times = np.diff([0.0, *samples.t[list(idx)]])
     prev = np.vstack([samples.q[0], q[:-1]])
     speed = np.abs(q - prev) / times[:, None]
     if np.any(speed > robot.velocity_limit * (1 + 1e-9)):
@@ -111,15 +117,14 @@ def _via_lines(move: Move, solved: Solved, every: int, end: str, robot: Any) -> 
     return lines, names
 
 
-VIA_ZONE = "z200"
-"""Zone of the via points inside an optimized move: large, so that the controller reduces it
-to half the distance to the neighbouring via points and keeps speed through them."""
+VIA_ZONE = f"z{VIA_ZONE_MM:.0f}"
+"""Zone of the via points inside an optimized move (:data:`joulepath.program._via.VIA_ZONE_MM`)."""
 
 CHECK_TOLERANCES = {"cycle_pct": 2.0, "energy_pct": 3.0, "path_mm": 5.0}
 """How far the written module, run by the controller emulation, may depart from the plan."""
 
 
-def check_written(result: CycleResult, text: str) -> dict[str, Any]:
+def check_written(result: CycleResult, text: str, cell: Cell | None = None) -> dict[str, Any]:
     """The written module run by the controller emulation against the planned cycle.
 
     Cycle time, energy on physics (same model and 2.5 ms grid as the plan) and the TCP
@@ -150,6 +155,9 @@ def check_written(result: CycleResult, text: str) -> dict[str, Any]:
     p_plan, _ = _tcp(first.robot, np.vstack(planned_q), first.tcp)
     p_emu, _ = _tcp(first.robot, traj.q, first.tcp)
     dev = 1000.0 * max(cKDTree(p_plan).query(p_emu)[0].max(), cKDTree(p_emu).query(p_plan)[0].max())
+    clear_mm = None
+    if cell is not None:  # the written program's own motion against the cell, on the same grid
+        clear_mm = 1000.0 * (clearance(cell, first.robot, traj.q, first.tcp).distance - cell.margin)
     cycle_pct = 100.0 * (plan.cycle_time / result.optimized_cycle_s - 1.0)
     energy_pct = 100.0 * (energy / result.optimized_energy_J - 1.0)
     tol = CHECK_TOLERANCES
@@ -163,9 +171,25 @@ def check_written(result: CycleResult, text: str) -> dict[str, Any]:
         "energy_diff_pct": energy_pct,
         "emulated_energy_lab_J": energy_lab,
         "tcp_path_deviation_mm": dev,
+        "cell_clearance_mm": clear_mm,
         "tolerances": dict(tol),
         "within_tolerances": bool(ok),
     }
+
+
+def _unfaithful_reason(check: dict[str, Any]) -> str:
+    """Why a module the controller emulation does not run as planned is not written (one line)."""
+    tol = CHECK_TOLERANCES
+    cyc, plan_cyc = check["emulated_cycle_s"], check["planned_cycle_s"]
+    e, plan_e, dev = check["emulated_energy_J"], check["planned_energy_J"], check["tcp_path_deviation_mm"]
+    return (
+        "the via points do not reproduce the plan: run by the controller emulation the module takes "
+        f"{cyc:.3f} s per cycle against the planned {plan_cyc:.3f} s and {e:.2f} J against {plan_e:.2f} J, "
+        f"TCP path within {dev:.1f} mm (tolerances {tol['cycle_pct']:g} %, {tol['energy_pct']:g} %, "
+        f"{tol['path_mm']:g} mm); not written. The planned motion is in optimized_cycle.csv (for a "
+        "trajectory-streaming interface); a gentler plan (--accel-time, with a longer --cycle-time) may be "
+        "followed; --write-anyway writes the module with this warning"
+    )
 
 
 def _mark_unfaithful(text: str, check: dict[str, Any]) -> str:
@@ -286,9 +310,19 @@ def pareto_plot(points: list[ParetoPoint], default: tuple[float, float, float], 
 
 
 def write_cycle_run(
-    out: Path, result: CycleResult, *, via_every: int, pareto: list[ParetoPoint] | None, write_rapid: bool
+    out: Path,
+    result: CycleResult,
+    *,
+    via_every: int,
+    pareto: list[ParetoPoint] | None,
+    write_rapid: bool,
+    cell: Cell | None = None,
+    write_anyway: bool = False,
 ) -> dict[str, Path]:
-    """Write the run folder; the module only when every limit holds (else cycle.json says why)."""
+    """Write the run folder; the module only when every limit holds, the controller emulation
+    runs it as planned (within :data:`CHECK_TOLERANCES`; ``write_anyway``: written all the same,
+    with a warning in its header) and, with a cell, its emulated motion keeps the margin
+    (else cycle.json says why)."""
     files: dict[str, Path] = {}
     text = refused = None
     if write_rapid:
@@ -296,9 +330,22 @@ def write_cycle_run(
             text = optimized_module(result, via_every=via_every)
         except LimitViolation as err:
             refused = str(err)
-    check = check_written(result, text) if text is not None else None
-    if text is not None and check is not None and not check["within_tolerances"]:
-        text = _mark_unfaithful(text, check)
+    check = check_written(result, text, cell) if text is not None else None
+    inside = None if check is None else check["cell_clearance_mm"]
+    if inside is not None and inside < 0.0:
+        text, refused = (
+            None,
+            (
+                f"the written program, run by the controller emulation, comes {-inside:.1f} mm "
+                "inside the cell's margin (its via points do not follow the plan closely enough); not written"
+            ),
+        )
+    elif check is not None and not check["within_tolerances"]:
+        if write_anyway:
+            assert text is not None
+            text = _mark_unfaithful(text, check)
+        else:
+            text, refused = None, _unfaithful_reason(check)
     out.mkdir(parents=True, exist_ok=True)
     stale = out / "optimized.mod"
     if text is not None:

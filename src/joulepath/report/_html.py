@@ -782,7 +782,8 @@ def _cycle(run: _Run) -> str:
         verdict = "within" if check.get("within_tolerances") else "<b>outside</b>"
         tol = check.get("tolerances") or {}
         out += (
-            "<p>The written module (<code>optimized.mod</code>) run by the controller emulation: cycle "
+            f"<p>The {'written' if data.get('rapid') else 'would-be (not written)'} module "
+            "(<code>optimized.mod</code>) run by the controller emulation: cycle "
             f"{_fmt(check.get('emulated_cycle_s'), 4)} s against the planned "
             f"{_fmt(check.get('planned_cycle_s'), 4)} s ({_fmt(check.get('cycle_diff_pct'), 3)} %), energy "
             f"{_fmt(check.get('emulated_energy_J'), 4)} J against {_fmt(check.get('planned_energy_J'), 4)} J "
@@ -791,6 +792,8 @@ def _cycle(run: _Run) -> str:
             f"({_e(tol.get('cycle_pct'))} % cycle, {_e(tol.get('energy_pct'))} % energy, "
             f"{_e(tol.get('path_mm'))} mm). The savings above are those of the planned motion.</p>"
         )
+    if data.get("rapid_refused") and data.get("limits_ok"):
+        out += f'<p class="note">optimized.mod not written: {_e(data["rapid_refused"])}</p>'
     if data.get("pareto"):
         out += _image(run.path(f"{CYCLE_STAGE}/{CYCLE_PARETO_PNG}"), "Energy against cycle time")
     if data.get("kept_verbatim_lines"):
