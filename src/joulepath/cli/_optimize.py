@@ -175,16 +175,6 @@ def optimize(
             console.print(f"on the emulated lab robot: {s.saved_lab_pct:.1f} % saved")
         else:
             console.print(f"on a {s.lab_plant}: {s.saved_lab_pct:.1f} % saved")
-    if "path.mod" in files:
-        import json
-
-        c = json.loads((out / "result.json").read_text())["rapid_check"]
-        console.print(
-            f"path.mod's optimized move ({c['via_points']:.0f} via points) run by the controller emulation: "
-            f"{c['emulated_duration_s']:.3f} s, {c['emulated_energy_J']:.3f} J (planned "
-            f"{c['planned_duration_s']:.3f} s, {c['planned_energy_J']:.3f} J), TCP path within "
-            f"{c['tcp_path_deviation_mm']:.1f} mm (result.json: rapid_check)"
-        )
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
     return 0
 

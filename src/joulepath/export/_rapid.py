@@ -24,7 +24,7 @@ from joulepath import __version__
 from joulepath._typing import FloatArray
 from joulepath.abb import EXTERNAL_AXES_UNUSED, SPEEDS, ZONES
 from joulepath.data import LOG_COLUMNS
-from joulepath.dynamics import Friction, Robot
+from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.export._base import check_path
 from joulepath.export._moves import draw_moves
@@ -309,7 +309,7 @@ def path_module(
     path_qd: FloatArray,
     duration: float,
     *,
-    every: int = 2,
+    every: int = 4,
     repeats: int = 5,
     pause: float = 2.0,
     name: str = "JPPath",
@@ -320,13 +320,9 @@ def path_module(
     log to measure both moves (thesis Appendix G, without its bug of taking both end
     points from the same target). The default move is ``MoveAbsJ`` to the goal with
     ``\\T`` set to the duration (the controller's own move at equal cycle time); the
-    optimized move passes through via points on the path, each segment timed with
-    ``\\T`` so the total time equals the duration, in ``z200`` zones (the controller
-    reduces them to half the distance to the neighbouring point and keeps speed through
-    them) and stopping ``fine`` at the goal. The via points sit at equal TCP arc length,
-    about ``every`` samples apart on average, and one is removed wherever the emulated
-    controller would break the chain (:func:`joulepath.program._via.layout`);
-    :func:`path_module_check` runs the result through the controller emulation.
+    optimized move passes through the path's configuration every ``every`` samples,
+    each segment timed with ``\\T`` so the total time equals the duration, blended
+    with ``z1`` and stopping ``fine`` at the goal.
 
     Raises
     ------
@@ -341,7 +337,7 @@ def path_module(
     check_path(robot, q, qd, what="path.mod")
     if every < 1 or repeats < 1:
         raise InvalidInput("every and repeats must be ≥ 1")
-    idx = optimized_via_points(robot, q, duration, every=every)
+    idx = list(range(every, n - 1, every)) + [n - 1]
     seg_times = np.diff([0, *idx]) * (duration / (n - 1))
     deg = np.degrees(q)
     out = [
@@ -378,85 +374,10 @@ def path_module(
         "",
         "    PROC OptimizedMove()",
         f"        FOR k FROM 1 TO {len(idx) - 1} DO",
-        "            MoveAbsJ OPT{k}, v7000 \\T:=OPT_T{k}, z200, tool0;",
+        "            MoveAbsJ OPT{k}, v7000 \\T:=OPT_T{k}, z1, tool0;",
         "        ENDFOR",
         f"        MoveAbsJ OPT{{{len(idx)}}}, v7000 \\T:=OPT_T{{{len(idx)}}}, fine, tool0;",
         "    ENDPROC",
         "ENDMODULE",
     ]
     return "\n".join(out) + "\n"
-
-
-def optimized_via_points(robot: Robot, q: FloatArray, duration: float, *, every: int = 2) -> list[int]:
-    """Sample indices of the optimized move's via points in :func:`path_module` (the last: the goal)."""
-    from joulepath.program._via import layout
-    from joulepath.sim import ControllerConfig
-    from joulepath.trajectory import Trajectory
-
-    n = q.shape[0]
-    t = np.linspace(0.0, duration, n)
-    path = Trajectory(t=t, q=q, qd=np.zeros_like(q), qdd=np.zeros_like(q))
-    (idx,) = layout(robot, np.eye(4), [path], spacing=every * duration / (n - 1), config=ControllerConfig())
-    return idx
-
-
-def path_module_check(
-    robot: Robot, trajectory: Trajectory, duration: float, *, friction: Friction | None, every: int = 2
-) -> dict[str, float]:
-    """The optimized move of :func:`path_module` run by the controller emulation against the path.
-
-    Duration (s) and energy on physics (J, same model and ``friction``, on a 2.5 ms grid) of
-    the emulated move and of the path (interpolated to the same grid), and the largest TCP
-    (tool0) distance (mm) between the two paths, each as a set of points.
-    """
-    from scipy.interpolate import CubicHermiteSpline
-    from scipy.spatial import cKDTree
-
-    from joulepath.energy import path_energy
-    from joulepath.program._resolve import CycleSpec, Step
-    from joulepath.program._timing import FINE_DT, evaluate_cycle, plan_cycle
-    from joulepath.program._via import VIA_SPEED, VIA_ZONE_MM
-    from joulepath.sim import ControllerConfig
-
-    q = np.asarray(trajectory.q, dtype=float)
-    idx = optimized_via_points(robot, q, duration, every=every)
-    t = np.linspace(0.0, duration, q.shape[0])
-    steps, t_prev = [], 0.0
-    for k, i in enumerate(idx):
-        steps.append(
-            Step(
-                kind="move",
-                line=k + 1,
-                label=f"OPT{{{k + 1}}}",
-                statement=None,
-                q=q[i],
-                speed=VIA_SPEED,
-                time_s=float(t[i] - t_prev),
-                zone_mm=VIA_ZONE_MM if k < len(idx) - 1 else None,
-                tcp=np.eye(4),
-                robot=robot,
-            )
-        )
-        t_prev = float(t[i])
-    config = ControllerConfig()
-    plan = plan_cycle(CycleSpec(tuple(steps), q[0], "path.mod", None, (), robot), config)
-    emulated = plan.cycle_time - config.fine_dwell
-    grid = np.linspace(0.0, emulated, max(2, int(round(emulated / FINE_DT)) + 1))
-    run = evaluate_cycle(plan, grid)
-    spline = CubicHermiteSpline(t, q, np.asarray(trajectory.qd, dtype=float), axis=0)
-    fine_t = np.linspace(0.0, duration, max(2, int(round(duration / FINE_DT)) + 1))
-    planned = (spline(fine_t), spline(fine_t, 1), spline(fine_t, 2))
-
-    def energy(qq: FloatArray, qd: FloatArray, qdd: FloatArray, dt: float) -> float:
-        tau = robot.inverse_dynamics(qq, qd, qdd, friction=friction)
-        return float(path_energy(tau, qd, dt).total)
-
-    a, b = robot.fk(run.q).position_m, robot.fk(planned[0]).position_m
-    return {
-        "via_points": float(len(idx)),
-        "emulated_duration_s": float(emulated),
-        "planned_duration_s": float(duration),
-        "emulated_energy_J": energy(run.q, run.qd, run.qdd, float(grid[1] - grid[0])),
-        "planned_energy_J": energy(*planned, float(fine_t[1] - fine_t[0])),
-        "tcp_path_deviation_mm": 1000.0 * max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max()),
-    }

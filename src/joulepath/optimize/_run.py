@@ -523,12 +523,6 @@ def write_run(
                 stale.unlink()
     summary["program"] = sorted(programs) if refused is None else None
     summary["rapid"] = "path.mod" if "path.mod" in files else None
-    if "path.mod" in files:  # the optimized move as the controller emulation runs path.mod's via points
-        from joulepath.export._rapid import path_module_check
-
-        summary["rapid_check"] = path_module_check(
-            robot, result.optimized, s.duration_s, friction=robot.friction
-        )
     if refused is not None:
         summary["program_refused"] = refused
         if exporter.name == "rapid":
