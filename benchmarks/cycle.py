@@ -72,9 +72,7 @@ def main() -> None:
     texts = []
     for label, settings in runs:
         r, _ = optimize_cycle(spec, settings)
-        texts.append(
-            optimized_module(r, via_every=settings.via_every)
-        )  # raises if a written move breaks a limit
+        texts.append(optimized_module(r))  # raises if a written move breaks a limit
         rows.append(_row(label, r))
         results.append(r)
         print(rows[-1], flush=True)

@@ -118,9 +118,9 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
 
     bad = replace(result, limits_ok=False)
     with pytest.raises(LimitViolation, match="not written"):
-        optimized_module(bad, via_every=2)
+        optimized_module(bad)
     (tmp_path / "optimized.mod").write_text("old")
-    files = write_cycle_run(tmp_path, bad, via_every=2, pareto=None, write_rapid=True)
+    files = write_cycle_run(tmp_path, bad, pareto=None, write_rapid=True)
     assert "optimized.mod" not in files and not (tmp_path / "optimized.mod").exists()
     assert json.loads((tmp_path / "cycle.json").read_text())["rapid_refused"]
     # more cycle time never costs energy (each point: best combination within a larger budget)
@@ -252,7 +252,7 @@ def test_written_program_check_is_reported(tmp_path, robot):
 
     spec = resolve_module(parse_module(SMALL, path="small.mod"), robot)
     r, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, use_waits=True))
-    check = check_written(r, optimized_module(r, via_every=2))
+    check = check_written(r, optimized_module(r))
     tol = check["tolerances"]
     expected = (
         abs(check["cycle_diff_pct"]) <= tol["cycle_pct"]
@@ -265,7 +265,7 @@ def test_written_program_check_is_reported(tmp_path, robot):
     # the module written to the run folder says so in its header when it does not reproduce the plan
     from joulepath.program import write_cycle_run
 
-    files = write_cycle_run(tmp_path, r, via_every=2, pareto=None, write_rapid=True, write_anyway=True)
+    files = write_cycle_run(tmp_path, r, pareto=None, write_rapid=True, write_anyway=True)
     text = files["optimized.mod"].read_text()
     assert ("WARNING: run by joulepath's controller emulation" in text) == (not expected)
     assert (
@@ -297,7 +297,7 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):
     assert a.energy_J + b.energy_J == pytest.approx(whole, rel=1e-9)
     np.testing.assert_allclose(a.fine.qd[0], 0.0, atol=1e-9)  # the chain starts and ends at rest
     np.testing.assert_allclose(b.fine.qd[-1], 0.0, atol=1e-9)
-    text = optimized_module(result, via_every=2)
+    text = optimized_module(result)
     line = spec.steps[first].line
     via = [ln for ln in text.splitlines() if f"jpL{line}_" in ln and "MoveAbsJ" in ln]
     assert via and via[-1].rstrip().endswith("z20, tool0;")  # the program's own zone at the target

@@ -121,7 +121,6 @@ def cycle(
     files = write_cycle_run(
         out,
         result,
-        via_every=settings.via_every,
         pareto=front,
         write_rapid=rapid,
         cell=cell_data,

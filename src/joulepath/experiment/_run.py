@@ -1018,7 +1018,6 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
         files = write_cycle_run(
             folder,
             result,
-            via_every=settings.via_every,
             pareto=front,
             write_rapid=rapid,
             cell=cell_data,

@@ -66,9 +66,9 @@ class CycleSettings:
 
     ``cycle_time``: s, or None for the default program's cycle time. ``use_waits``:
     spend ``WaitTime`` slack on the moves. ``table_points``: durations solved per
-    move; ``via_every``: samples (25 ms) between the via points written per optimized
-    move. ``corridor_mm``: tool0 stays within this distance of the joint-interpolated
-    taught move (the path ``MoveJ`` itself follows) at every sample (None: none).
+    move; ``via_every``: average spacing, in 25 ms samples, of the via points written per
+    optimized move (:func:`joulepath.program._via.layout`). ``corridor_mm``: tool0 stays
+    within this distance of the joint-interpolated taught move (the path ``MoveJ`` itself follows) at every sample (None: none).
     ``cell``: obstacles every optimized move must clear (a move too close is solved
     again in corridors of 1/2, 1/4, 1/8 of ``corridor_mm``, else not used).
     ``warm_start``: start each solve of a move from its nearest solved duration
@@ -330,7 +330,8 @@ class CycleOptimizer:
             (float(e * STEP), self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
         )
 
-    def _chain_problem(self, i: int, T: float, corridor: float | None, knot_spacing: float) -> SplineProblem:
+    def _chain_problem(self, i: int, T: float) -> SplineProblem:
+        """The chain's problem at ``T``: fine knots, no corridor (its smoothest path is ``origin``)."""
         m0, m1 = self.by_index[i], self.by_index[self.chains[i][-1]]
         robot = self._robot(m0)
         g = self.settings.gradient
@@ -340,9 +341,8 @@ class CycleOptimizer:
             m1.path.q1,
             T,
             NOMINAL_FRICTION,
-            SplineBasis(T, knot_spacing=knot_spacing, degree=g.degree, dt=STEP),
+            SplineBasis(T, knot_spacing=g.knot_spacing, degree=g.degree, dt=STEP),
             check_factor=g.check_factor,
-            max_deviation_m=None if corridor is None else corridor / 1000,
             acceleration_limit=self._amax(robot),
             waypoints=self.waypoints(i, T),
         )
@@ -357,7 +357,7 @@ class CycleOptimizer:
         units = max(2 * n_legs + 2, int(np.floor(0.5 * upper / STEP)))
         while units * STEP < upper - 1e-9:
             T = units * STEP
-            problem = self._chain_problem(i, T, None, self.settings.gradient.knot_spacing)
+            problem = self._chain_problem(i, T)
             fine = problem.path(problem.origin, fine=True)
             if check_limits(robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok:
                 return round(T, 9)

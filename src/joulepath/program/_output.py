@@ -48,7 +48,7 @@ def _jt(q_deg: np.ndarray) -> str:
     return "[[" + ", ".join(_num(float(v)) for v in q_deg) + f"], [{ext}]]"
 
 
-def optimized_module(result: CycleResult, *, via_every: int) -> str:
+def optimized_module(result: CycleResult) -> str:
     """The module with each optimized move replaced by its via points; refused outside a limit."""
     spec = result.spec
     module = spec.module
@@ -313,7 +313,6 @@ def write_cycle_run(
     out: Path,
     result: CycleResult,
     *,
-    via_every: int,
     pareto: list[ParetoPoint] | None,
     write_rapid: bool,
     cell: Cell | None = None,
@@ -327,7 +326,7 @@ def write_cycle_run(
     text = refused = None
     if write_rapid:
         try:
-            text = optimized_module(result, via_every=via_every)
+            text = optimized_module(result)
         except LimitViolation as err:
             refused = str(err)
     check = check_written(result, text, cell) if text is not None else None
