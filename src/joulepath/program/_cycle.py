@@ -68,7 +68,8 @@ class CycleSettings:
     spend ``WaitTime`` slack on the moves. ``table_points``: durations solved per
     move; ``via_every``: average spacing, in 25 ms samples, of the via points written per
     optimized move (:func:`joulepath.program._via.layout`). ``corridor_mm``: tool0 stays
-    within this distance of the joint-interpolated taught move (the path ``MoveJ`` itself follows) at every sample (None: none).
+    within this distance of the joint-interpolated taught move (the path ``MoveJ`` itself
+    follows) at every sample (None: none).
     ``cell``: obstacles every optimized move must clear (a move too close is solved
     again in corridors of 1/2, 1/4, 1/8 of ``corridor_mm``, else not used).
     ``warm_start``: start each solve of a move from its nearest solved duration
