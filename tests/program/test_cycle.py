@@ -21,8 +21,8 @@ from joulepath.program import (
     resolve_module,
 )
 from joulepath.program._cycle import CycleOptimizer
-from joulepath.program._timing import FINE_DT, evaluate_cycle, standalone
 from joulepath.sim import ControllerConfig
+from joulepath.sim._timing import FINE_DT, evaluate_cycle, standalone
 
 SMALL = """MODULE Small
     CONST jointtarget jA := [[-30, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
@@ -313,9 +313,9 @@ def test_via_layout_of_a_gentle_move_is_run_as_planned(robot):
     """A minimum-jerk move (gentle at both ends) written as via points: the emulated controller keeps
     every corner, takes the planned time and stays on the path; the target is always a via point."""
     from joulepath.program._cycle import _energy
-    from joulepath.program._timing import _chain_profiles
-    from joulepath.program._via import _segment, layout
     from joulepath.sim import make_plant
+    from joulepath.sim._timing import _chain_profiles
+    from joulepath.sim._via import _segment, layout
     from joulepath.trajectory import minimum_jerk
 
     tool = np.eye(4)

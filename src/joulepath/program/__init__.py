@@ -15,8 +15,8 @@ from joulepath.program._model import Module, RapidError
 from joulepath.program._output import CYCLE_FILES, optimized_module, write_cycle_run
 from joulepath.program._parse import parse_module, read_module
 from joulepath.program._resolve import CycleSpec, read_cycle_program, read_cycle_toml, resolve_module
-from joulepath.program._timing import plan_cycle
 from joulepath.program._write import format_move, write_module
+from joulepath.sim._timing import plan_cycle
 
 __all__ = [
     "Breakdown",

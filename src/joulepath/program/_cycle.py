@@ -43,7 +43,8 @@ from joulepath.optimize._gradient import SplineProblem, optimize_spline, solve_m
 from joulepath.optimize._verify import shortest_feasible_duration, tcp_deviation_mm
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._resolve import CycleSpec, Step
-from joulepath.program._timing import (
+from joulepath.sim import ControllerConfig, Plant, make_plant
+from joulepath.sim._timing import (
     FINE_DT,
     PlannedCycle,
     PlannedMove,
@@ -51,8 +52,7 @@ from joulepath.program._timing import (
     plan_cycle,
     standalone,
 )
-from joulepath.program._via import layout as via_layout
-from joulepath.sim import ControllerConfig, Plant, make_plant
+from joulepath.sim._via import layout as via_layout
 from joulepath.trajectory import SplineBasis, Trajectory
 from joulepath.units import SAMPLE_PERIOD
 
@@ -67,7 +67,7 @@ class CycleSettings:
     ``cycle_time``: s, or None for the default program's cycle time. ``use_waits``:
     spend ``WaitTime`` slack on the moves. ``table_points``: durations solved per
     move; ``via_every``: average spacing, in 25 ms samples, of the via points written per
-    optimized move (:func:`joulepath.program._via.layout`). ``corridor_mm``: tool0 stays
+    optimized move (:func:`joulepath.sim._via.layout`). ``corridor_mm``: tool0 stays
     within this distance of the joint-interpolated taught move (the path ``MoveJ`` itself
     follows) at every sample (None: none).
     ``cell``: obstacles every optimized move must clear (a move too close is solved

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from joulepath.errors import InvalidInput
+from joulepath.sim._steps import SpeedData
 
 
 class RapidError(InvalidInput):
@@ -33,16 +34,6 @@ class RobTarget:
     quaternion: tuple[float, float, float, float]
     conf: tuple[int, int, int, int]
     external: tuple[float, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class SpeedData:
-    """``speeddata``: TCP speed (mm/s), reorientation (deg/s), external axes (mm/s, deg/s)."""
-
-    v_tcp: float
-    v_ori: float
-    v_leax: float
-    v_reax: float
 
 
 @dataclass(frozen=True, slots=True)

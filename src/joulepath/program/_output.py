@@ -18,8 +18,8 @@ from joulepath.errors import LimitViolation
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._cycle import CycleResult, ParetoPoint, Solved
 from joulepath.program._model import Move, WaitTime
-from joulepath.program._via import VIA_ZONE_MM
 from joulepath.program._write import _num, format_move, write_module
+from joulepath.sim._via import VIA_ZONE_MM
 
 CYCLE_FILES = ("cycle.json", "optimized.mod", "pareto.csv", "pareto.png", "optimized_cycle.csv")
 """Files ``joulepath cycle`` may write in its run folder (``optimized.mod`` only within every limit)."""
@@ -118,7 +118,7 @@ def _via_lines(
 
 
 VIA_ZONE = f"z{VIA_ZONE_MM:.0f}"
-"""Zone of the via points inside an optimized move (:data:`joulepath.program._via.VIA_ZONE_MM`)."""
+"""Zone of the via points inside an optimized move (:data:`joulepath.sim._via.VIA_ZONE_MM`)."""
 
 CHECK_TOLERANCES = {"cycle_pct": 2.0, "energy_pct": 3.0, "path_mm": 5.0}
 """How far the written module, run by the controller emulation, may depart from the plan."""
@@ -136,8 +136,8 @@ def check_written(result: CycleResult, text: str, cell: Cell | None = None) -> d
     from joulepath.program._cycle import _energy
     from joulepath.program._parse import parse_module
     from joulepath.program._resolve import resolve_module
-    from joulepath.program._timing import FINE_DT, _tcp, evaluate_cycle, plan_cycle, standalone
     from joulepath.sim import ControllerConfig, make_plant
+    from joulepath.sim._timing import FINE_DT, _tcp, evaluate_cycle, plan_cycle, standalone
 
     spec = result.spec
     config = ControllerConfig()
@@ -231,7 +231,7 @@ def cycle_json(
         "written_program_matches_plan": None if check is None else check["within_tolerances"],
         "written_program_note": "optimized_cycle_s and energy_optimized_J are those of the planned "
         "(optimized) motion; written_program_check is the written module run by the controller emulation "
-        "(timed fly-by via points, see joulepath.program._timing); when written_program_matches_plan is "
+        "(timed fly-by via points, see joulepath.sim._timing); when written_program_matches_plan is "
         "false the written program does not reproduce the plan within the tolerances and the savings "
         "claimed are not those of the written program",
         "shortest_cycle_s": result.shortest_cycle_s,

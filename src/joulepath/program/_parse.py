@@ -36,7 +36,6 @@ from joulepath.program._model import (
     Procedure,
     RapidError,
     RobTarget,
-    SpeedData,
     Statement,
     ToolData,
     Value,
@@ -45,6 +44,7 @@ from joulepath.program._model import (
     WhileTrue,
     ZoneData,
 )
+from joulepath.sim._steps import SpeedData
 
 READ_TYPES = ("jointtarget", "robtarget", "speeddata", "zonedata", "tooldata", "num")
 MOVES = ("MoveAbsJ", "MoveJ", "MoveL")

@@ -28,7 +28,6 @@ from joulepath.program._model import (
     Move,
     RapidError,
     RobTarget,
-    SpeedData,
     Statement,
     ToolData,
     Verbatim,
@@ -37,31 +36,7 @@ from joulepath.program._model import (
     ZoneData,
 )
 from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES, TOOL0, read_module
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Step:
-    """One step of the cycle.
-
-    ``kind`` is ``"move"``, ``"wait"`` or ``"fixed"`` (an instruction kept verbatim).
-    For a move: the joint target (rad), whether the TCP moves on a straight line
-    (``MoveL``), the speed, ``\\T`` (s), the zone radius (mm; None: a stop point), the
-    tool (TCP in m as a 4x4 flange-to-TCP transform) and the robot carrying its load.
-    """
-
-    kind: str
-    line: int
-    label: str
-    statement: Statement | None
-    q: FloatArray | None = None
-    linear: bool = False
-    speed: SpeedData | None = None
-    time_s: float | None = None
-    zone_mm: float | None = None
-    tcp: FloatArray | None = None
-    robot: Robot | None = None
-    seconds: float = 0.0
-    repeated: bool = False
+from joulepath.sim._steps import SpeedData, Step
 
 
 @dataclass(frozen=True, slots=True, eq=False)

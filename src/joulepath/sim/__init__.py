@@ -1,4 +1,11 @@
-"""Simulated data collection: an emulated ABB controller and two plants (sim twin, lab robot)."""
+"""The controller model and simulated data collection.
+
+One controller model (STYLE §15): the emulated ABB controller's moves
+(:mod:`joulepath.sim._controller`, :mod:`joulepath.sim._profile`), its timing of whole
+programs with zones, ``\\T`` and timed fly-by chains (:mod:`joulepath.sim._timing`), and
+where via points go so that it follows an optimized path (:mod:`joulepath.sim._via`);
+two plants (the sim twin and the emulated lab robot) and the measurement loop.
+"""
 
 from joulepath.sim._controller import (
     ControllerConfig,
@@ -18,6 +25,8 @@ from joulepath.sim._run import (
     simulate,
     simulate_plan,
 )
+from joulepath.sim._steps import SpeedData, Step, StepSequence
+from joulepath.sim._timing import PlannedCycle, evaluate_cycle, plan_cycle
 
 __all__ = [
     "ControllerConfig",
@@ -25,16 +34,22 @@ __all__ = [
     "Measured",
     "MotionPlan",
     "PLANTS",
+    "PlannedCycle",
     "Plant",
     "Segment",
     "SimulatedLog",
+    "SpeedData",
+    "Step",
+    "StepSequence",
     "THESIS_PLAN",
+    "evaluate_cycle",
     "evaluate_plan",
     "log_text",
     "log_times",
     "make_plant",
     "measure",
     "moves_text",
+    "plan_cycle",
     "plan_moves",
     "run_plant",
     "simulate",

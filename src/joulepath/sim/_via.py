@@ -2,7 +2,7 @@
 
 An optimized move (or a fly-by chain of them) is written as ``MoveAbsJ`` via points, each
 with ``\\T`` and a large zone; the controller runs such a chain as the emulation in
-:mod:`joulepath.program._timing` models it: constant joint velocity between the points,
+:mod:`joulepath.sim._timing` models it: constant joint velocity between the points,
 a corner path (velocity linear in time) inside each zone, the zone reduced to half the
 TCP distance to the nearest point, sin² ramps from and to rest at the acceleration limit.
 A corner the controller cannot keep (a joint over its acceleration limit in the corner,
@@ -25,11 +25,10 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
-from joulepath.program._model import SpeedData
-from joulepath.program._resolve import Step
-from joulepath.program._timing import SegmentPath, _chain_profiles, _tcp, fastest_profile, segment_path
-from joulepath.sim import ControllerConfig
+from joulepath.sim._controller import ControllerConfig
 from joulepath.sim._profile import Profile
+from joulepath.sim._steps import SpeedData, Step
+from joulepath.sim._timing import SegmentPath, _chain_profiles, _tcp, fastest_profile, segment_path
 from joulepath.trajectory import Trajectory
 
 VIA_ZONE_MM = 200.0

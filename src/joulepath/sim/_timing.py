@@ -44,9 +44,9 @@ from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
 from joulepath.kinematics._ik import solve_ik
-from joulepath.program._resolve import CycleSpec, Step
-from joulepath.sim import ControllerConfig
+from joulepath.sim._controller import ControllerConfig
 from joulepath.sim._profile import Profile, evaluate_profile, plan_profile, time_at_fraction
+from joulepath.sim._steps import Step, StepSequence
 from joulepath.trajectory import Trajectory
 
 LINE_POINTS = 64
@@ -221,7 +221,7 @@ def fastest_profile(step: Step, path: SegmentPath, config: ControllerConfig) -> 
 class PlannedMove:
     """A move of the planned cycle: its step, path, profile and start time (s)."""
 
-    index: int  # position in CycleSpec.steps
+    index: int  # position in StepSequence.steps
     step: Step
     path: SegmentPath
     profile: AnyProfile
@@ -243,11 +243,11 @@ class PlannedCycle:
     start: FloatArray
 
 
-def moves_of(spec: CycleSpec) -> list[int]:
+def moves_of(spec: StepSequence) -> list[int]:
     return [i for i, s in enumerate(spec.steps) if s.kind == "move"]
 
 
-def stops_after(spec: CycleSpec, i: int) -> bool:
+def stops_after(spec: StepSequence, i: int) -> bool:
     """Whether the robot stops at the end of move ``i``: fine, a wait next, or the end of the cycle."""
     step = spec.steps[i]
     if step.zone_mm is None:
@@ -359,7 +359,7 @@ def _chain_profiles(
     return profiles, None
 
 
-def plan_cycle(spec: CycleSpec, config: ControllerConfig) -> PlannedCycle:
+def plan_cycle(spec: StepSequence, config: ControllerConfig) -> PlannedCycle:
     """The controller's timing of one cycle (it starts at rest at ``spec.start``)."""
     q = spec.start
     plans: list[tuple[int, Step, SegmentPath, Profile, float, bool]] = []

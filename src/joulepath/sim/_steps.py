@@ -1,0 +1,61 @@
+"""What the controller emulation runs: the steps of a program (moves, waits) and their speed data.
+
+The RAPID reader (:mod:`joulepath.program`) resolves a module into these steps; the
+controller's timing (:mod:`joulepath.sim._timing`) runs them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import Robot
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedData:
+    """``speeddata``: TCP speed (mm/s), reorientation (deg/s), external axes (mm/s, deg/s)."""
+
+    v_tcp: float
+    v_ori: float
+    v_leax: float
+    v_reax: float
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Step:
+    """One step of the cycle.
+
+    ``kind`` is ``"move"``, ``"wait"`` or ``"fixed"`` (an instruction kept verbatim).
+    For a move: the joint target (rad), whether the TCP moves on a straight line
+    (``MoveL``), the speed, ``\\T`` (s), the zone radius (mm; None: a stop point), the
+    tool (TCP in m as a 4x4 flange-to-TCP transform) and the robot carrying its load.
+    """
+
+    kind: str
+    line: int
+    label: str
+    statement: Any
+    q: FloatArray | None = None
+    linear: bool = False
+    speed: SpeedData | None = None
+    time_s: float | None = None
+    zone_mm: float | None = None
+    tcp: FloatArray | None = None
+    robot: Robot | None = None
+    seconds: float = 0.0
+    repeated: bool = False
+
+
+class StepSequence(Protocol):
+    """What :func:`joulepath.sim.plan_cycle` runs: steps from a start configuration (rad)."""
+
+    @property
+    def steps(self) -> tuple[Step, ...]: ...
+
+    @property
+    def start(self) -> FloatArray: ...
+
+    @property
+    def source(self) -> str: ...
