@@ -55,3 +55,8 @@ ZONES: dict[str, float | None] = {
 
 EXTERNAL_AXES_UNUSED = "9E9"
 """The value RAPID uses for external axes that do not exist."""
+
+VIA_ZONE_MM = 200.0
+"""Zone (mm) of the via points joulepath writes inside an optimized move (``z200``): large, so
+that the controller reduces it to half the distance to the neighbouring via points and keeps
+speed through them (:mod:`joulepath.sim._via`)."""

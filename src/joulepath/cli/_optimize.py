@@ -137,6 +137,7 @@ def optimize(
         max_gen=generations,
         pop_size=population,
         seed=seed,
+        follow=exporter.follows,
     )
     if np.isfinite(duration) and 0 < duration <= MAX_DURATION:
         sample_times(duration)  # a whole number of samples: checked before any model is loaded
@@ -162,19 +163,34 @@ def optimize(
         console.print(f"REFUSED: {program} was NOT written: {why}")
         console.print(f"wrote {', '.join(sorted(files))} in {out}")
         return 1
-    console.print(
+    plan = (
         f"default path {s.energy_default_J:.3f} J, optimized {s.energy_optimized_J:.3f} J "
         f"on physics: {s.saved_pct:.1f} % saved at equal cycle time "
         f"({s.algorithm}, {s.iterations} iterations, {s.evaluations:,} evaluations, {s.wall_s:.2f} s); "
         f"within every limit; largest TCP deviation {s.max_tcp_deviation_mm:.1f} mm"
     )
+    if exporter.follows == "via-points":
+        import json
+
+        e = json.loads((out / "result.json").read_text())
+        console.print(
+            f"{program} as the controller emulation runs it: {e['executed_saved_pct']:.1f} % saved on "
+            f"physics ({e['executed_energy_default_J']:.3f} J -> {e['executed_energy_optimized_J']:.3f} J), "
+            f"{e['executed_saved_lab_pct']:.1f} % on the emulated lab robot; the optimized move takes "
+            f"{e['executed_duration_s']:.3f} s (planned {s.duration_s:g} s), {e['executed_via_points']} via "
+            f"points, TCP within {e['executed_tcp_deviation_mm']:.1f} mm of the plan"
+        )
+        console.print(f"the plan: {plan}")
+    else:
+        console.print(plan)
     if r.friction is None:
         console.print(f"physics: no friction modelled for {r.name}; friction: {r.friction_note}")
     if s.saved_lab_pct is not None:
+        what = "the plan" if exporter.follows == "via-points" else "the optimized path"
         if s.lab_plant.startswith("emulated IRB 120"):
-            console.print(f"on the emulated lab robot: {s.saved_lab_pct:.1f} % saved")
+            console.print(f"{what} on the emulated lab robot: {s.saved_lab_pct:.1f} % saved")
         else:
-            console.print(f"on a {s.lab_plant}: {s.saved_lab_pct:.1f} % saved")
+            console.print(f"{what} on a {s.lab_plant}: {s.saved_lab_pct:.1f} % saved")
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
     return 0
 

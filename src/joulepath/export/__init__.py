@@ -33,7 +33,12 @@ from joulepath.export._urscript import render_urscript, render_urscript_cb3, urs
 
 register_exporter(
     Exporter(
-        "rapid", "ABB", ("path.mod",), "ABB RAPID module (MoveAbsJ), default and optimized move", render_rapid
+        "rapid",
+        "ABB",
+        ("path.mod",),
+        "ABB RAPID module (MoveAbsJ), default and optimized move",
+        render_rapid,
+        follows="via-points",
     )
 )
 register_exporter(

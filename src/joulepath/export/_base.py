@@ -50,6 +50,11 @@ class Exporter:
     render : callable
         ``render(robot, trajectory, duration) -> {file name: text}``; raises
         ``LimitViolation`` for a path outside the robot's limits.
+    follows : {"samples", "via-points"}
+        How the controller runs the program: ``"samples"``, it follows the given samples
+        one by one (servoj, a JointTrajectory, a stream); ``"via-points"``, it plans its own
+        motion through the samples it is given as via points (RAPID ``MoveAbsJ``), so the
+        caller passes the via points the controller follows (:mod:`joulepath.optimize._execute`).
     """
 
     name: str
@@ -57,6 +62,7 @@ class Exporter:
     files: tuple[str, ...]
     description: str
     render: Render
+    follows: str = "samples"
 
 
 EXPORTERS: dict[str, Exporter] = {}

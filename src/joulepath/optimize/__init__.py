@@ -7,6 +7,7 @@ from joulepath.optimize._bench import (
     summarize_bench,
     thesis_configurations,
 )
+from joulepath.optimize._execute import EXECUTION_TOLERANCES, Execution, rapid_execution
 from joulepath.optimize._features import path_features
 from joulepath.optimize._gradient import GradientResult, GradientSettings, SplineProblem, optimize_spline
 from joulepath.optimize._problem import (
@@ -24,6 +25,7 @@ from joulepath.optimize._problem import (
 )
 from joulepath.optimize._run import (
     ACCEL_TIME,
+    FOLLOW,
     MAX_DURATION,
     RUN_FILES,
     MoveResult,
@@ -50,12 +52,13 @@ __all__ = [
     "ALGORITHMS",
     "AUTO",
     "AlgorithmSpec",
+    "EXECUTION_TOLERANCES",
+    "Execution",
     "FINE_FACTOR",
     "FITNESS",
     "FITNESS_KINDS",
+    "FOLLOW",
     "FitnessKind",
-    "fitness_kind",
-    "register_fitness",
     "GradientResult",
     "GradientSettings",
     "LimitExcess",
@@ -76,6 +79,7 @@ __all__ = [
     "check_default_feasible",
     "check_limits",
     "default_configuration",
+    "fitness_kind",
     "limit_violation",
     "optimize_move",
     "optimize_spline",
@@ -83,6 +87,8 @@ __all__ = [
     "physics_energy",
     "random_tasks",
     "rank_joints_by_energy",
+    "rapid_execution",
+    "register_fitness",
     "resolve_algorithm",
     "shortest_feasible_duration",
     "summarize_bench",

@@ -39,6 +39,10 @@ ACCEL_TIME = 0.25
 ``v_max / ACCEL_TIME`` that the emulated controller also assumes (ABB publishes none)."""
 
 
+FOLLOW = ("samples", "via-points")
+"""How a program's controller runs a path (:attr:`joulepath.export.Exporter.follows`)."""
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class OptimizeConfig:
     """Settings of one optimization.
@@ -55,6 +59,13 @@ class OptimizeConfig:
     ``rest_to_rest``) into the initial population of the evolutionary searches, so
     they never return a path their fitness rates worse than the default; the thesis'
     protocol (and ``bench-optimizers``) starts from random chromosomes only.
+
+    ``follow`` is how the program's controller runs the path (:attr:`Exporter.follows`):
+    ``"samples"`` (servoj, a JointTrajectory, EGM) follows the samples, so the path may use
+    the whole acceleration limit; ``"via-points"`` (RAPID ``MoveAbsJ`` via points) plans
+    the controller's own ramps from and to rest through them, so the path is planned within
+    :data:`joulepath.sim.RAPID_ACCEL_SHARE` of the acceleration limit, the share whose
+    first and last via segments fit the controller's ramp.
     """
 
     algorithm: str = AUTO
@@ -76,6 +87,7 @@ class OptimizeConfig:
     informed_joints: tuple[int, ...] = ()
     inject_default: bool = True
     seed: int = 0
+    follow: str = "samples"
 
     def __post_init__(self) -> None:
         if self.fitness not in FITNESS:
@@ -85,6 +97,8 @@ class OptimizeConfig:
             raise InvalidInput(
                 f"parametrization must be one of {PARAMETRIZATIONS}, got {self.parametrization!r}"
             )
+        if self.follow not in FOLLOW:
+            raise InvalidInput(f"follow must be one of {', '.join(FOLLOW)}, got {self.follow!r}")
         if self.pop_size < 4 or self.max_gen < 1:
             raise InvalidInput("pop_size must be ≥ 4 and max_gen ≥ 1")
         if not (np.isfinite(self.knot_spacing) and 0.02 <= self.knot_spacing <= 1.0):
@@ -282,6 +296,10 @@ def optimize_move(
         )
     joints = tuple(config.informed_joints) or joints_ranked or rank_joints_by_energy(robot, default)
     amax = acceleration_limit(robot, config.accel_time)
+    if amax is not None and config.follow == "via-points":
+        from joulepath.sim import RAPID_ACCEL_SHARE
+
+        amax = amax * RAPID_ACCEL_SHARE
     task = SearchTask(
         robot=robot,
         q_start=q0,
@@ -506,13 +524,24 @@ def write_run(
     summary["export"] = exporter.name
     programs: dict[str, str] = {}
     refused = None
+    execution = None
     if not s.limits_ok:
         refused = "the optimized path violates a limit: " + "; ".join(s.limit_excess)
     else:
         try:
-            programs = exporter.render(robot, result.optimized, s.duration_s)
+            written = result.optimized
+            if exporter.follows == "via-points":
+                from joulepath.optimize._execute import rapid_execution
+
+                exporter.render(robot, result.optimized, s.duration_s)  # the plan's own limit check
+                execution, written = rapid_execution(robot, result.optimized, s.energy_optimized_fine_J)
+                refused = execution.refusal()
+            if refused is None:
+                programs = exporter.render(robot, written, s.duration_s)
         except (LimitViolation, InvalidInput) as err:
             refused = str(err)
+    if execution is not None:
+        summary.update(execution.to_json())
     if refused is None:
         for name, text in programs.items():
             files[name] = atomic_write_text(out / name, text)

@@ -13,13 +13,12 @@ import numpy as np
 
 from joulepath import __version__
 from joulepath._io import atomic_write_text, finite_json
-from joulepath.abb import EXTERNAL_AXES_UNUSED
+from joulepath.abb import EXTERNAL_AXES_UNUSED, VIA_ZONE_MM
 from joulepath.errors import LimitViolation
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._cycle import CycleResult, ParetoPoint, Solved
 from joulepath.program._model import Move, WaitTime
 from joulepath.program._write import _num, format_move, write_module
-from joulepath.sim._via import VIA_ZONE_MM
 
 CYCLE_FILES = ("cycle.json", "optimized.mod", "pareto.csv", "pareto.png", "optimized_cycle.csv")
 """Files ``joulepath cycle`` may write in its run folder (``optimized.mod`` only within every limit)."""
@@ -118,7 +117,7 @@ def _via_lines(
 
 
 VIA_ZONE = f"z{VIA_ZONE_MM:.0f}"
-"""Zone of the via points inside an optimized move (:data:`joulepath.sim._via.VIA_ZONE_MM`)."""
+"""Zone of the via points inside an optimized move (:data:`joulepath.abb.VIA_ZONE_MM`)."""
 
 CHECK_TOLERANCES = {"cycle_pct": 2.0, "energy_pct": 3.0, "path_mm": 5.0}
 """How far the written module, run by the controller emulation, may depart from the plan."""

@@ -27,15 +27,18 @@ from joulepath.sim._run import (
 )
 from joulepath.sim._steps import SpeedData, Step, StepSequence
 from joulepath.sim._timing import PlannedCycle, evaluate_cycle, plan_cycle
+from joulepath.sim._via import RAPID_ACCEL_SHARE, FollowedPath, follow_path, timed_move
 
 __all__ = [
     "ControllerConfig",
+    "FollowedPath",
     "LabFriction",
     "Measured",
     "MotionPlan",
     "PLANTS",
     "PlannedCycle",
     "Plant",
+    "RAPID_ACCEL_SHARE",
     "Segment",
     "SimulatedLog",
     "SpeedData",
@@ -44,6 +47,7 @@ __all__ = [
     "THESIS_PLAN",
     "evaluate_cycle",
     "evaluate_plan",
+    "follow_path",
     "log_text",
     "log_times",
     "make_plant",
@@ -54,4 +58,5 @@ __all__ = [
     "run_plant",
     "simulate",
     "simulate_plan",
+    "timed_move",
 ]

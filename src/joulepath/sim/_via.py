@@ -20,20 +20,28 @@ What remains is checked by the caller, on the whole written program
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
 from joulepath._typing import FloatArray
+from joulepath.abb import VIA_ZONE_MM
 from joulepath.dynamics import Robot
 from joulepath.sim._controller import ControllerConfig
 from joulepath.sim._profile import Profile
 from joulepath.sim._steps import SpeedData, Step
-from joulepath.sim._timing import SegmentPath, _chain_profiles, _tcp, fastest_profile, segment_path
+from joulepath.sim._timing import (
+    FINE_DT,
+    SegmentPath,
+    _chain_profiles,
+    _tcp,
+    evaluate_cycle,
+    fastest_profile,
+    plan_cycle,
+    segment_path,
+)
 from joulepath.trajectory import Trajectory
 
-VIA_ZONE_MM = 200.0
-"""Zone of the via points (``z200``): large, so that the controller reduces it to half the
-distance to the neighbouring via points and keeps speed through them."""
 VIA_SPEED = SpeedData(7000.0, 500.0, 5000.0, 1000.0)
 """``v7000``: the speed data written with the via points (``\\T`` replaces it)."""
 MAX_MERGES = 400
@@ -134,3 +142,149 @@ def _segment(
     else:
         fastest = fastest_profile(step, path, config)
     return (n, step, path, fastest, 0.0, last)
+
+
+RAPID_ACCEL_SHARE = 3.0 / (2.0 * np.pi)
+"""Share of the controller's acceleration limit that a path written as via points may use.
+
+A timed chain starts and ends with the controller's own sin² ramp at its acceleration limit
+``a``, inside the first (last) segment of ``T`` s, and the corner to the next segment takes
+up to half of it (:func:`joulepath.sim._timing.chain_corners`). A path that accelerates
+from rest at ``a_p`` covers ``a_p T² / 2`` in its first segment; the controller's ramp
+``r = T - sqrt(T² - pi |dq| / a)`` fits before the corner (``r <= T / 2``) when
+``pi a_p / (2 a) <= 3/4``, i.e. ``a_p <= 3 a / (2 pi)`` (0.477 a)."""
+VIA_SPACINGS = (0.04, 0.05, 0.075, 0.1)
+"""s between via points tried by :func:`follow_path` (the layout the controller keeps best wins)."""
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FollowedPath:
+    """A path written as timed via points, and the motion the emulated controller makes of it.
+
+    ``indices``: the via points (sample indices into the planned path, its last sample the
+    target); ``spacing``: the mean spacing (s) the layout started from; ``executed``: the
+    commanded motion on a grid of ``dt`` from the first via move's start to the robot's stop
+    at the target (``executed_duration_s``); ``max_joint_deviation_rad``: the largest
+    difference between the planned and the executed joint positions at the same time.
+    """
+
+    indices: tuple[int, ...]
+    spacing: float
+    executed: Trajectory
+    executed_duration_s: float
+    max_joint_deviation_rad: float
+
+
+class _Steps:
+    """A :class:`~joulepath.sim.StepSequence` of loose steps."""
+
+    def __init__(self, steps: Sequence[Step], start: FloatArray, source: str) -> None:
+        self.steps = tuple(steps)
+        self.start = np.asarray(start, dtype=float)
+        self.source = source
+
+
+def _run(
+    robot: Robot, steps: Sequence[Step], start: FloatArray, config: ControllerConfig, dt: float
+) -> tuple[float, Trajectory]:
+    plan = plan_cycle(_Steps(steps, start, "the written program"), config)
+    end = plan.moves[-1].t_end
+    n = max(2, int(np.ceil(end / dt)) + 1)
+    return end, evaluate_cycle(plan, np.linspace(0.0, end, n))
+
+
+def timed_move(
+    robot: Robot,
+    q_start: FloatArray,
+    q_end: FloatArray,
+    duration: float,
+    *,
+    config: ControllerConfig | None = None,
+    dt: float = FINE_DT,
+) -> tuple[float, Trajectory]:
+    """``MoveAbsJ q_end, v7000 \\T:=duration, fine`` from rest at ``q_start``: the controller's
+    own move in (at least) ``duration`` s, as it runs it (its duration and motion on ``dt``)."""
+    step = Step(
+        kind="move",
+        line=1,
+        label="MoveAbsJ \\T",
+        statement=None,
+        q=np.asarray(q_end, dtype=float),
+        speed=VIA_SPEED,
+        time_s=float(duration),
+        zone_mm=None,
+        tcp=np.eye(4),
+        robot=robot,
+    )
+    return _run(robot, [step], np.asarray(q_start, dtype=float), config or ControllerConfig(), dt)
+
+
+def via_steps(
+    robot: Robot, path: Trajectory, indices: Sequence[int], *, tcp: FloatArray | None = None
+) -> list[Step]:
+    """The ``MoveAbsJ`` via moves (``\\T``, ``z200``, the last ``fine``) through ``path``'s samples."""
+    tool = np.eye(4) if tcp is None else tcp
+    steps, prev = [], 0.0
+    for k, i in enumerate(indices):
+        last = k == len(indices) - 1
+        steps.append(
+            Step(
+                kind="move",
+                line=k + 1,
+                label=f"via {k + 1}",
+                statement=None,
+                q=path.q[i],
+                speed=VIA_SPEED,
+                time_s=float(path.t[i]) - prev,
+                zone_mm=None if last else VIA_ZONE_MM,
+                tcp=tool,
+                robot=robot,
+            )
+        )
+        prev = float(path.t[i])
+    return steps
+
+
+def follow_path(
+    robot: Robot,
+    path: Trajectory,
+    *,
+    config: ControllerConfig | None = None,
+    spacings: Sequence[float] = VIA_SPACINGS,
+    dt: float = FINE_DT,
+) -> FollowedPath:
+    """The via-point layout of a rest-to-rest path that the emulated controller follows most closely.
+
+    Each spacing of ``spacings`` is laid out (:func:`layout`, one move from rest to rest),
+    written as :func:`via_steps` and run by the controller emulation; the layout whose
+    executed motion stays closest to the plan (largest joint deviation at the same time,
+    then the duration) is returned with its executed motion.
+    """
+    cfg = config or ControllerConfig()
+    tcp = np.eye(4)
+    best: FollowedPath | None = None
+    for spacing in spacings:
+        idx = layout(robot, tcp, [path], spacing=spacing, config=cfg, target_zones=[None])[0]
+        end, executed = _run(robot, via_steps(robot, path, idx), path.q[0], cfg, dt)
+        planned = _interpolate(path, np.minimum(executed.t, float(path.t[-1])))
+        dev = float(np.abs(planned - executed.q).max())
+        candidate = FollowedPath(tuple(idx), float(spacing), executed, float(end), dev)
+        score = (round(dev, 6), abs(end - float(path.t[-1])))
+        if best is None or score < (
+            round(best.max_joint_deviation_rad, 6),
+            abs(best.executed_duration_s - float(path.t[-1])),
+        ):
+            best = candidate
+    assert best is not None
+    return best
+
+
+def _interpolate(path: Trajectory, t: FloatArray) -> FloatArray:
+    """The path's positions at ``t``: quintic Hermite through its samples (q, qd, qdd)."""
+    from scipy.interpolate import BPoly
+
+    x = np.asarray(path.t, dtype=float)
+    y = np.stack([path.q, path.qd, path.qdd], axis=1)  # (n, 3, joints)
+    poly = BPoly.from_derivatives(x, y)
+    out: FloatArray = poly(t)
+    return out
