@@ -116,13 +116,15 @@ def test_rapid_path_mod_reads_back_to_path_csv(irb120, tmp_path):
     q_deg = np.degrees(columns(path, "q", 6))
     targets = re.findall(r"\[\[([-\d., ]+)\], \[[^\]]+\]\]", text.split("CONST jointtarget OPT")[1])
     opt = np.array([[float(v) for v in t.split(",")] for t in targets])
-    n = len(path)
-    idx = [*range(4, n - 1, 4), n - 1]
+    times = re.search(r"OPT_T\{\d+\} := \[(.*?)\];", text, re.S).group(1)
+    seg = np.array([float(v) for v in times.replace("\n", " ").split(",")])
+    assert seg.sum() == pytest.approx(1.5, abs=1e-3) and len(seg) == len(opt) == summary["executed_via_points"]
+    # every via point is the planned path's sample at the via point's time (laid out by sim.follow_path)
+    idx = np.round(np.cumsum(seg) / 0.025).astype(int)
+    assert np.all(np.diff(idx) > 0) and idx[-1] == len(path) - 1
     np.testing.assert_allclose(opt, q_deg[idx], atol=5e-5 + 1e-9)  # 4 decimals of a degree
     start = re.search(r"CONST jointtarget START := \[\[([-\d., ]+)\]", text).group(1)
     np.testing.assert_allclose([float(v) for v in start.split(",")], q_deg[0], atol=5e-5 + 1e-9)
-    times = re.search(r"OPT_T\{\d+\} := \[(.*?)\];", text, re.S).group(1)
-    assert sum(float(v) for v in times.replace("\n", " ").split(",")) == pytest.approx(1.5, abs=1e-3)
 
 
 @pytest.mark.parametrize(("name", "period"), [("urscript", E_SERIES_PERIOD), ("urscript-cb3", CB3_PERIOD)])
