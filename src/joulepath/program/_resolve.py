@@ -2,7 +2,9 @@
 
 The cycle is the body of ``main``'s ``WHILE TRUE`` loop, or ``main``'s body when there is
 no loop; calls of the module's procedures are followed (their statements join the
-cycle where the call stands). The robot starts each cycle where the previous one ended:
+cycle where the call stands), and FOR loops with moves are unrolled (each run's
+statements in turn; a move inside a loop that runs more than once is ``repeated``).
+The robot starts each cycle where the previous one ended:
 at the last move's target. Robtargets are solved with the closed-form inverse
 kinematics, choosing the solution their ``confdata`` names; a tool's TCP and load
 are taken into account (targets are TCP poses, the load is carried in the dynamics).
@@ -23,6 +25,7 @@ from joulepath.kinematics import quaternion_to_rotation
 from joulepath.kinematics._ik import check_layout, confdata, solve_ik
 from joulepath.program._model import (
     Call,
+    ForLoop,
     JointTarget,
     Module,
     Move,
@@ -101,13 +104,26 @@ def _flatten(module: Module, body: tuple[Statement, ...]) -> list[Statement]:
             out.extend(_flatten(module, proc.body))
         elif isinstance(s, WhileTrue):
             out.extend(_flatten(module, s.body))
+        elif isinstance(s, ForLoop):  # unrolled: every run in order
+            for run in s.runs:
+                out.extend(_flatten(module, run))
         else:
             out.append(s)
     return out
 
 
 def _lookup(module: Module, name: str, type_: str, line: int) -> object:
-    d = module.declaration(name)
+    base, _, index = name.partition("{")  # an array element, checked when read: NAME{k}
+    d = module.declaration(base)
+    if d is not None and index:
+        if d.type != type_:
+            raise module.error(
+                line, f"{base} is a {d.type} array (line {d.line}), but a {type_} is needed here"
+            )
+        assert isinstance(d.value, tuple)
+        return d.value[int(index.rstrip("}")) - 1]
+    if d is not None and isinstance(d.value, tuple):
+        raise module.error(line, f"{name} is an array (line {d.line}); name one element, e.g. {name}{{1}}")
     if d is None:
         if type_ == "speeddata" and name.lower() in PREDEFINED_SPEEDS:
             return PREDEFINED_SPEEDS[name.lower()]
