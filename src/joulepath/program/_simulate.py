@@ -21,11 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from joulepath._io import make_folder
+from joulepath._io import atomic_write_text, make_folder
 from joulepath._typing import FloatArray
-from joulepath.data import write_controller_log
-from joulepath.description import DEFAULT_ROBOT
-from joulepath.dynamics import Robot, load_robot
+from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
 from joulepath.program._parse import read_module
 from joulepath.program._resolve import CycleSpec, resolve_module
@@ -105,8 +103,8 @@ def simulate_program(
     program: str | os.PathLike[str],
     out: str | os.PathLike[str],
     *,
+    robot: Robot,
     plant: str = "lab",
-    robot: str = DEFAULT_ROBOT,
     seed: int = 0,
     start: FloatArray | None = None,
     config: ControllerConfig | None = None,
@@ -121,10 +119,10 @@ def simulate_program(
         ``path.mod`` of ``joulepath optimize`` or the ``optimized.mod`` of ``joulepath cycle``.
     out : path
         The controller log (CSV) to write, atomically.
+    robot : Robot
+        The robot the program drives (``joulepath.load_robot``).
     plant : str
         ``"sim"``, ``"lab"`` or a twin folder (:func:`joulepath.sim.make_plant`).
-    robot : str
-        The robot the program drives.
     seed : int
         Seed of the measurement loop's jitter and of the plant's noise.
     start : ndarray of shape (n_joints,), optional
@@ -141,7 +139,7 @@ def simulate_program(
     InvalidInput
         A start outside the joint ranges, an unknown plant.
     """
-    r = load_robot(robot)
+    r = robot
     config = config or ControllerConfig()
     q0 = None if start is None else _check_start(r, start)
     spec = resolve_module(read_module(program), r)
@@ -152,7 +150,7 @@ def simulate_program(
     measured = run_plant(the_plant, motion, t, rng=rng)
     path = Path(out)
     make_folder(path.parent)
-    write_controller_log(path, log_text(r, measured))
+    atomic_write_text(path, log_text(r, measured))
     return ProgramRun(
         log=path,
         n_rows=int(t.size),
