@@ -16,6 +16,7 @@ and after the last, as :func:`joulepath.sim.simulate` does.
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -82,7 +83,7 @@ def program_motion(
     return ProgramMotion(plan, config.idle)
 
 
-def _check_start(robot: Robot, start: FloatArray) -> FloatArray:
+def _check_start(robot: Robot, start: FloatArray | Sequence[float]) -> FloatArray:
     q = np.asarray(start, dtype=float)
     if q.shape != (robot.n_joints,) or not np.all(np.isfinite(q)):
         raise InvalidInput(
@@ -106,7 +107,7 @@ def simulate_program(
     robot: Robot,
     plant: str = "lab",
     seed: int = 0,
-    start: FloatArray | None = None,
+    start: FloatArray | Sequence[float] | None = None,
     config: ControllerConfig | None = None,
     instance_seed: int = 120,
 ) -> ProgramRun:
@@ -142,7 +143,7 @@ def simulate_program(
     r = robot
     config = config or ControllerConfig()
     q0 = None if start is None else _check_start(r, start)
-    spec = resolve_module(read_module(program), r)
+    spec = resolve_module(read_module(Path(program)), r)
     motion = program_motion(spec, config, start=q0)
     the_plant = make_plant(plant, r, instance_seed=instance_seed)
     rng = np.random.default_rng(seed)
