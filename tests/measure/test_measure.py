@@ -96,6 +96,13 @@ def test_measure_reports_the_executed_against_the_planned_duration(measured):
     assert m.planned_duration_s == 1.6
     assert m.default.executed_over_planned == pytest.approx(m.default.duration_mean_s / 1.6)
     assert m.default.duration_mean_s == pytest.approx(1.6, abs=3 * m.sample_period_s)  # MoveAbsJ \T keeps it
+    off = {
+        kind: abs(k.executed_over_planned - 1.0) > 0.05
+        for kind, k in (("default", m.default), ("optimized", m.optimized))
+    }
+    assert off["default"] is False
+    for kind in ("default", "optimized"):
+        assert any(n.startswith(f"the {kind} move ran") for n in m.notes) == off[kind]
     for r in m.repetitions:
         assert (r.tracking_error_max_deg is None) == (r.kind == "default")
         if r.kind == "optimized":

@@ -39,5 +39,7 @@ def measure(
         f"executed {m.default.duration_mean_s:.2f} s (default) and {m.optimized.duration_mean_s:.2f} s "
         f"(optimized) for a planned {m.planned_duration_s:g} s"
     )
+    for note in m.notes:
+        console.print(f"note: {note}")
     console.print(f"wrote {files['measure.json']} and {files['power.png']}")
     return 0

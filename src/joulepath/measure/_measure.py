@@ -32,6 +32,8 @@ ENERGY_DEFINITION = (
 )
 SHAPE_MARGIN = 2.0
 """A move is told default or optimized by its path when one planned path is this many times closer."""
+DURATION_TOL = 0.05
+"""A kind whose mean executed duration is off its planned one by more than this share gets a note."""
 MATCH_TOL_DEG = 3.0
 """A move whose path is farther than this (mean, deg) from both planned paths is not a move of the plan."""
 
@@ -92,6 +94,7 @@ class Measurement:
     optimized: KindSummary
     saving: Saving
     planned: dict[str, float | None]
+    notes: tuple[str, ...] = ()
 
     def to_json(self) -> dict[str, Any]:
         """Plain JSON types; non-finite numbers become ``null``."""
@@ -259,6 +262,16 @@ def measure_run(log: str | os.PathLike[str], plan: str | os.PathLike[str]) -> Me
         np.array([r.energy_J for r in default]), np.array([r.energy_J for r in optimized])
     )
     half = len(reps) // 2
+    summaries = {
+        "default": _summary(default, the_plan.duration_s),
+        "optimized": _summary(optimized, the_plan.duration_s),
+    }
+    notes = tuple(
+        f"the {kind} move ran {k.duration_mean_s:.2f} s, {k.executed_over_planned:.2f} x its planned "
+        f"{the_plan.duration_s:g} s: the saving is not at the planned cycle time"
+        for kind, k in summaries.items()
+        if abs(k.executed_over_planned - 1.0) > DURATION_TOL
+    )
     measurement = Measurement(
         log=source,
         plan=str(the_plan.folder),
@@ -269,10 +282,11 @@ def measure_run(log: str | os.PathLike[str], plan: str | os.PathLike[str]) -> Me
         order_as_path_mod=all(r.kind == ("default" if r.index <= half else "optimized") for r in reps),
         energy_definition=ENERGY_DEFINITION,
         repetitions=tuple(reps),
-        default=_summary(default, the_plan.duration_s),
-        optimized=_summary(optimized, the_plan.duration_s),
+        default=summaries["default"],
+        optimized=summaries["optimized"],
         saving=saving,
         planned=the_plan.planned,
+        notes=notes,
     )
     return MeasureRun(measurement, the_log, tuple(windows))
 
