@@ -89,6 +89,31 @@ def test_loop_that_runs_once_is_not_repeated(robot):
     assert [(m.label, m.repeated) for m in moves] == [("MoveAbsJ J{1}", False)]
 
 
+def test_arrays_of_predefined_speeds_and_zones_indexed_through_an_index_array(robot):
+    decl = (
+        "    CONST speeddata SPEEDS{2} := [v100, v7000];\n"
+        "    CONST zonedata ZONES{2} := [fine, z50];\n"
+        "    CONST num PICK{3} := [2, 1, 2];\n"
+    )
+    body = (
+        "        FOR k FROM 1 TO 3 DO\n"
+        "            MoveAbsJ J{k}, SPEEDS{PICK{k}}, ZONES{PICK{4 - 1}}, tool0;\n"
+        "        ENDFOR\n"
+    )
+    with pytest.raises(RapidError, match=r"loops.mod:13: the index '4 - 1'"):
+        _moves(_module(body, decl=decl), robot)
+    moves = _moves(_module(body.replace("4 - 1", "k"), decl=decl), robot)
+    assert [m.statement.speed for m in moves] == ["SPEEDS{2}", "SPEEDS{1}", "SPEEDS{2}"]
+    assert [m.speed.v_tcp for m in moves] == [7000.0, 100.0, 7000.0]
+    assert [m.zone_mm for m in moves] == [50.0, None, 50.0]  # z50, fine, z50
+
+
+def test_array_of_speeds_names_only_predefined_data(robot):
+    decl = "    CONST speeddata SPEEDS{2} := [v100, vFast];\n"
+    with pytest.raises(RapidError, match=r"loops.mod:8: element 2 of SPEEDS is 'vFast'"):
+        parse_module(_module(LOOP, decl=decl), path="loops.mod")
+
+
 def test_for_loop_round_trips_unchanged():
     text = _module(LOOP)
     assert write_module(parse_module(text, path="loops.mod")) == text

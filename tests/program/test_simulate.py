@@ -91,3 +91,22 @@ def test_simulate_program_refuses_an_unreadable_module(tmp_path, robot):
     with pytest.raises(RapidError, match=r"bad.mod:5: the FOR loop's TO 'n'"):
         simulate_program(bad, tmp_path / "log.csv", robot=robot)
     assert not (tmp_path / "log.csv").exists()
+
+
+def test_collection_program_in_table_mode_runs_as_simulate_draws_it(tmp_path, robot):
+    """JPCollect.mod (table mode) as a program: the moves and times ``simulate --seed`` runs."""
+    from joulepath.export import collection_programs, draw_moves
+    from joulepath.sim import plan_moves
+
+    path = tmp_path / "JPCollect.mod"
+    path.write_text(collection_programs(robot, n_moves=12, mode="table", seed=4)["JPCollect.mod"])
+    config = ControllerConfig()
+    drawn = draw_moves(robot, 12, range_set="collection", rng=np.random.default_rng(4))
+    direct = plan_moves(robot, robot.home, drawn, config)
+    spec = resolve_module(read_module(path), robot)
+    program = program_motion(spec, config, start=robot.home)
+    assert len(program.plan.moves) == len(direct.segments) == 12
+    for seg, move in zip(direct.segments, program.plan.moves, strict=True):
+        np.testing.assert_allclose(move.step.q, seg.move.target, atol=1e-5)  # 4 decimals of a degree
+        assert move.t0 + program.offset == pytest.approx(seg.t0, abs=1e-3)
+        assert move.t_end + program.offset == pytest.approx(seg.t_end, abs=1e-3)

@@ -6,11 +6,14 @@ Read (and checked): ``MODULE`` / ``ENDMODULE``; ``PROC name()`` / ``ENDPROC``;
 ``MoveAbsJ`` / ``MoveJ`` / ``MoveL`` with ``\\V``, ``\\T``, ``\\Z``, ``\\WObj:=wobj0``
 (and ``\\NoEOffs`` on ``MoveAbsJ``); ``WaitTime``; ``WHILE TRUE DO`` in ``main``;
 calls of the module's procedures without arguments; one-dimensional arrays of
-``jointtarget``, ``robtarget`` and ``num`` (``CONST jointtarget OPT{3} := [...]``);
+``jointtarget``, ``robtarget`` and ``num`` (``CONST jointtarget OPT{3} := [...]``), and
+of ``speeddata`` / ``zonedata`` (literal values or predefined names: ``[v100, v7000]``);
 ``FOR i FROM a TO b [STEP s] DO`` with moves or calls inside, when its bounds are
 whole numbers or ``CONST num``: the loop is unrolled (its body read once per value
 of ``i``), and ``i`` may index the arrays (``MoveAbsJ OPT{i}, v1000 \\T:=OPT_T{i}, ...``).
-Indices are whole numbers, ``CONST num`` or the variables of the FOR loops around.
+Indices are whole numbers, ``CONST num``, the variables of the FOR loops around or
+elements of ``CONST num`` arrays (``SPEED_ARR{SPEED_IDX{i}}``, as ``JPCollect.mod`` in
+table mode writes).
 
 Kept verbatim, their run time treated as fixed: every other instruction
 (``SetDO``, ``WaitDI``, ``TPWrite`` ...), declarations of other types, ``FUNC`` and
@@ -386,8 +389,28 @@ def _declaration(path: str, unit: Unit) -> Declaration | None:
     return Declaration(unit.line, unit.end_line, storage.upper(), type_l, name, parsed)
 
 
-ARRAY_TYPES = ("jointtarget", "robtarget", "num")
+ARRAY_TYPES = ("jointtarget", "robtarget", "num", "speeddata", "zonedata")
 """Types whose one-dimensional arrays are read (their elements are indexed by a FOR loop's variable)."""
+_NAME_LIST = re.compile(r"^\s*\[\s*([A-Za-z]\w*(?:\s*,\s*[A-Za-z]\w*)*)\s*\]\s*$", re.DOTALL)
+
+
+def _predefined_list(path: str, line: int, type_: str, name: str, text: str) -> list[Value] | None:
+    """``[v100, v200, ...]`` / ``[fine, z10, ...]``: predefined data by name; None: not such a list."""
+    m = _NAME_LIST.match(text)
+    if m is None or type_ not in ("speeddata", "zonedata"):
+        return None
+    table: dict[str, SpeedData] | dict[str, ZoneData] = (
+        PREDEFINED_SPEEDS if type_ == "speeddata" else PREDEFINED_ZONES
+    )
+    out: list[Value] = []
+    for k, item in enumerate(re.split(r"\s*,\s*", m.group(1).strip())):
+        if item.lower() not in table:
+            raise RapidError(
+                f"{path}:{line}: element {k + 1} of {name} is {item!r}; an array of {type_} holds predefined "
+                f"names ({'v5 .. v7000' if type_ == 'speeddata' else 'fine, z0 .. z200'}) or literal values"
+            )
+        out.append(table[item.lower()])
+    return out
 
 
 def _array_declaration(
@@ -410,8 +433,9 @@ def _array_declaration(
         if type_ == "num":
             return None
         raise RapidError(f"{path}:{unit.line}: {type_} {name}{{{n}}} has no value; give it one with := [...]")
+    named = _predefined_list(path, unit.line, type_, name, value)
     try:
-        agg = _aggregate(path, unit.line, value)
+        agg = _aggregate(path, unit.line, value) if named is None else named
     except RapidError:
         if type_ == "num":  # an expression: kept verbatim, refused only where a move needs it
             return None
@@ -419,6 +443,8 @@ def _array_declaration(
     if not isinstance(agg, list) or len(agg) != n:
         got = len(agg) if isinstance(agg, list) else "not a list"
         raise RapidError(f"{path}:{unit.line}: {name}{{{n}}} needs [{n} elements], got {got}")
+    if named is not None:
+        return Declaration(unit.line, unit.end_line, storage.upper(), type_, name, tuple(named))
     items = tuple(
         _value_of(path, unit.line, type_, item, f"{name}{{{k + 1}}} = {item}") for k, item in enumerate(agg)
     )
@@ -487,10 +513,12 @@ _ELEMENT = re.compile(r"^([A-Za-z]\w*)\s*\{\s*(.*?)\s*\}$", re.DOTALL)
 
 
 def _index(path: str, line: int, text: str, names: Names) -> int:
-    """An array index: a whole number, a ``CONST num`` or a FOR loop's variable."""
+    """An array index: a number, a ``CONST num``, a FOR loop's variable or an element of a CONST num array."""
     text = text.strip()
     value: float | None = None
-    if _NUMBER.fullmatch(text):
+    if _ELEMENT.match(text):
+        value = _number(path, line, text, names, f"the index {text!r}")
+    elif _NUMBER.fullmatch(text):
         value = float(text)
     elif _IDENT.match(text) and text.lower() in names.loop:
         value = float(names.loop[text.lower()])
@@ -498,8 +526,8 @@ def _index(path: str, line: int, text: str, names: Names) -> int:
         value = names.nums[text.lower()]
     if value is None:
         raise RapidError(
-            f"{path}:{line}: the index {text!r} must be a number, a CONST num or the variable of a FOR "
-            "loop around it (expressions are not read)"
+            f"{path}:{line}: the index {text!r} must be a number, a CONST num, the variable of a FOR "
+            "loop around it or an element of a CONST num array (expressions are not read)"
         )
     if value != round(value):
         raise RapidError(f"{path}:{line}: the index {text!r} = {value:g} is not a whole number")
@@ -565,7 +593,7 @@ def _move(path: str, unit: Unit, names: Names) -> Move:
                 raise RapidError(
                     f"{path}:{unit.line}: {instr} argument \\{sw} (on the {what}) is not supported; remove it"
                 )
-        at = element(path, unit.line, primary, names) if what == "target" else None
+        at = element(path, unit.line, primary, names) if what != "tool" else None
         if at is not None:
             primary = f"{at[0]}{{{at[1]}}}"  # the element this run of the loops names
         elif not _IDENT.match(primary):
