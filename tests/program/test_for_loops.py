@@ -114,6 +114,28 @@ def test_array_of_speeds_names_only_predefined_data(robot):
         parse_module(_module(LOOP, decl=decl), path="loops.mod")
 
 
+def test_for_loop_that_never_runs_adds_no_step(robot):
+    body = LOOP.replace("FROM 1 TO N", "FROM 2 TO 1") + "        MoveAbsJ J{3}, v1000, fine, tool0;\n"
+    main = parse_module(_module(body), path="loops.mod").procedure("main")
+    assert isinstance(main.body[0], ForLoop) and main.body[0].runs == ()
+    assert [m.label for m in _moves(_module(body), robot)] == ["MoveAbsJ J{3}"]
+
+
+def test_loops_of_calls_of_loops_are_refused_before_they_blow_up(robot):
+    body = "        FOR i FROM 1 TO 9000 DO\n            Visit;\n        ENDFOR\n"
+    text = _module(body).replace(
+        "ENDMODULE\n",
+        "    PROC Visit()\n"
+        "        FOR k FROM 1 TO 9000 DO\n"
+        "            MoveAbsJ J{1}, v1000, fine, tool0;\n"
+        "        ENDFOR\n"
+        "    ENDPROC\n"
+        "ENDMODULE\n",
+    )
+    with pytest.raises(RapidError, match=r"^loops.mod:8: main runs more than 200000 statements"):
+        resolve_module(parse_module(text, path="loops.mod"), robot)
+
+
 def test_for_loop_round_trips_unchanged():
     text = _module(LOOP)
     assert write_module(parse_module(text, path="loops.mod")) == text

@@ -740,13 +740,14 @@ class _Reader:
         first, last, step = bounds
         if step == 0:
             raise self.fail(u.line, "the FOR loop's STEP is 0; the loop would never end")
-        values = tuple(range(first, last + (1 if step > 0 else -1), step))
-        if len(values) > MAX_RUNS or self.unrolled + len(values) > MAX_UNROLLED:
+        runs_of = range(first, last + (1 if step > 0 else -1), step)  # its length without building it
+        if len(runs_of) > MAX_RUNS or self.unrolled + len(runs_of) > MAX_UNROLLED:
             raise self.fail(
                 u.line,
-                f"the FOR loop runs {len(values)} times; at most {MAX_RUNS} runs per loop and "
+                f"the FOR loop runs {len(runs_of)} times; at most {MAX_RUNS} runs per loop and "
                 f"{MAX_UNROLLED} in the module are unrolled; run fewer",
             )
+        values = tuple(runs_of)
         self.unrolled += len(values)
         if var.lower() in self.names.loop:
             raise self.fail(u.line, f"the FOR variable {var} is already the variable of a loop around it")

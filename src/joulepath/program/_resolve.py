@@ -95,6 +95,32 @@ def target_pose(target: RobTarget) -> FloatArray:
     return out
 
 
+MAX_STEPS = 200_000
+"""Most statements a program's run may unroll into (calls and FOR loops followed)."""
+
+
+def _size(module: Module, body: tuple[Statement, ...], memo: dict[str, int]) -> int:
+    """How many statements :func:`_flatten` gives, without building them (each procedure counted once)."""
+    n = 0
+    for s in body:
+        if isinstance(s, Call):
+            key = s.name.lower()
+            if key not in memo:
+                proc = module.procedure(s.name)
+                assert proc is not None
+                memo[key] = _size(module, proc.body, memo)
+            n += memo[key]
+        elif isinstance(s, WhileTrue):
+            n += _size(module, s.body, memo)
+        elif isinstance(s, ForLoop):
+            n += sum(_size(module, run, memo) for run in s.runs)
+        else:
+            n += 1
+        if n > MAX_STEPS:
+            return n
+    return n
+
+
 def _flatten(module: Module, body: tuple[Statement, ...]) -> list[Statement]:
     out: list[Statement] = []
     for s in body:
@@ -145,6 +171,13 @@ def resolve_module(module: Module, robot: Robot) -> CycleSpec:
     assert main is not None
     loop = next((s for s in main.body if isinstance(s, WhileTrue)), None)
     body = loop.body if loop is not None else main.body
+    size = _size(module, body, {})
+    if size > MAX_STEPS:
+        raise module.error(
+            main.line,
+            f"main runs more than {MAX_STEPS} statements once its calls and FOR loops are unrolled; "
+            "run fewer repetitions",
+        )
     flat = _flatten(module, body)
     lo, hi = robot.joint_ranges()
     counts: dict[int, int] = {}
