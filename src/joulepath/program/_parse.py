@@ -498,14 +498,12 @@ class Names:
     """What a number or an index may name while a routine is read.
 
     ``nums``: the module's ``CONST num`` (lower-case names); ``arrays``: its arrays
-    (``type``, elements); ``loop``: the variables of the FOR loops being unrolled
-    around the statement, bound to their value in this run.
+    as (storage, type, elements); ``loop``: the variables of the FOR loops being
+    unrolled around the statement, bound to their value in this run.
     """
 
     nums: dict[str, float] = field(default_factory=dict)
-    arrays: dict[str, tuple[str, str, tuple[Value, ...]]] = field(
-        default_factory=dict
-    )  # (storage, type, items)
+    arrays: dict[str, tuple[str, str, tuple[Value, ...]]] = field(default_factory=dict)
     loop: dict[str, int] = field(default_factory=dict)
 
 
@@ -534,7 +532,7 @@ def _index(path: str, line: int, text: str, names: Names) -> int:
     return int(round(value))
 
 
-def element(path: str, line: int, text: str, names: Names) -> tuple[str, int] | None:
+def _array_element(path: str, line: int, text: str, names: Names) -> tuple[str, int] | None:
     """``NAME{index}`` -> (the array's declared name, index), checked against its size; None: not indexed."""
     m = _ELEMENT.match(text.strip())
     if m is None:
@@ -560,7 +558,7 @@ def _number(path: str, line: int, text: str, names: Names, what: str) -> float:
         return float(names.loop[text.lower()])
     if _IDENT.match(text) and text.lower() in names.nums:
         return names.nums[text.lower()]
-    at = element(path, line, text, names)
+    at = _array_element(path, line, text, names)
     if at is not None:
         storage, type_, items = names.arrays[at[0].lower()]
         if type_ == "num" and storage == "CONST":
@@ -593,7 +591,7 @@ def _move(path: str, unit: Unit, names: Names) -> Move:
                 raise RapidError(
                     f"{path}:{unit.line}: {instr} argument \\{sw} (on the {what}) is not supported; remove it"
                 )
-        at = element(path, unit.line, primary, names) if what != "tool" else None
+        at = _array_element(path, unit.line, primary, names) if what != "tool" else None
         if at is not None:
             primary = f"{at[0]}{{{at[1]}}}"  # the element this run of the loops names
         elif not _IDENT.match(primary):
@@ -696,8 +694,8 @@ class _Reader:
                     "condition or a WHILE loop are not supported; take them out of the block",
                 )
 
-    def has_motion(self, opener: Unit, close: str) -> bool:
-        """Whether the block opened by ``opener`` (just taken) holds a move or a call; reads nothing."""
+    def has_motion(self) -> bool:
+        """Whether the block just opened holds a move or a call; reads nothing."""
         depth = 1
         for u in self.units[self.pos :]:
             head = u.head
@@ -718,7 +716,7 @@ class _Reader:
                 return True
         return False
 
-    def for_loop(self, u: Unit, inside: str) -> ForLoop:
+    def for_loop(self, u: Unit) -> ForLoop:
         """A FOR loop with moves inside: its constant bounds, and its body read once per run."""
         m = _FOR.fullmatch(u.text.strip())
         if m is None:
@@ -771,8 +769,8 @@ class _Reader:
         u = self.take()
         head = u.head
         up = head.upper()
-        if up == "FOR" and u.text.rstrip().upper().endswith("DO") and self.has_motion(u, "ENDFOR"):
-            return self.for_loop(u, inside)
+        if up == "FOR" and u.text.rstrip().upper().endswith("DO") and self.has_motion():
+            return self.for_loop(u)
         if up == "WHILE" and re.fullmatch(r"WHILE\s+TRUE\s+DO", u.text, re.IGNORECASE):
             if inside != "PROC main":
                 raise self.fail(u.line, "WHILE TRUE is read as the cycle only directly in PROC main")
