@@ -22,6 +22,7 @@ PACKAGES = [
     "joulepath.experiment",
     "joulepath.report",
     "joulepath.program",
+    "joulepath.measure",
 ]
 
 
@@ -69,6 +70,7 @@ ALLOWED = {
         "energy",
     },
     "program": {"kinematics", "dynamics", "trajectory", "optimize", "sim", "energy"},
+    "measure": {"data", "energy"},  # a log and a run folder's files in, measure.json out
     "energy": set(),
     "units": set(),
     "abb": set(),

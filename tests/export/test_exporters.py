@@ -118,7 +118,8 @@ def test_rapid_path_mod_reads_back_to_path_csv(irb120, tmp_path):
     opt = np.array([[float(v) for v in t.split(",")] for t in targets])
     times = re.search(r"OPT_T\{\d+\} := \[(.*?)\];", text, re.S).group(1)
     seg = np.array([float(v) for v in times.replace("\n", " ").split(",")])
-    assert seg.sum() == pytest.approx(1.5, abs=1e-3) and len(seg) == len(opt) == summary["executed_via_points"]
+    assert seg.sum() == pytest.approx(1.5, abs=1e-3)
+    assert len(seg) == len(opt) == summary["executed_via_points"]
     # every via point is the planned path's sample at the via point's time (laid out by sim.follow_path)
     idx = np.round(np.cumsum(seg) / 0.025).astype(int)
     assert np.all(np.diff(idx) > 0) and idx[-1] == len(path) - 1

@@ -142,6 +142,17 @@ def _toml_set(section: str, key: str, value: str) -> str:
     )
 
 
+LOOP_MOD = """MODULE P
+    CONST jointtarget J{2} := [[[10, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]],
+        [[20, 5, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]]];
+    VAR num n := 2;
+    PROC main()
+        FOR k FROM 1 TO 2 DO
+            MoveAbsJ J{k}, v1000, fine, tool0;
+        ENDFOR
+    ENDPROC
+ENDMODULE
+"""
 OPT = "optimize --start 0,0,0,0,0,0 --end 0.5,0,0,0,0,0 --duration 1 --generations 1 --population 4"
 MODEL = "@model"  # files key: copy the trained model folder to {in}/m first
 
@@ -596,6 +607,19 @@ CASES = [
     C("cli-bench-zero-tasks", "bench-optimizers --tasks 0 --out {out}", 2, "--tasks", {}),
     C("cli-bench-population-2", "bench-optimizers --tasks 1 --population 2 --out {out}", 2, "--population", {}),
     C("cli-run-unknown-bundled", "run nosuch --out {out}", 2, "no such experiment file", {}),
+    C("cli-simulate-program-missing", "simulate --program {in}/none.mod --out {out}/a.csv", 2, "cannot be read", {}),
+    C("cli-simulate-program-not-csv", "simulate --program {in}/p.mod --out {out}/a.log", 2, "give a .csv file", {"p.mod": LOOP_MOD}),
+    C("cli-simulate-program-var-bound", "simulate --program {in}/p.mod --out {out}/a.csv", 2, "p.mod:6: the FOR loop's TO 'n'", {"p.mod": LOOP_MOD.replace("TO 2", "TO n")}),
+    C("cli-simulate-program-index-past-end", "simulate --program {in}/p.mod --out {out}/a.csv", 2, "p.mod:7: J{3} is outside the array J{2}", {"p.mod": LOOP_MOD.replace("TO 2", "TO 3")}),
+    C("cli-simulate-program-step-0", "simulate --program {in}/p.mod --out {out}/a.csv", 2, "STEP is 0", {"p.mod": LOOP_MOD.replace("TO 2", "TO 2 STEP 0")}),
+    C("cli-simulate-program-huge-loop", "simulate --program {in}/p.mod --out {out}/a.csv", 2, "runs 1000000000 times", {"p.mod": LOOP_MOD.replace("TO 2", "TO 1000000000")}),
+    C("cli-simulate-program-with-moves", "simulate --program {in}/p.mod --moves 3 --out {out}/a.csv", 2, "drop --moves", {"p.mod": LOOP_MOD}),
+    C("cli-simulate-program-start-nan", "simulate --program {in}/p.mod --start nan,0,0,0,0,0 --out {out}/a.csv", 2, "not a finite number", {"p.mod": LOOP_MOD}),
+    C("cli-simulate-start-without-program", "simulate --start 0,0,0,0,0,0 --out {out}/a.csv", 2, "give --program", {}),
+    C("cli-measure-no-plan-folder", "measure {in}/a.csv --plan {in}/none --out {out}", 2, "not a folder", {"a.csv": "t\n"}),
+    C("cli-measure-plan-without-result", "measure {in}/a.csv --plan {in} --out {out}", 2, "missing result.json", {"a.csv": "t\n"}),
+    C("cli-measure-result-not-json", "measure {in}/a.csv --plan {in} --out {out}", 2, "not readable JSON", {"a.csv": "t\n", "result.json": "{", "path.csv": "t\n", "default_path.csv": "t\n"}),
+    C("cli-measure-result-without-ends", "measure {in}/a.csv --plan {in} --out {out}", 2, "start_rad must be a list", {"a.csv": "t\n", "result.json": "{}", "path.csv": "t\n", "default_path.csv": "t\n"}),
 ]
 # fmt: on
 

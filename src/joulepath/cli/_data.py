@@ -1,4 +1,4 @@
-"""``joulepath rapid collect``, ``joulepath simulate``, ``joulepath ingest``."""
+"""``joulepath rapid collect``, ``joulepath simulate`` (random moves or a program), ``joulepath ingest``."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from joulepath.cli._common import check_out_file, check_out_folder, console, robot_inputs
+from joulepath.cli._common import check_out_file, check_out_folder, console, parse_joints, robot_inputs
 from joulepath.description import DEFAULT_ROBOT
 
 if TYPE_CHECKING:
@@ -106,19 +106,32 @@ def simulate(
     plant: str = typer.Option(
         "lab", help="sim (nominal twin), lab (emulated real robot) or a twin folder (`joulepath identify`)."
     ),
-    moves: int = typer.Option(1000, min=1, help="Number of random moves."),
+    moves: int | None = typer.Option(None, min=1, help="Number of random moves (default 1000)."),
     seed: int = typer.Option(
         0, min=0, max=2**32 - 1, help="Seed of the random moves and of the plant's noise."
     ),
     plan: str = typer.Option("", help="'thesis': real, sim, micro and test datasets in one go."),
+    program: Path | None = typer.Option(
+        None,
+        "--program",
+        help="Run this RAPID module's main once (e.g. path.mod of `joulepath optimize`) on the emulated "
+        "controller and the plant, instead of random moves; --out is the log file (.csv).",
+    ),
+    start: str = typer.Option(
+        "",
+        "--start",
+        help="--program: where the robot rests when main starts, q1,...,qn (default: the first move's "
+        "target).",
+    ),
+    degrees: bool = typer.Option(False, "--degrees", help="--start is in degrees (default rad)."),
     robot: str = typer.Option(
         DEFAULT_ROBOT, help="Robot name (irb120, ur5, panda, ...) or .irml/.urdf path."
     ),
-    range_set: str = typer.Option(
-        "collection",
+    range_set: str | None = typer.Option(
+        None,
         "--range-set",
-        help="Joint bounds of the moves: collection (App. D.1), lab, nominal; a robot without the set "
-        "uses its nominal ranges.",
+        help="Joint bounds of the moves: collection (App. D.1, the default), lab, nominal; a robot without "
+        "the set uses its nominal ranges.",
     ),
     workers: int = typer.Option(2, min=1, help="Processes for --plan."),
     mode: str = typer.Option(
@@ -127,7 +140,29 @@ def simulate(
     periods: int = typer.Option(3, min=1, help="--mode excitation: periods of the 10 s trajectory."),
     harmonics: int = typer.Option(5, min=1, max=20, help="--mode excitation: harmonics per joint."),
 ) -> int:
-    """Simulate data collection: random moves on the sim or lab plant, logged like the controller."""
+    """Simulate data collection: random moves (or a RAPID program) on a plant, logged like the controller."""
+    if program is not None:
+        given = [
+            name
+            for name, used in (
+                ("--plan", bool(plan)),
+                ("--mode", mode != "moves"),
+                ("--moves", moves is not None),
+                ("--range-set", range_set is not None),
+            )
+            if used
+        ]
+        if given:
+            raise typer.BadParameter(
+                f"--program runs the program's own moves; drop {', '.join(given)}", param_hint="--program"
+            )
+        return _simulate_program(
+            program, out, plant=plant, robot=robot, seed=seed, start=start, degrees=degrees
+        )
+    if start:
+        raise typer.BadParameter("--start is where a --program starts; give --program", param_hint="--start")
+    n_moves = 1000 if moves is None else moves
+    range_set = "collection" if range_set is None else range_set
     if mode not in ("moves", "excitation"):
         raise typer.BadParameter(f"unknown mode {mode!r}; use moves or excitation", param_hint="--mode")
     if mode == "excitation" and plan:
@@ -168,8 +203,8 @@ def simulate(
         return _simulate_excitation(
             target, plant=plant, robot=robot, seed=seed, periods=periods, harmonics=harmonics
         )
-    with console.status(f"simulating {moves} moves on the {plant} plant..."):
-        res = run(target, plant=plant, n_moves=moves, seed=seed, robot=robot, range_set=range_set)
+    with console.status(f"simulating {n_moves} moves on the {plant} plant..."):
+        res = run(target, plant=plant, n_moves=n_moves, seed=seed, robot=robot, range_set=range_set)
     if res.range_set != range_set:
         console.print(f"note: {robot} has no {range_set!r} range set; the moves use its nominal ranges")
     if plant == "lab" and not res.plant_note.startswith("emulated IRB 120"):
@@ -177,6 +212,26 @@ def simulate(
     console.print(
         f"wrote {res.log} ({res.n_rows:,} rows, {res.n_moves} moves: simulated {res.duration_s:.1f} s "
         f"of robot motion) and {res.moves}"
+    )
+    return 0
+
+
+def _simulate_program(
+    program: Path, out: Path, *, plant: str, robot: str, seed: int, start: str, degrees: bool
+) -> int:
+    from joulepath import load_robot
+    from joulepath.program import simulate_program
+
+    if out.suffix.lower() != ".csv":
+        raise typer.BadParameter(f"--program writes one log; give a .csv file, got {out}", param_hint="--out")
+    check_out_file(out, example="path-run.csv", inputs=[program, *robot_inputs(robot)])
+    r = load_robot(robot)
+    q0 = parse_joints(start, option="--start", degrees=degrees, n=r.n_joints) if start else None
+    with console.status(f"running {program.name} on the emulated controller and the {plant} plant..."):
+        res = simulate_program(program, out, robot=r, plant=plant, seed=seed, start=q0)
+    console.print(
+        f"wrote {res.log} ({res.n_rows:,} rows: {res.n_moves} moves of {program.name} in "
+        f"{res.program_time_s:.2f} s on the {res.plant} plant, {res.plant_note})"
     )
     return 0
 

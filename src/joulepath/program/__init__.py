@@ -15,6 +15,7 @@ from joulepath.program._model import Module, RapidError
 from joulepath.program._output import CYCLE_FILES, optimized_module, write_cycle_run
 from joulepath.program._parse import parse_module, read_module
 from joulepath.program._resolve import CycleSpec, read_cycle_program, read_cycle_toml, resolve_module
+from joulepath.program._simulate import ProgramMotion, ProgramRun, program_motion, simulate_program
 from joulepath.program._write import format_move, write_module
 from joulepath.sim._timing import plan_cycle
 
@@ -28,6 +29,8 @@ __all__ = [
     "Module",
     "MoveOutcome",
     "ParetoPoint",
+    "ProgramMotion",
+    "ProgramRun",
     "RapidError",
     "format_move",
     "optimize_cycle",
@@ -35,10 +38,12 @@ __all__ = [
     "pareto",
     "parse_module",
     "plan_cycle",
+    "program_motion",
     "read_cycle_program",
     "read_cycle_toml",
     "read_module",
     "resolve_module",
+    "simulate_program",
     "write_cycle_run",
     "write_module",
 ]

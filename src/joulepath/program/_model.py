@@ -60,14 +60,19 @@ Value = JointTarget | RobTarget | SpeedData | ZoneData | ToolData | float
 
 @dataclass(frozen=True, slots=True)
 class Declaration:
-    """``CONST|PERS|VAR type name := value;`` of a type joulepath reads (``num`` included)."""
+    """``CONST|PERS|VAR type name := value;`` of a type joulepath reads (``num`` included).
+
+    An array ``type name{n} := [v1, ..., vn];`` (one dimension; ``jointtarget``,
+    ``robtarget`` or ``num``) holds its elements as a tuple; ``name{k}`` is element k
+    (1-based, as in RAPID).
+    """
 
     line: int
     end_line: int
     storage: str
     type: str
     name: str
-    value: Value
+    value: Value | tuple[Value, ...]
 
 
 @dataclass(frozen=True, slots=True)
@@ -122,7 +127,24 @@ class WhileTrue:
     body: tuple[Statement, ...]
 
 
-Statement = Move | WaitTime | Call | Verbatim | WhileTrue
+@dataclass(frozen=True, slots=True)
+class ForLoop:
+    """``FOR var FROM first TO last [STEP step] DO ... ENDFOR`` with moves inside, unrolled.
+
+    The bounds are constants (numbers or ``CONST num``), so the loop's runs are known
+    when the module is read: ``runs`` holds the body once per value of the loop
+    variable (``values``), each read with the variable bound (``OPT{k}`` names element
+    k of an array). A statement of the body keeps its source line in every run.
+    """
+
+    line: int
+    end_line: int
+    variable: str
+    values: tuple[int, ...]
+    runs: tuple[tuple[Statement, ...], ...]
+
+
+Statement = Move | WaitTime | Call | Verbatim | WhileTrue | ForLoop
 
 
 @dataclass(frozen=True, slots=True)

@@ -5,7 +5,15 @@ Read (and checked): ``MODULE`` / ``ENDMODULE``; ``PROC name()`` / ``ENDPROC``;
 ``speeddata``, ``zonedata``, ``tooldata`` and ``num`` (a literal value);
 ``MoveAbsJ`` / ``MoveJ`` / ``MoveL`` with ``\\V``, ``\\T``, ``\\Z``, ``\\WObj:=wobj0``
 (and ``\\NoEOffs`` on ``MoveAbsJ``); ``WaitTime``; ``WHILE TRUE DO`` in ``main``;
-calls of the module's procedures without arguments.
+calls of the module's procedures without arguments; one-dimensional arrays of
+``jointtarget``, ``robtarget`` and ``num`` (``CONST jointtarget OPT{3} := [...]``), and
+of ``speeddata`` / ``zonedata`` (literal values or predefined names: ``[v100, v7000]``);
+``FOR i FROM a TO b [STEP s] DO`` with moves or calls inside, when its bounds are
+whole numbers or ``CONST num``: the loop is unrolled (its body read once per value
+of ``i``), and ``i`` may index the arrays (``MoveAbsJ OPT{i}, v1000 \\T:=OPT_T{i}, ...``).
+Indices are whole numbers, ``CONST num``, the variables of the FOR loops around or
+elements of ``CONST num`` arrays (``SPEED_ARR{SPEED_IDX{i}}``, as ``JPCollect.mod`` in
+table mode writes).
 
 Kept verbatim, their run time treated as fixed: every other instruction
 (``SetDO``, ``WaitDI``, ``TPWrite`` ...), declarations of other types, ``FUNC`` and
@@ -16,7 +24,8 @@ Refused (:class:`RapidError`, one line ``file:line: what; how to fix``): syntax
 errors, unknown names, arguments joulepath does not model (``\\Conc``, ``\\ID``,
 ``\\Inpos``, a work object other than ``wobj0`` ...), other motion instructions
 (``MoveC``, ``SearchL`` ...), instructions that change how the robot moves
-(``VelSet``, ``AccSet``, ``ConfJ \\Off`` ...), and moves inside conditional blocks.
+(``VelSet``, ``AccSet``, ``ConfJ \\Off`` ...), moves inside conditional blocks and
+other ``WHILE`` loops, and FOR loops with moves inside whose bounds are not constants.
 Reading never executes anything.
 """
 
@@ -24,12 +33,13 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from joulepath.program._model import (
     Call,
     Declaration,
+    ForLoop,
     JointTarget,
     Module,
     Move,
@@ -65,6 +75,13 @@ MOTION_SETTINGS = (
     "GripLoad",
     "MotionSup",
     "SoftAct",
+)
+MAX_RUNS = 10_000
+"""Most runs of one FOR loop with moves inside that are unrolled."""
+MAX_UNROLLED = 100_000
+"""Most runs of all such FOR loops of a module together (nested runs count each)."""
+_FOR = re.compile(
+    r"FOR\s+([A-Za-z]\w*)\s+FROM\s+(.+?)\s+TO\s+(.+?)(?:\s+STEP\s+(.+?))?\s+DO", re.IGNORECASE | re.DOTALL
 )
 BLOCK_CLOSE = {"IF": "ENDIF", "FOR": "ENDFOR", "WHILE": "ENDWHILE", "TEST": "ENDTEST"}
 _IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -259,7 +276,11 @@ def _nums(path: str, line: int, item: object, size: int, what: str) -> tuple[flo
 
 
 def _value(path: str, line: int, type_: str, text: str) -> Value:
-    agg = _aggregate(path, line, text)
+    return _value_of(path, line, type_, _aggregate(path, line, text), text)
+
+
+def _value_of(path: str, line: int, type_: str, agg: object, text: str) -> Value:
+    """A value of ``type_`` from its parsed aggregate (``text``: how it was written, for messages)."""
     if type_ == "num":
         if not isinstance(agg, float):
             raise RapidError(f"{path}:{line}: a num value must be a number, got {text.strip()!r}")
@@ -354,11 +375,7 @@ def _declaration(path: str, unit: Unit) -> Declaration | None:
     if type_l not in READ_TYPES:
         return None
     if dims:
-        if type_l == "num":
-            return None
-        raise RapidError(
-            f"{path}:{unit.line}: arrays of {type_l} are not supported; declare each {type_l} by name"
-        )
+        return _array_declaration(path, unit, storage, type_l, name, dims, value)
     if value is None:
         if type_l == "num":
             return None
@@ -370,6 +387,68 @@ def _declaration(path: str, unit: Unit) -> Declaration | None:
             return None
         raise
     return Declaration(unit.line, unit.end_line, storage.upper(), type_l, name, parsed)
+
+
+ARRAY_TYPES = ("jointtarget", "robtarget", "num", "speeddata", "zonedata")
+"""Types whose one-dimensional arrays are read (their elements are indexed by a FOR loop's variable)."""
+_NAME_LIST = re.compile(r"^\s*\[\s*([A-Za-z]\w*(?:\s*,\s*[A-Za-z]\w*)*)\s*\]\s*$", re.DOTALL)
+
+
+def _predefined_list(path: str, line: int, type_: str, name: str, text: str) -> list[Value] | None:
+    """``[v100, v200, ...]`` / ``[fine, z10, ...]``: predefined data by name; None: not such a list."""
+    m = _NAME_LIST.match(text)
+    if m is None or type_ not in ("speeddata", "zonedata"):
+        return None
+    table: dict[str, SpeedData] | dict[str, ZoneData] = (
+        PREDEFINED_SPEEDS if type_ == "speeddata" else PREDEFINED_ZONES
+    )
+    out: list[Value] = []
+    for k, item in enumerate(re.split(r"\s*,\s*", m.group(1).strip())):
+        if item.lower() not in table:
+            raise RapidError(
+                f"{path}:{line}: element {k + 1} of {name} is {item!r}; an array of {type_} holds predefined "
+                f"names ({'v5 .. v7000' if type_ == 'speeddata' else 'fine, z0 .. z200'}) or literal values"
+            )
+        out.append(table[item.lower()])
+    return out
+
+
+def _array_declaration(
+    path: str, unit: Unit, storage: str, type_: str, name: str, dims: str, value: str | None
+) -> Declaration | None:
+    """``type name{n} := [v1, ..., vn];``: the elements as a tuple (one dimension, literal values)."""
+    size = dims.strip()[1:-1].strip()
+    if type_ not in ARRAY_TYPES:
+        raise RapidError(
+            f"{path}:{unit.line}: arrays of {type_} are not supported; declare each {type_} by name"
+        )
+    if not re.fullmatch(r"\d+", size) or int(size) < 1:
+        if type_ == "num":  # kept verbatim, refused only where a move needs it
+            return None
+        raise RapidError(
+            f"{path}:{unit.line}: the array {name}{dims} needs one positive whole size, e.g. {name}{{4}}"
+        )
+    n = int(size)
+    if value is None:
+        if type_ == "num":
+            return None
+        raise RapidError(f"{path}:{unit.line}: {type_} {name}{{{n}}} has no value; give it one with := [...]")
+    named = _predefined_list(path, unit.line, type_, name, value)
+    try:
+        agg = _aggregate(path, unit.line, value) if named is None else named
+    except RapidError:
+        if type_ == "num":  # an expression: kept verbatim, refused only where a move needs it
+            return None
+        raise
+    if not isinstance(agg, list) or len(agg) != n:
+        got = len(agg) if isinstance(agg, list) else "not a list"
+        raise RapidError(f"{path}:{unit.line}: {name}{{{n}}} needs [{n} elements], got {got}")
+    if named is not None:
+        return Declaration(unit.line, unit.end_line, storage.upper(), type_, name, tuple(named))
+    items = tuple(
+        _value_of(path, unit.line, type_, item, f"{name}{{{k + 1}}} = {item}") for k, item in enumerate(agg)
+    )
+    return Declaration(unit.line, unit.end_line, storage.upper(), type_, name, items)
 
 
 # ---------------------------------------------------------------- instructions
@@ -414,16 +493,85 @@ def _argument(path: str, line: int, text: str) -> tuple[str, dict[str, str | Non
     return primary, switches
 
 
-def _number(path: str, line: int, text: str, nums: dict[str, float], what: str) -> float:
+@dataclass
+class Names:
+    """What a number or an index may name while a routine is read.
+
+    ``nums``: the module's ``CONST num`` (lower-case names); ``arrays``: its arrays
+    as (storage, type, elements); ``loop``: the variables of the FOR loops being
+    unrolled around the statement, bound to their value in this run.
+    """
+
+    nums: dict[str, float] = field(default_factory=dict)
+    arrays: dict[str, tuple[str, str, tuple[Value, ...]]] = field(default_factory=dict)
+    loop: dict[str, int] = field(default_factory=dict)
+
+
+_ELEMENT = re.compile(r"^([A-Za-z]\w*)\s*\{\s*(.*?)\s*\}$", re.DOTALL)
+
+
+def _index(path: str, line: int, text: str, names: Names) -> int:
+    """An array index: a number, a ``CONST num``, a FOR loop's variable or an element of a CONST num array."""
+    text = text.strip()
+    value: float | None = None
+    if _ELEMENT.match(text):
+        value = _number(path, line, text, names, f"the index {text!r}")
+    elif _NUMBER.fullmatch(text):
+        value = float(text)
+    elif _IDENT.match(text) and text.lower() in names.loop:
+        value = float(names.loop[text.lower()])
+    elif _IDENT.match(text) and text.lower() in names.nums:
+        value = names.nums[text.lower()]
+    if value is None:
+        raise RapidError(
+            f"{path}:{line}: the index {text!r} must be a number, a CONST num, the variable of a FOR "
+            "loop around it or an element of a CONST num array (expressions are not read)"
+        )
+    if value != round(value):
+        raise RapidError(f"{path}:{line}: the index {text!r} = {value:g} is not a whole number")
+    return int(round(value))
+
+
+def _array_element(path: str, line: int, text: str, names: Names) -> tuple[str, int] | None:
+    """``NAME{index}`` -> (the array's declared name, index), checked against its size; None: not indexed."""
+    m = _ELEMENT.match(text.strip())
+    if m is None:
+        return None
+    name, index = m.group(1), m.group(2)
+    if name.lower() not in names.arrays:
+        raise RapidError(
+            f"{path}:{line}: {name} is not an array declared in the module before this line; declare "
+            f"it (CONST ... {name}{{n}} := [...])"
+        )
+    k = _index(path, line, index, names)
+    n = len(names.arrays[name.lower()][2])
+    if not 1 <= k <= n:
+        raise RapidError(f"{path}:{line}: {name}{{{k}}} is outside the array {name}{{{n}}} (indices 1..{n})")
+    return name, k
+
+
+def _number(path: str, line: int, text: str, names: Names, what: str) -> float:
     text = text.strip()
     if _NUMBER.fullmatch(text):
         return float(text)
-    if _IDENT.match(text) and text.lower() in nums:
-        return nums[text.lower()]
-    raise RapidError(f"{path}:{line}: {what} must be a number or a num constant of the module, got {text!r}")
+    if _IDENT.match(text) and text.lower() in names.loop:
+        return float(names.loop[text.lower()])
+    if _IDENT.match(text) and text.lower() in names.nums:
+        return names.nums[text.lower()]
+    at = _array_element(path, line, text, names)
+    if at is not None:
+        storage, type_, items = names.arrays[at[0].lower()]
+        if type_ == "num" and storage == "CONST":
+            value = items[at[1] - 1]
+            assert isinstance(value, float)
+            return value
+    raise RapidError(
+        f"{path}:{line}: {what} must be a number, a num constant of the module or an element of a "
+        f"CONST num array, got {text!r}"
+    )
 
 
-def _move(path: str, unit: Unit, nums: dict[str, float]) -> Move:
+def _move(path: str, unit: Unit, names: Names) -> Move:
     instr = unit.head
     body = unit.text[len(instr) :].rstrip(";").strip()
     if body.startswith("\\"):
@@ -443,7 +591,10 @@ def _move(path: str, unit: Unit, nums: dict[str, float]) -> Move:
                 raise RapidError(
                     f"{path}:{unit.line}: {instr} argument \\{sw} (on the {what}) is not supported; remove it"
                 )
-        if not _IDENT.match(primary):
+        at = _array_element(path, unit.line, primary, names) if what != "tool" else None
+        if at is not None:
+            primary = f"{at[0]}{{{at[1]}}}"  # the element this run of the loops names
+        elif not _IDENT.match(primary):
             raise RapidError(
                 f"{path}:{unit.line}: the {what} of {instr} must be a name declared in the module, got "
                 f"{primary!r}; declare it (CONST ... := ...) and use its name"
@@ -460,9 +611,9 @@ def _move(path: str, unit: Unit, nums: dict[str, float]) -> Move:
             raise RapidError(f"{path}:{unit.line}: \\{key} needs a value (\\{key}:=...)")
     if "V" in sp and "T" in sp:
         raise RapidError(f"{path}:{unit.line}: \\V and \\T together; keep one")
-    v = _number(path, unit.line, sp["V"] or "", nums, "\\V") if "V" in sp else None
-    t = _number(path, unit.line, sp["T"] or "", nums, "\\T") if "T" in sp else None
-    z = _number(path, unit.line, zs["Z"] or "", nums, "\\Z") if "Z" in zs else None
+    v = _number(path, unit.line, sp["V"] or "", names, "\\V") if "V" in sp else None
+    t = _number(path, unit.line, sp["T"] or "", names, "\\T") if "T" in sp else None
+    z = _number(path, unit.line, zs["Z"] or "", names, "\\Z") if "Z" in zs else None
     if t is not None and not 0 < t <= 600:
         raise RapidError(f"{path}:{unit.line}: \\T:={t:g} s must be within (0, 600] s")
     if v is not None and v <= 0:
@@ -472,13 +623,13 @@ def _move(path: str, unit: Unit, nums: dict[str, float]) -> Move:
     return Move(unit.line, unit.end_line, instr, target, speed, v, t, zone, z, tool)
 
 
-def _wait(path: str, unit: Unit, nums: dict[str, float]) -> WaitTime:
+def _wait(path: str, unit: Unit, names: Names) -> WaitTime:
     body = unit.text.split(None, 1)[1].rstrip(";").strip() if len(unit.text.split()) > 1 else ""
     if body.startswith("\\"):
         raise RapidError(f"{path}:{unit.line}: WaitTime {body.split()[0]} is not supported; remove it")
     if not body:
         raise RapidError(f"{path}:{unit.line}: WaitTime needs a time in s")
-    seconds = _number(path, unit.line, body, nums, "the WaitTime")
+    seconds = _number(path, unit.line, body, names, "the WaitTime")
     if not 0 <= seconds <= 3600:
         raise RapidError(f"{path}:{unit.line}: WaitTime {seconds:g} s must be within [0, 3600] s")
     return WaitTime(unit.line, unit.end_line, seconds)
@@ -489,8 +640,9 @@ class _Reader:
     path: str
     units: list[Unit]
     procs: set[str]
-    nums: dict[str, float]
+    names: Names
     pos: int = 0
+    unrolled: int = 0
 
     def peek(self) -> Unit | None:
         return self.units[self.pos] if self.pos < len(self.units) else None
@@ -517,7 +669,7 @@ class _Reader:
                 )
             body.append(self.statement(inside))
 
-    def skip_block(self, opener: Unit, close: str) -> Unit:
+    def skip_block(self, opener: Unit, close: str, *, refuse_motion: bool = True) -> Unit:
         """A conditional block kept verbatim; a move inside it is refused."""
         depth = 1
         while True:
@@ -535,17 +687,90 @@ class _Reader:
                     return u
             elif up in ("ENDPROC", "ENDMODULE"):
                 raise self.fail(u.line, f"{head} before {close} (opened at line {opener.line}); add {close}")
-            elif head in MOVES or OTHER_MOTION.match(head) or head.lower() in self.procs:
+            elif refuse_motion and (head in MOVES or OTHER_MOTION.match(head) or head.lower() in self.procs):
                 raise self.fail(
                     u.line,
                     f"{head} inside {opener.head.upper()} (line {opener.line}): moves or calls under a "
-                    "condition or loop are not supported; take them out of the block",
+                    "condition or a WHILE loop are not supported; take them out of the block",
                 )
+
+    def has_motion(self) -> bool:
+        """Whether the block just opened holds a move or a call; reads nothing."""
+        depth = 1
+        for u in self.units[self.pos :]:
+            head = u.head
+            up = head.upper()
+            if up in BLOCK_CLOSE and u.text.rstrip().upper().endswith(("THEN", "DO")) or up == "TEST":
+                depth += 1
+            elif up in BLOCK_CLOSE.values():
+                depth -= 1
+                if depth == 0:
+                    return False
+            elif up in ("ENDPROC", "ENDMODULE"):
+                return False  # the unclosed block is refused by whoever reads it
+            elif head in MOVES or OTHER_MOTION.match(head) or head.lower() in self.procs:
+                return True
+            elif up == "IF" and any(
+                OTHER_MOTION.match(w) or w.lower() in self.procs for w in re.findall(r"[A-Za-z]\w*", u.text)
+            ):
+                return True
+        return False
+
+    def for_loop(self, u: Unit) -> ForLoop:
+        """A FOR loop with moves inside: its constant bounds, and its body read once per run."""
+        m = _FOR.fullmatch(u.text.strip())
+        if m is None:
+            raise self.fail(u.line, f"cannot read {u.text[:50]!r}; write FOR i FROM 1 TO n [STEP s] DO")
+        var = m.group(1)
+        bounds = []
+        for text, what in ((m.group(2), "FROM"), (m.group(3), "TO"), (m.group(4), "STEP")):
+            if text is None:
+                bounds.append(1)
+                continue
+            try:
+                bounds.append(_index(self.path, u.line, text, self.names))
+            except RapidError:
+                raise self.fail(
+                    u.line,
+                    f"the FOR loop's {what} {text.strip()!r} must be a whole number or a CONST num of the "
+                    "module to read the moves inside (they are unrolled); write it as a constant",
+                ) from None
+        first, last, step = bounds
+        if step == 0:
+            raise self.fail(u.line, "the FOR loop's STEP is 0; the loop would never end")
+        runs_of = range(first, last + (1 if step > 0 else -1), step)  # its length without building it
+        if len(runs_of) > MAX_RUNS or self.unrolled + len(runs_of) > MAX_UNROLLED:
+            raise self.fail(
+                u.line,
+                f"the FOR loop runs {len(runs_of)} times; at most {MAX_RUNS} runs per loop and "
+                f"{MAX_UNROLLED} in the module are unrolled; run fewer",
+            )
+        values = tuple(runs_of)
+        self.unrolled += len(values)
+        if var.lower() in self.names.loop:
+            raise self.fail(u.line, f"the FOR variable {var} is already the variable of a loop around it")
+        body_start = self.pos
+        runs: list[tuple[Statement, ...]] = []
+        end: Unit | None = None
+        try:
+            for value in values:
+                self.pos = body_start
+                self.names.loop[var.lower()] = value
+                body, end = self.block("ENDFOR", u, inside=f"FOR {var}")
+                runs.append(tuple(body))
+        finally:
+            self.names.loop.pop(var.lower(), None)
+        if end is None:  # no run: the body is skipped as written (its moves never run)
+            self.pos = body_start
+            end = self.skip_block(u, "ENDFOR", refuse_motion=False)
+        return ForLoop(u.line, end.end_line, var, values, tuple(runs))
 
     def statement(self, inside: str) -> Statement:
         u = self.take()
         head = u.head
         up = head.upper()
+        if up == "FOR" and u.text.rstrip().upper().endswith("DO") and self.has_motion():
+            return self.for_loop(u)
         if up == "WHILE" and re.fullmatch(r"WHILE\s+TRUE\s+DO", u.text, re.IGNORECASE):
             if inside != "PROC main":
                 raise self.fail(u.line, "WHILE TRUE is read as the cycle only directly in PROC main")
@@ -566,7 +791,7 @@ class _Reader:
         if not u.text.endswith(";"):
             raise self.fail(u.line, f"cannot read {u.text[:50]!r}; an instruction ends with ';'")
         if head in MOVES:
-            return _move(self.path, u, self.nums)
+            return _move(self.path, u, self.names)
         for m in MOVES:
             if head.lower() == m.lower():
                 raise self.fail(u.line, f"{head}: write {m} (RAPID names are read as written here)")
@@ -575,7 +800,7 @@ class _Reader:
                 u.line, f"{head} is not supported (joulepath reads MoveAbsJ, MoveJ and MoveL); replace it"
             )
         if head.lower() == "waittime":
-            return _wait(self.path, u, self.nums)
+            return _wait(self.path, u, self.names)
         for s in MOTION_SETTINGS:
             if head.lower() == s.lower():
                 if s in ("ConfJ", "ConfL") and re.search(r"\\\s*On\b", u.text, re.IGNORECASE):
@@ -619,9 +844,9 @@ def parse_module(text: str, *, path: str = "<program>") -> Module:
             procs.add(pm.group(1).lower())
     decls: list[Declaration] = []
     names: dict[str, int] = {}
-    nums: dict[str, float] = {}
+    scope = Names()
     procedures: list[Procedure] = []
-    reader = _Reader(path, units[1:-1], procs, nums)
+    reader = _Reader(path, units[1:-1], procs, scope)
     while (cur := reader.peek()) is not None:
         u = cur
         head = u.head.upper()
@@ -636,7 +861,9 @@ def parse_module(text: str, *, path: str = "<program>") -> Module:
             if d is not None:
                 decls.append(d)
                 if d.type == "num" and isinstance(d.value, float) and d.storage == "CONST":
-                    nums[d.name.lower()] = d.value
+                    scope.nums[d.name.lower()] = d.value
+                if isinstance(d.value, tuple):
+                    scope.arrays[d.name.lower()] = (d.storage, d.type, d.value)
         elif head == "PROC":
             reader.take()
             pm = re.fullmatch(r"(?:LOCAL\s+)?PROC\s+([A-Za-z]\w*)\s*\(\s*(.*?)\s*\)", u.text, re.IGNORECASE)
@@ -667,10 +894,14 @@ def parse_module(text: str, *, path: str = "<program>") -> Module:
 
 
 def _statements(body: tuple[Statement, ...]) -> Iterator[Statement]:
+    """Every statement of a body, those inside WHILE TRUE and every run of a FOR loop included."""
     for s in body:
         yield s
         if isinstance(s, WhileTrue):
             yield from _statements(s.body)
+        elif isinstance(s, ForLoop):
+            for run in s.runs:
+                yield from _statements(run)
 
 
 def _check_calls(module: Module) -> None:
@@ -682,15 +913,18 @@ def _check_calls(module: Module) -> None:
         raise module.error(loops[1].line, "a second WHILE TRUE in main; the cycle is one loop")
 
     def visit(proc: Procedure, stack: tuple[str, ...]) -> None:
+        calls: dict[str, Call] = {}  # each callee once (a FOR loop repeats its calls)
         for s in _statements(proc.body):
             if isinstance(s, Call):
-                if s.name.lower() in stack:
-                    raise module.error(
-                        s.line, f"{s.name} calls itself (through {' -> '.join(stack)}); not supported"
-                    )
-                callee = module.procedure(s.name)
-                assert callee is not None
-                visit(callee, (*stack, callee.name.lower()))
+                calls.setdefault(s.name.lower(), s)
+        for s in calls.values():
+            if s.name.lower() in stack:
+                raise module.error(
+                    s.line, f"{s.name} calls itself (through {' -> '.join(stack)}); not supported"
+                )
+            callee = module.procedure(s.name)
+            assert callee is not None
+            visit(callee, (*stack, callee.name.lower()))
 
     visit(main, ("main",))
 

@@ -2,7 +2,9 @@
 
 The cycle is the body of ``main``'s ``WHILE TRUE`` loop, or ``main``'s body when there is
 no loop; calls of the module's procedures are followed (their statements join the
-cycle where the call stands). The robot starts each cycle where the previous one ended:
+cycle where the call stands), and FOR loops with moves are unrolled (each run's
+statements in turn; a move inside a loop that runs more than once is ``repeated``).
+The robot starts each cycle where the previous one ended:
 at the last move's target. Robtargets are solved with the closed-form inverse
 kinematics, choosing the solution their ``confdata`` names; a tool's TCP and load
 are taken into account (targets are TCP poses, the load is carried in the dynamics).
@@ -23,6 +25,7 @@ from joulepath.kinematics import quaternion_to_rotation
 from joulepath.kinematics._ik import check_layout, confdata, solve_ik
 from joulepath.program._model import (
     Call,
+    ForLoop,
     JointTarget,
     Module,
     Move,
@@ -67,6 +70,32 @@ def target_pose(target: RobTarget) -> FloatArray:
     return out
 
 
+MAX_STEPS = 200_000
+"""Most statements a program's run may unroll into (calls and FOR loops followed)."""
+
+
+def _size(module: Module, body: tuple[Statement, ...], memo: dict[str, int]) -> int:
+    """How many statements :func:`_flatten` gives, without building them (each procedure counted once)."""
+    n = 0
+    for s in body:
+        if isinstance(s, Call):
+            key = s.name.lower()
+            if key not in memo:
+                proc = module.procedure(s.name)
+                assert proc is not None
+                memo[key] = _size(module, proc.body, memo)
+            n += memo[key]
+        elif isinstance(s, WhileTrue):
+            n += _size(module, s.body, memo)
+        elif isinstance(s, ForLoop):
+            n += sum(_size(module, run, memo) for run in s.runs)
+        else:
+            n += 1
+        if n > MAX_STEPS:
+            return n
+    return n
+
+
 def _flatten(module: Module, body: tuple[Statement, ...]) -> list[Statement]:
     out: list[Statement] = []
     for s in body:
@@ -76,13 +105,26 @@ def _flatten(module: Module, body: tuple[Statement, ...]) -> list[Statement]:
             out.extend(_flatten(module, proc.body))
         elif isinstance(s, WhileTrue):
             out.extend(_flatten(module, s.body))
+        elif isinstance(s, ForLoop):  # unrolled: every run in order
+            for run in s.runs:
+                out.extend(_flatten(module, run))
         else:
             out.append(s)
     return out
 
 
 def _lookup(module: Module, name: str, type_: str, line: int) -> object:
-    d = module.declaration(name)
+    base, _, index = name.partition("{")  # an array element, checked when read: NAME{k}
+    d = module.declaration(base)
+    if d is not None and index:
+        if d.type != type_:
+            raise module.error(
+                line, f"{base} is a {d.type} array (line {d.line}), but a {type_} is needed here"
+            )
+        assert isinstance(d.value, tuple)
+        return d.value[int(index.rstrip("}")) - 1]
+    if d is not None and isinstance(d.value, tuple):
+        raise module.error(line, f"{name} is an array (line {d.line}); name one element, e.g. {name}{{1}}")
     if d is None:
         if type_ == "speeddata" and name.lower() in PREDEFINED_SPEEDS:
             return PREDEFINED_SPEEDS[name.lower()]
@@ -104,6 +146,13 @@ def resolve_module(module: Module, robot: Robot) -> CycleSpec:
     assert main is not None
     loop = next((s for s in main.body if isinstance(s, WhileTrue)), None)
     body = loop.body if loop is not None else main.body
+    size = _size(module, body, {})
+    if size > MAX_STEPS:
+        raise module.error(
+            main.line,
+            f"main runs more than {MAX_STEPS} statements once its calls and FOR loops are unrolled; "
+            "run fewer repetitions",
+        )
     flat = _flatten(module, body)
     lo, hi = robot.joint_ranges()
     counts: dict[int, int] = {}
