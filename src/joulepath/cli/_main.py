@@ -14,6 +14,7 @@ from joulepath.cli._identify import identify
 from joulepath.cli._learn import importance, train
 from joulepath.cli._optimize import bench_optimizers, optimize
 from joulepath.cli._robot import robot_app
+from joulepath.cli._stream import stream
 from joulepath.cli._synth import compare, synth
 from joulepath.errors import JoulepathError
 
@@ -36,6 +37,7 @@ app.command("compare")(compare)
 app.command("optimize")(optimize)
 app.command("bench-optimizers")(bench_optimizers)
 app.command("cycle")(cycle)
+app.command("stream")(stream)
 app.command("run")(run)
 app.command("demo")(demo)
 

@@ -8,10 +8,11 @@ No socket, no clock of the PC: the plan is indexed by the controller's time.
 Phases (:class:`Phase`):
 
 * ``wait`` — hold: the reference is the start while the robot is within
-  ``start_tolerance_deg`` of it, else the robot's own feedback. The path starts at
-  the first message that reports EGM running (motors on, ``mciState`` running) with
-  the feedback at the start. EGM running with the robot away from the start is a
-  fault: the controller would ramp in to a far reference.
+  ``start_tolerance_deg`` of it, else the robot's own feedback. The path starts
+  ``ramp_in_s`` of controller time after the first message that reports EGM running
+  (motors on, ``mciState`` running) with the feedback at the start. EGM running with
+  the robot away from the start is a fault: the controller would ramp in to a far
+  reference.
 * ``run`` — the plan at (controller time − the time the run started).
 * ``hold`` — the plan's end, until the feedback stays within ``end_tolerance_deg``
   of it for ``settle_messages`` messages: one repetition done.
@@ -67,6 +68,10 @@ class StreamSettings:
     max_hold_s : float
         Controller time allowed to converge after the plan's end (or a return); longer
         is a fault.
+    ramp_in_s : float
+        Controller time the start is held after EGM reports running, before the run
+        begins: at least the RAPID module's ``\\RampInTime``, so that the controller's
+        ramp-in from its own position ends before the path moves.
     """
 
     repeats: int = 1
@@ -75,6 +80,7 @@ class StreamSettings:
     settle_messages: int = 5
     max_step_deg: float = 5.0
     max_hold_s: float = 2.0
+    ramp_in_s: float = 0.1
 
     def __post_init__(self) -> None:
         if not 1 <= self.repeats <= 1000:
@@ -83,6 +89,8 @@ class StreamSettings:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise InvalidInput(f"{name} must be a positive number, got {value}")
+        if not (math.isfinite(self.ramp_in_s) and 0 <= self.ramp_in_s <= 10):
+            raise InvalidInput(f"ramp_in_s must be 0..10 s, got {self.ramp_in_s}")
         if self.end_tolerance_deg > self.start_tolerance_deg:
             raise InvalidInput(
                 f"end_tolerance_deg ({self.end_tolerance_deg}) must not exceed start_tolerance_deg "
@@ -139,6 +147,8 @@ class PolicyState:
         Runs cut short because EGM stopped running.
     fault : str or None
         Why the stream stopped, in ``fault``.
+    running_since : float or None
+        Controller time since which EGM has been running at the start, in ``wait``.
     """
 
     phase: Phase = Phase.WAIT
@@ -147,6 +157,7 @@ class PolicyState:
     settled: int = 0
     interrupted: int = 0
     fault: str | None = None
+    running_since: float | None = None
 
 
 def _far(a: FloatArray, b: FloatArray, tol_deg: float) -> int | None:
@@ -203,8 +214,9 @@ def _step(
     phase = state.phase
     if phase is Phase.DONE:
         return Reference(q=plan.end.copy(), qd=zero, plan_time=plan.duration), state
-    if not robot.running and phase in (Phase.RUN, Phase.RETURN):
-        return _hold(robot), replace(state, phase=Phase.WAIT, settled=0, interrupted=state.interrupted + 1)
+    if not robot.running and phase in (Phase.RUN, Phase.RETURN):  # a return cut short is no lost run
+        cut = state.interrupted + (phase is Phase.RUN)
+        return _hold(robot), replace(state, phase=Phase.WAIT, settled=0, interrupted=cut)
     if not robot.running and phase is Phase.HOLD:
         if _far(robot.q, plan.end, settings.end_tolerance_deg) is None:  # the controller ended at the end
             return _next_repetition(plan, settings, state, robot, running=False)
@@ -224,8 +236,12 @@ def _step(
                 )
             return _hold(robot), state
         if not robot.running:
-            return Reference(q=plan.start.copy(), qd=zero, plan_time=0.0), state
-        return _run_from(plan, replace(state, phase=Phase.RUN, t0=robot.t, settled=0), robot)
+            return Reference(q=plan.start.copy(), qd=zero, plan_time=0.0), replace(state, running_since=None)
+        since = robot.t if state.running_since is None else state.running_since
+        if robot.t - since < settings.ramp_in_s:  # the controller's ramp-in: hold the start
+            return Reference(q=plan.start.copy(), qd=zero, plan_time=0.0), replace(state, running_since=since)
+        start = replace(state, phase=Phase.RUN, t0=robot.t, settled=0, running_since=None)
+        return _run_from(plan, start, robot)
     if phase is Phase.RUN:
         return _run_from(plan, state, robot)
     if phase is Phase.HOLD:
