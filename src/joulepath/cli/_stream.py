@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import typer
@@ -39,7 +38,7 @@ def stream(
     config = ServeConfig(host=host, port=port, timeout_s=timeout, settings=StreamSettings(repeats=repeat))
 
     def listening(address: tuple[str, int]) -> None:
-        print(f"listening on udp {address[0]}:{address[1]}", file=sys.stderr, flush=True)
+        print(f"listening on udp {address[0]}:{address[1]}", flush=True)
 
     outcome = stream_run(run_folder, config, robot=robot or None, on_listening=listening)
     s = outcome.summary
