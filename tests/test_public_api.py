@@ -22,6 +22,7 @@ PACKAGES = [
     "joulepath.experiment",
     "joulepath.report",
     "joulepath.program",
+    "joulepath.egm",
 ]
 
 
@@ -73,6 +74,7 @@ ALLOWED = {
     "units": set(),
     "abb": set(),
     "report": set(),  # reads a run folder's files only
+    "egm": {"description", "dynamics", "energy"},  # streams a run folder's path; its robot and energy
     "experiment": None,  # orchestrates every stage, like the CLI
     "cli": None,  # may import anything
 }
