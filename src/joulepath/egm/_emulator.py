@@ -9,9 +9,9 @@ per tick; the speed reference is not used). It waits for each answer, so a run i
 the same whatever the PC's load; ``wall_period_s`` below ``period_s`` runs it faster
 than real time, which also shows whether a server follows the controller's clock.
 
-It stops after ``stop_after_missed`` consecutive unanswered messages once it has been
-answered (the server finished), after ``max_ticks`` ticks, or after ``timeout_s``
-seconds of wall time, whichever comes first.
+Once answered, it stops when the server's port is closed (the ICMP "port unreachable"
+of loopback) or after ``stop_after_missed`` consecutive unanswered messages; in any case
+after ``max_ticks`` ticks or ``timeout_s`` seconds of wall time.
 
 Faults to inject: ``garbage_every`` (a datagram that is not an ``EgmRobot`` before
 every k-th message), ``foreign_every`` (a valid ``EgmRobot`` from a second socket,
@@ -48,8 +48,8 @@ class EmulatorConfig:
     lag_s: float = 0.01
     clock_start_s: float = 1000.0
     running_after_s: float = 0.04
-    reply_timeout_s: float = 0.2
-    stop_after_missed: int = 10
+    reply_timeout_s: float = 1.0
+    stop_after_missed: int = 5
     max_ticks: int = 20_000
     timeout_s: float = 60.0
     garbage_every: int = 0
@@ -137,10 +137,11 @@ def run_emulator(server: Address, config: EmulatorConfig) -> EmulatorLog:
     rows_speed: list[FloatArray] = []
     seqnos: list[int] = []
     tms: list[int] = []
-    answered = missed = garbage = foreign = foreign_answered = 0
+    answered = missed = garbage = foreign = foreign_answered = refused_before = 0
     stopped = f"max_ticks ({config.max_ticks}) reached"
     wall_start = time.monotonic()
     with UdpEndpoint(LOOPBACK, 0) as sock, UdpEndpoint(LOOPBACK, 0) as other:
+        sock.connect(server)  # as a controller's UDPUC device: one remote address
         for k in range(config.max_ticks):
             tick_wall = time.monotonic()
             if tick_wall - wall_start > config.timeout_s:
@@ -166,6 +167,11 @@ def run_emulator(server: Address, config: EmulatorConfig) -> EmulatorLog:
             got = _await_reply(sock, round(t * 1000.0), n, config.reply_timeout_s)
             if other.receive(0.0) is not None:
                 foreign_answered += 1
+            if answered and sock.refused > refused_before:
+                rows_ref.append(np.full(n, np.nan))
+                rows_speed.append(np.full(n, np.nan))
+                stopped = "the server closed its port"
+                break
             if got is None:
                 rows_ref.append(np.full(n, np.nan))
                 rows_speed.append(np.full(n, np.nan))
@@ -175,6 +181,8 @@ def run_emulator(server: Address, config: EmulatorConfig) -> EmulatorLog:
                     break
             else:
                 planned, speed, seqno, tm = got
+                if not answered:
+                    refused_before = sock.refused  # before the server listened: not an end
                 ref = planned
                 rows_ref.append(planned)
                 rows_speed.append(speed)
@@ -212,7 +220,7 @@ def _await_reply(
         left = deadline - time.monotonic()
         if left <= 0:
             return None
-        dgram = sock.receive(left)
+        dgram = sock.receive(left, stop_on_refused=True)
         if dgram is None:
             return None
         try:

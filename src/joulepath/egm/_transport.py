@@ -35,6 +35,9 @@ class UdpEndpoint:
     """
 
     def __init__(self, host: str, port: int) -> None:
+        self.refused = 0
+        """ICMP "port unreachable" reports seen (a connected peer that closed its port)."""
+        self._peer: Address | None = None
         if not 0 <= port <= 65535:
             raise InvalidInput(f"port must be 0..65535, got {port}")
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -53,8 +56,12 @@ class UdpEndpoint:
         host, port = self._sock.getsockname()[:2]
         return str(host), int(port)
 
-    def receive(self, timeout_s: float) -> Datagram | None:
-        """The next datagram, or None when none arrives within ``timeout_s`` seconds."""
+    def receive(self, timeout_s: float, *, stop_on_refused: bool = False) -> Datagram | None:
+        """The next datagram, or None when none arrives within ``timeout_s`` seconds.
+
+        An ICMP "port unreachable" for an earlier send is counted in :attr:`refused`;
+        with ``stop_on_refused`` it also ends the wait (None), else the wait goes on.
+        """
         deadline = time.monotonic() + timeout_s
         while True:
             left = deadline - time.monotonic()
@@ -66,12 +73,27 @@ class UdpEndpoint:
             except TimeoutError:
                 return None
             except (ConnectionResetError, ConnectionRefusedError):
-                continue  # an ICMP "port unreachable" for an earlier send: not a datagram, keep waiting
+                self.refused += 1
+                if stop_on_refused:
+                    return None
+                continue
             return Datagram(data=data, sender=(str(sender[0]), int(sender[1])), received_s=time.monotonic())
 
+    def connect(self, address: Address) -> None:
+        """Talk to ``address`` only: datagrams from elsewhere are dropped by the system, and a
+        closed port there shows as :attr:`refused` (the ICMP reports reach connected sockets)."""
+        self._sock.connect(address)
+        self._peer = address
+
     def send(self, data: bytes, address: Address) -> None:
-        """Send one datagram to ``address``."""
-        self._sock.sendto(data, address)
+        """Send one datagram to ``address`` (a connected socket's refused send counts in :attr:`refused`)."""
+        try:
+            if address == self._peer:
+                self._sock.send(data)
+            else:
+                self._sock.sendto(data, address)
+        except (ConnectionRefusedError, ConnectionResetError):
+            self.refused += 1
 
     def close(self) -> None:
         """Release the socket."""
