@@ -33,6 +33,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/optimizers.py
 	$(BIN)/python benchmarks/synth.py
 	$(BIN)/python benchmarks/experiment.py
+	$(BIN)/python benchmarks/egm.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks scripts

@@ -287,7 +287,7 @@ def summarize(
 
     Keys of quantities measured on the executed motion contain ``executed``.
     """
-    run = np.array([p in (Phase.RUN.value,) for p in session.phase], dtype=bool)
+    run = np.array([p == Phase.RUN.value for p in session.phase], dtype=bool)
     err_deg = np.degrees(np.abs(session.q_ref - session.q_fb))[run] if run.any() else np.zeros((0, 1))
     reps = []
     energies = []
