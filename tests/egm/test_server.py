@@ -3,6 +3,7 @@
 import json
 import math
 import shutil
+import threading
 
 import numpy as np
 import pandas as pd
@@ -15,11 +16,16 @@ from joulepath.egm import (  # noqa: E402
     STREAM_CSV,
     STREAM_JSON,
     EmulatorConfig,
+    RobotMessage,
     ServeConfig,
     StreamSettings,
+    UdpEndpoint,
+    decode_sensor,
+    encode_robot,
     executed_energy,
     read_plan,
     run_emulator,
+    serve,
     stream_run,
 )
 from joulepath.errors import LimitViolation, StreamAborted  # noqa: E402
@@ -206,3 +212,35 @@ def test_stream_refuses_a_plan_outside_the_limits_before_listening(tmp_path, irb
         stream_run(folder, ServeConfig(port=0), robot="irb120", on_listening=heard.append)
     assert heard == []
     assert not (folder / STREAM_JSON).exists()
+
+
+def test_serve_counts_late_messages_and_answers_the_others(egm_run):
+    plan = read_plan(egm_run / "path.csv")
+    start = tuple(float(v) for v in np.degrees(plan.start))
+    got = {}
+    with UdpEndpoint("127.0.0.1", 0) as endpoint, UdpEndpoint("127.0.0.1", 0) as robot:
+        config = ServeConfig(port=0, timeout_s=0.5)
+        thread = threading.Thread(target=lambda: got.update(s=serve(plan, endpoint, config)), daemon=True)
+        thread.start()
+        replies = []
+        for k, t in enumerate((1000.0, 1000.008, 1000.004, 1000.012)):  # the third is older than the second
+            msg = RobotMessage(
+                seqno=k,
+                tm_ms=round(t * 1000),
+                time_s=t,
+                joints_deg=start,
+                motors_on=True,
+                egm_running=False,
+                rapid_running=True,
+            )
+            robot.send(encode_robot(msg), endpoint.address)
+            reply = robot.receive(
+                0.1 if k == 2 else 1.0
+            )  # no answer to the late one: wait less than the timeout
+            replies.append(None if reply is None else decode_sensor(reply.data, 6))
+        thread.join(10)
+    session = got["s"]
+    assert session.late == 1 and session.parsed == 3 and session.received == 4
+    assert [r is None for r in replies] == [False, False, True, False]
+    assert [r.tm_ms for r in replies if r is not None] == [1000000, 1000008, 1000012]
+    assert session.fault is not None and "no datagram" in session.fault
