@@ -285,7 +285,14 @@ def summarize(
 ) -> dict[str, Any]:
     """``stream.json``: datagrams, tracking error, executed duration and energy against the plan.
 
-    Keys of quantities measured on the executed motion contain ``executed``.
+    Keys of quantities measured on the executed motion contain ``executed``. Per run:
+    ``executed_duration_s`` is the controller time from the run's first reference to
+    the first message past the plan's end; ``executed_settle_s`` from there to the
+    settled end; ``energy_executed_J`` the feedback's energy over both
+    (:func:`executed_energy`), and ``saved_executed_pct`` against ``result.json``'s
+    ``energy_default_J``. The tracking error is |reference − feedback| of the messages
+    in ``run``. ``late``: messages whose controller time is not after the previous
+    one's (ignored, not answered).
     """
     run = np.array([p == Phase.RUN.value for p in session.phase], dtype=bool)
     err_deg = np.degrees(np.abs(session.q_ref - session.q_fb))[run] if run.any() else np.zeros((0, 1))

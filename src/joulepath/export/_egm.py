@@ -157,7 +157,9 @@ What the module sets: convergence limits ±{CONVERGENCE_DEG:g} deg on every join
 `\\CondTime` = {duration + SETTLE_S:g} s (the move plus {SETTLE_S:g} s: the EGM motion ends when every
 joint has converged to the held end, or then at the latest), `\\RampInTime` = {RAMP_IN_S:g} s,
 `\\SampleRate` = {SAMPLE_RATE_MS} ms, `\\MaxSpeedDeviation` = the fastest joint's limit, and
-`EGM_STOP_HOLD`.
+`EGM_STOP_HOLD`. Not yet run on a real controller: if your RobotWare ends the EGM motion as soon
+as the robot meets `CONV` at the held start, `stream.json` counts the runs as interrupted
+(`repetitions_interrupted`); narrow `CONV` then.
 
 ## PC
 
