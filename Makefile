@@ -13,7 +13,7 @@ $(BIN)/python:
 
 $(STAMP): $(BIN)/python pyproject.toml constraints.txt
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -c constraints.txt -e ".[ml,synth,dask,reference,robots,test]"
+	$(BIN)/python -m pip install -q -c constraints.txt -e ".[ml,synth,dask,reference,robots,abb,test]"
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -33,6 +33,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/optimizers.py
 	$(BIN)/python benchmarks/synth.py
 	$(BIN)/python benchmarks/experiment.py
+	$(BIN)/python benchmarks/egm.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks scripts

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import threading
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -116,3 +119,62 @@ def dask_scheduler():
         dashboard_address=None,
     ) as cluster:
         yield cluster.scheduler_address
+
+
+# The EGM tests' fixed task (tests/egm, tests/export/test_egm.py, tests/cli/test_stream.py).
+EGM_START = (0.3, 0.2, -0.4, 0.5, -0.6, 1.0)
+EGM_END = (-0.9, 0.6, 0.3, -1.2, 0.8, -1.5)
+EGM_DURATION = 1.6
+
+
+@pytest.fixture(scope="session")
+def egm_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The fixed task optimized with the default settings, written with ``export="egm"``."""
+    from joulepath.optimize import OptimizeConfig, optimize_move, write_run
+
+    robot = joulepath.load_robot("irb120")
+    result = optimize_move(robot, np.array(EGM_START), np.array(EGM_END), EGM_DURATION, OptimizeConfig())
+    out = tmp_path_factory.mktemp("egm_run")
+    write_run(result, robot, out, export="egm")
+    return out
+
+
+class Background:
+    """Run ``target`` in a thread; ``address`` is set once it listens, ``result``/``error`` when it ends."""
+
+    def __init__(self, target: Callable[[Callable[[tuple[str, int]], None]], Any]) -> None:
+        self.address: tuple[str, int] | None = None
+        self.result: Any = None
+        self.error: BaseException | None = None
+        self._listening = threading.Event()
+
+        def run() -> None:
+            try:
+                self.result = target(self._on_listening)
+            except BaseException as err:  # handed to the test
+                self.error = err
+            finally:
+                self._listening.set()
+
+        self._thread = threading.Thread(target=run, daemon=True)
+        self._thread.start()
+
+    def _on_listening(self, address: tuple[str, int]) -> None:
+        self.address = address
+        self._listening.set()
+
+    def wait_listening(self, timeout: float = 30.0) -> tuple[str, int]:
+        assert self._listening.wait(timeout), "the server did not start listening"
+        if self.error is not None:
+            raise self.error
+        assert self.address is not None
+        return self.address
+
+    def join(self, timeout: float = 60.0) -> None:
+        self._thread.join(timeout)
+        assert not self._thread.is_alive(), "the server did not stop"
+
+
+@pytest.fixture
+def background() -> Iterator[type[Background]]:
+    yield Background

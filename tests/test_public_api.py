@@ -23,6 +23,7 @@ PACKAGES = [
     "joulepath.report",
     "joulepath.program",
     "joulepath.measure",
+    "joulepath.egm",
 ]
 
 
@@ -75,6 +76,7 @@ ALLOWED = {
     "units": set(),
     "abb": set(),
     "report": set(),  # reads a run folder's files only
+    "egm": {"description", "dynamics", "energy"},  # streams a run folder's path; its robot and energy
     "experiment": None,  # orchestrates every stage, like the CLI
     "cli": None,  # may import anything
 }

@@ -9,6 +9,8 @@ derives from the matching built-in so that ``except ValueError`` keeps working::
     ├── InvalidLog (ValueError)                a joint log or energy table that cannot be used
     ├── LimitViolation (ValueError)            a result that would drive a joint past a limit
     ├── InvalidModel (ValueError)              a model file refused, or a table it cannot read
+    ├── InvalidMessage (ValueError)            a controller datagram that is not a valid message
+    ├── StreamAborted (RuntimeError)           a controller connection stopped on a fault
     └── MissingDependency (ImportError)        an optional extra is not installed
 
 Messages say what was received, what was expected and how to fix it.
@@ -39,6 +41,18 @@ class LimitViolation(JoulepathError, ValueError):
 
 class InvalidModel(JoulepathError, ValueError):
     """A model file is refused (unknown types, bad card) or does not fit the table given."""
+
+
+class InvalidMessage(JoulepathError, ValueError):
+    """A datagram from a robot controller does not parse or misses a field (``reason`` says which)."""
+
+    def __init__(self, reason: str, detail: str = "") -> None:
+        super().__init__(f"{reason}: {detail}" if detail else reason)
+        self.reason = reason
+
+
+class StreamAborted(JoulepathError, RuntimeError):
+    """A streaming session to a controller stopped on a fault (silence, robot away from the plan)."""
 
 
 class MissingDependency(JoulepathError, ImportError):

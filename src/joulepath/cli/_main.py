@@ -15,6 +15,7 @@ from joulepath.cli._learn import importance, train
 from joulepath.cli._measure import measure
 from joulepath.cli._optimize import bench_optimizers, optimize
 from joulepath.cli._robot import robot_app
+from joulepath.cli._stream import stream
 from joulepath.cli._synth import compare, synth
 from joulepath.errors import JoulepathError
 
@@ -38,6 +39,7 @@ app.command("optimize")(optimize)
 app.command("bench-optimizers")(bench_optimizers)
 app.command("cycle")(cycle)
 app.command("measure")(measure)
+app.command("stream")(stream)
 app.command("run")(run)
 app.command("demo")(demo)
 

@@ -101,7 +101,8 @@ def optimize(
     export: str = typer.Option(
         "",
         "--export",
-        help="Program to write: rapid, urscript, urscript-cb3 or ros2 (default: the robot's own controller).",
+        help="Program to write: rapid, egm (ABB EGM streaming), urscript, urscript-cb3 or ros2 "
+        "(default: the robot's own controller).",
     ),
     lock: list[str] = lock_option(),
     unchecked: bool = unchecked_option(),

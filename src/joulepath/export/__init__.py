@@ -1,8 +1,9 @@
 """Programs that leave the tool: exporters for robot controllers, and the moves they run.
 
 Every exporter renders a verified path into files (:class:`Exporter`,
-:data:`EXPORTERS`): ABB RAPID, Universal Robots URScript (e-series 500 Hz, CB3
-125 Hz) and a ROS 2 ``JointTrajectory``. Which one a robot gets by default is the
+:data:`EXPORTERS`): ABB RAPID, an ABB EGM session (RAPID module + setup note; the PC
+streams the path with ``joulepath stream``), Universal Robots URScript (e-series
+500 Hz, CB3 125 Hz) and a ROS 2 ``JointTrajectory``. Which one a robot gets by default is the
 controller it declares (:func:`declared_controller`).
 """
 
@@ -18,6 +19,7 @@ from joulepath.export._base import (
     robot_vendor,
     select_exporter,
 )
+from joulepath.export._egm import EGM_DEVICE, EGM_PORT, egm_module, render_egm
 from joulepath.export._excitation import excitation_module
 from joulepath.export._moves import Move, draw_moves, random_moves
 from joulepath.export._rapid import (
@@ -39,6 +41,15 @@ register_exporter(
         "ABB RAPID module (MoveAbsJ), default and optimized move",
         render_rapid,
         follows="via-points",
+    )
+)
+register_exporter(
+    Exporter(
+        "egm",
+        "ABB",
+        ("egm.mod", "EGM_SETUP.md"),
+        "ABB EGM joint streaming (RAPID module + setup note; the PC runs `joulepath stream`)",
+        render_egm,
     )
 )
 register_exporter(
@@ -71,6 +82,8 @@ register_exporter(
 
 __all__ = [
     "DEFAULT_CONTROLLER",
+    "EGM_DEVICE",
+    "EGM_PORT",
     "EXPORTERS",
     "Exporter",
     "MODES",
@@ -80,6 +93,7 @@ __all__ = [
     "collection_programs",
     "declared_controller",
     "draw_moves",
+    "egm_module",
     "excitation_module",
     "get_exporter",
     "measurement_module",
@@ -87,6 +101,7 @@ __all__ = [
     "random_moves",
     "refuse_foreign",
     "register_exporter",
+    "render_egm",
     "render_rapid",
     "render_ros2",
     "render_urscript",
