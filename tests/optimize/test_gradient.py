@@ -9,11 +9,14 @@ from scipy.interpolate import BSpline
 from joulepath.dynamics import NOMINAL_FRICTION, inverse_dynamics_derivatives
 from joulepath.errors import LimitViolation
 from joulepath.optimize import (
+    ACCEL_TIME,
+    JERK_TIME,
     OptimizeConfig,
     SplineProblem,
     acceleration_limit,
     check_default_feasible,
     check_limits,
+    jerk_limit,
     optimize_move,
     random_tasks,
     shortest_feasible_duration,
@@ -163,7 +166,7 @@ def test_corridor_keeps_the_tcp_near_the_default(irb120):
 
 def test_infeasible_default_is_refused_with_the_shortest_feasible_duration(irb120):
     with pytest.raises(
-        LimitViolation, match=r"infeasible task: .*joint \d (speed|acceleration).*shortest duration"
+        LimitViolation, match=r"infeasible task: .*joint \d (speed|acceleration|jerk).*shortest duration"
     ):
         optimize_move(irb120, Q0, QF, 0.5, OptimizeConfig())
     T = shortest_feasible_duration(
@@ -172,7 +175,8 @@ def test_infeasible_default_is_refused_with_the_shortest_feasible_duration(irb12
         QF,
         dt=0.025,
         friction=NOMINAL_FRICTION,
-        acceleration_limit=acceleration_limit(irb120, 0.25),
+        acceleration_limit=acceleration_limit(irb120, ACCEL_TIME),
+        jerk_limit=jerk_limit(irb120, ACCEL_TIME, JERK_TIME),
     )
     assert T is not None
     check_default_feasible(irb120, Q0, QF, T)
@@ -181,11 +185,15 @@ def test_infeasible_default_is_refused_with_the_shortest_feasible_duration(irb12
 
 
 def test_random_tasks_are_feasible(irb120):
-    amax = acceleration_limit(irb120, 0.25)
+    amax = acceleration_limit(irb120, ACCEL_TIME)
+    jmax = jerk_limit(irb120, ACCEL_TIME, JERK_TIME)
     tasks = random_tasks(irb120, 20, seed=3, durations=(0.5, 1.5))
     for q0, qf, T in tasks:
         fine = minimum_jerk(q0, qf, T, dt=0.0025)
-        assert check_limits(irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok
+        report = check_limits(
+            irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=jmax
+        )
+        assert report.ok
 
 
 QW = np.array([-0.2, 0.1, 0.1, -0.3, 0.2, -0.2])

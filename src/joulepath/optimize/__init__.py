@@ -23,13 +23,11 @@ from joulepath.optimize._problem import (
     register_fitness,
 )
 from joulepath.optimize._run import (
-    ACCEL_TIME,
     MAX_DURATION,
     RUN_FILES,
     MoveResult,
     MoveSummary,
     OptimizeConfig,
-    acceleration_limit,
     check_default_feasible,
     optimize_move,
     rank_joints_by_energy,
@@ -42,8 +40,10 @@ from joulepath.optimize._verify import (
     LimitExcess,
     LimitReport,
     check_limits,
+    path_jerk,
     shortest_feasible_duration,
 )
+from joulepath.sim import ACCEL_TIME, JERK_TIME, acceleration_limit, jerk_limit
 
 __all__ = [
     "ACCEL_TIME",
@@ -58,6 +58,7 @@ __all__ = [
     "register_fitness",
     "GradientResult",
     "GradientSettings",
+    "JERK_TIME",
     "LimitExcess",
     "LimitReport",
     "MAX_DURATION",
@@ -76,10 +77,12 @@ __all__ = [
     "check_default_feasible",
     "check_limits",
     "default_configuration",
+    "jerk_limit",
     "limit_violation",
     "optimize_move",
     "optimize_spline",
     "path_features",
+    "path_jerk",
     "physics_energy",
     "random_tasks",
     "rank_joints_by_energy",

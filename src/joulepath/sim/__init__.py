@@ -8,6 +8,7 @@ from joulepath.sim._controller import (
     log_times,
     plan_moves,
 )
+from joulepath.sim._limits import ACCEL_TIME, JERK_TIME, acceleration_limit, jerk_limit
 from joulepath.sim._plants import PLANTS, LabFriction, Measured, Plant, make_plant, run_plant
 from joulepath.sim._run import (
     THESIS_PLAN,
@@ -20,7 +21,9 @@ from joulepath.sim._run import (
 )
 
 __all__ = [
+    "ACCEL_TIME",
     "ControllerConfig",
+    "JERK_TIME",
     "LabFriction",
     "Measured",
     "MotionPlan",
@@ -29,7 +32,9 @@ __all__ = [
     "Segment",
     "SimulatedLog",
     "THESIS_PLAN",
+    "acceleration_limit",
     "evaluate_plan",
+    "jerk_limit",
     "log_text",
     "log_times",
     "make_plant",
