@@ -110,6 +110,13 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
     tau = r.inverse_dynamics(s.fine.q, s.fine.qd, s.fine.qdd, friction=NOMINAL_FRICTION)
     assert s.energy_J == pytest.approx(float(path_energy(tau, s.fine.qd, s.fine.dt).total))
     assert s.fine.dt == pytest.approx(FINE_DT)
+    # every optimized move keeps the jerk limit (the controller's default) on the 2.5 ms grid
+    from joulepath.optimize import jerk_limit, path_jerk
+
+    jmax = jerk_limit(r, settings.accel_time, settings.jerk_time)
+    assert jmax is not None
+    for p in result.paths.values():
+        assert np.all(np.abs(path_jerk(p.fine)[1]) <= jmax * (1 + 1e-7))
     # a result outside a limit is refused: no module, the reason in cycle.json, a stale module removed
     from dataclasses import replace
 
@@ -128,6 +135,16 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
     e = [p.energy_J for p in front]
     assert all(b <= a + 1e-9 for a, b in zip(e, e[1:], strict=False))
     assert front[0].cycle_time_s == pytest.approx(opt.shortest_cycle + opt.wait_total)
+
+
+def test_cycle_settings_refuse_a_negative_jerk_time(tmp_path):
+    from joulepath.errors import InvalidInput
+
+    with pytest.raises(InvalidInput, match=r"jerk_time must be in \[0, 10\] s"):
+        CycleSettings(jerk_time=-0.1)
+    prog = tmp_path / "small.mod"
+    prog.write_text(SMALL)
+    assert main(["cycle", str(prog), "--out", str(tmp_path / "run"), "--jerk-time", "-1"]) == 2
 
 
 def test_cycle_time_too_short_refused(spec):

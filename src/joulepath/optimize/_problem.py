@@ -210,11 +210,11 @@ class TrajectoryProblem:
     def xu(self) -> FloatArray:
         return np.full(self.n_var, GRID_HIGH)
 
-    def trajectory(self, X: FloatArray) -> Trajectory:
-        """Paths of chromosomes X (P, 6·n) or (6·n,)."""
+    def trajectory(self, X: FloatArray, *, dt: float | None = None) -> Trajectory:
+        """Paths of chromosomes X (P, 6·n) or (6·n,), on the samples (or every ``dt`` s)."""
         chrom = np.asarray(X, dtype=float).reshape(-1, self.robot.n_joints, N_COEFFICIENTS)
         build = rest_to_rest if self.parametrization == "rest_to_rest" else thesis_quintic
-        return build(chrom, self.q_start, self.q_end, self.duration, dt=self.dt)
+        return build(chrom, self.q_start, self.q_end, self.duration, dt=self.dt if dt is None else dt)
 
     def energy(self, traj: Trajectory) -> tuple[FloatArray, FloatArray | None]:
         """Unpenalized fitness energy of paths (J) and torques where computed."""
@@ -231,11 +231,25 @@ class TrajectoryProblem:
         return total, None
 
     def evaluate(self, X: FloatArray) -> FloatArray:
+        """Penalized energy; with a jerk limit the kinematic limits are penalized on the fine grid.
+
+        A jerk that peaks between samples (at the ends of a polynomial path) is averaged
+        away by the samples' differences, so with ``jerk_limit`` the ranges, speeds,
+        accelerations and jerks are measured on the grid results are checked on
+        (``FINE_FACTOR`` times finer), the efforts on the samples.
+        """
         traj = self.trajectory(X)
         energy, tau = self.energy(traj)
         self.n_evaluated += energy.size
-        viol = limit_violation(
-            self.robot, traj, tau, acceleration_limit=self.acceleration_limit, jerk_limit=self.jerk_limit
-        )
-        out: FloatArray = energy + PENALTY * viol.total
+        amax, jmax = self.acceleration_limit, self.jerk_limit
+        if jmax is None:
+            viol = limit_violation(self.robot, traj, tau, acceleration_limit=amax)
+            total = viol.total
+        else:
+            from joulepath.optimize._verify import FINE_FACTOR  # _verify imports this module
+
+            fine = self.trajectory(X, dt=self.dt / FINE_FACTOR)
+            kin = limit_violation(self.robot, fine, None, acceleration_limit=amax, jerk_limit=jmax)
+            total = kin.range + kin.speed + limit_violation(self.robot, traj, tau).torque
+        out: FloatArray = energy + PENALTY * total
         return out
