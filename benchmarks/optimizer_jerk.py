@@ -18,6 +18,7 @@ stopped by ``--deadline`` keeps its results; ``--report-only`` writes the BENCHM
 
 Usage:
     python benchmarks/optimizer_jerk.py --tasks 12 --deadline-utc 09:05
+    python benchmarks/optimizer_jerk.py --first 12 --tasks 10 --skip-reference   # more tasks, defaults only
     python benchmarks/optimizer_jerk.py --report-only
 """
 
@@ -193,8 +194,9 @@ def run(args: argparse.Namespace) -> None:
     amax = acceleration_limit(robot, ACCEL_TIME)
     jmax = jerk_limit(robot, ACCEL_TIME, JERK_TIME)
     assert amax is not None and jmax is not None
-    draw = random_tasks(robot, args.tasks, seed=SEED, range_set="lab", jerk_time=0)
-    todo = [("fixed", *FIXED_TASK), *((str(k), *task) for k, task in enumerate(draw))]
+    draw = random_tasks(robot, args.first + args.tasks, seed=SEED, range_set="lab", jerk_time=0)
+    todo = [("fixed", *FIXED_TASK)] if args.first == 0 else []
+    todo += [(str(k), *draw[k]) for k in range(args.first, args.first + args.tasks)]
     stamp = time.strftime("%Y%m%d-%H%M", time.gmtime())
     out = args.out / f"optimizer_jerk_{stamp}.csv"
     commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout
@@ -209,6 +211,8 @@ def run(args: argparse.Namespace) -> None:
         "started_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
         "load_at_start": os.getloadavg(),
         "tasks_asked": args.tasks,
+        "first": args.first,
+        "reference": not args.skip_reference,
         "skipped_jerk_infeasible": [],
     }
     meta_path = out.with_suffix(".json")
@@ -391,6 +395,7 @@ def main() -> None:
     parser.add_argument(
         "--tasks", type=int, default=12, help="random tasks of the draw (after the fixed task)"
     )
+    parser.add_argument("--first", type=int, default=0, help="first random task (above 0: no fixed task)")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     parser.add_argument(
         "--deadline-utc", default=None, help="HH:MM today (UTC): start no task that may end after it"
