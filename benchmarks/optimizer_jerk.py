@@ -345,6 +345,21 @@ def report(folder: Path) -> str:
             f"| within every limit, jerk included | {okj} of {len(pairs)} | {okn} of {len(pairs)} | - |",
             "",
         ]
+        better = [
+            (t, m["jerk"]["saved_fine_pct"], m["no-jerk"]["saved_fine_pct"])
+            for t, m in by.items()
+            if t != "fixed"
+            and "jerk" in m
+            and "no-jerk" in m
+            and m["jerk"]["saved_fine_pct"] > m["no-jerk"]["saved_fine_pct"]
+        ]
+        if better:
+            lines += [
+                "A constraint cannot lower the optimum, but both are local searches: on "
+                + ", ".join(f"task {t} ({a:.1f} % with, {b:.1f} % without)" for t, a, b in better)
+                + " the search without jerk limits ended in a worse local minimum than the one with them.",
+                "",
+            ]
     shares, worse = [], []
     for t, m in by.items():
         refs = [
