@@ -2,7 +2,9 @@
 
 On feasible random tasks (``random_tasks``: lab ranges, T in [1, 3] s, fixed seed)
 and on the issue's fixed task, each of these is run on the physics fitness (nominal
-rigid body + ``NOMINAL_FRICTION``, acceleration limits ``v_max / ACCEL_TIME``):
+rigid body + ``NOMINAL_FRICTION``, acceleration limits ``v_max / ACCEL_TIME`` and jerk limits
+``v_max / ACCEL_TIME / --jerk-time``, default ``JERK_TIME``; ``--jerk-time 0``: none, as before
+jerk limits existed; every method, the reference included, gets the same limits):
 
 * ``default`` — ``optimize_move`` with ``OptimizeConfig()`` (algorithm "auto": the
   coarse-to-fine constrained gradient search);
@@ -33,8 +35,13 @@ with ``friction=None``; ``OptimizeConfig`` has no friction switch), the referenc
 and the scipy/pymoo peers; the package's CMA-ES and thesis searches always use the
 nominal friction, so they are skipped there.
 
+The CSVs in benchmarks/results without a ``jerk`` tag in their name were run without jerk limits
+(before they existed, or with ``--jerk-time 0``); the report aggregates every CSV of ``--prefix``,
+so give runs with jerk limits their own prefix (``benchmarks/optimizer_jerk.py`` measures what
+jerk limits cost).
+
 Usage:
-    python benchmarks/optimizer_peers.py --tasks 10 --first 0 --fixed
+    python benchmarks/optimizer_peers.py --tasks 10 --first 0 --fixed --jerk-time 0
     python benchmarks/optimizer_peers.py --tasks 30 --first 20 --methods default,reference
     python benchmarks/optimizer_peers.py --report-only     # aggregate CSVs, write BENCHMARKS.md
 """
@@ -63,13 +70,17 @@ from threadpoolctl import threadpool_limits  # noqa: E402
 
 import joulepath  # noqa: E402
 from joulepath.dynamics import NOMINAL_FRICTION, Robot  # noqa: E402
+from joulepath.errors import LimitViolation  # noqa: E402
 from joulepath.optimize import (  # noqa: E402
     ACCEL_TIME,
     FINE_FACTOR,
+    JERK_TIME,
     PENALTY,
     OptimizeConfig,
     acceleration_limit,
+    check_default_feasible,
     check_limits,
+    jerk_limit,
     limit_violation,
     optimize_move,
     physics_energy,
@@ -193,9 +204,17 @@ class SplineObjective:
     """Penalized energy of B-spline coefficient vectors, vectorized over a population."""
 
     def __init__(
-        self, robot: Robot, q0: np.ndarray, qf: np.ndarray, T: float, amax: np.ndarray, friction: Any
+        self,
+        robot: Robot,
+        q0: np.ndarray,
+        qf: np.ndarray,
+        T: float,
+        amax: np.ndarray,
+        friction: Any,
+        jmax: np.ndarray | None = None,
     ) -> None:
         self.robot, self.q0, self.qf, self.amax, self.friction = robot, q0, qf, amax, friction
+        self.jmax = jmax
         self.basis = SplineBasis(T, knot_spacing=PEER_KNOT_SPACING, dt=SAMPLE_PERIOD)
         self.m, self.n = self.basis.n_free, robot.n_joints
         # box for the coefficients: wide enough to hold the optimum's shapes (the default's
@@ -214,7 +233,7 @@ class SplineObjective:
         X = np.atleast_2d(X)
         traj = self.basis.trajectory(X.reshape(-1, self.m, self.n), self.q0, self.qf)
         energy, tau = physics_energy(self.robot, traj, friction=self.friction)
-        viol = limit_violation(self.robot, traj, tau, acceleration_limit=self.amax)
+        viol = limit_violation(self.robot, traj, tau, acceleration_limit=self.amax, jerk_limit=self.jmax)
         self.n_evaluated += X.shape[0]
         out: np.ndarray = energy + PENALTY * viol.total
         return out
@@ -304,6 +323,7 @@ class Bench:
         self.robot, self.args, self.out_csv = robot, args, out_csv
         self.friction = NOMINAL_FRICTION if args.friction == "nominal" else None
         self.amax = acceleration_limit(robot, ACCEL_TIME)
+        self.jmax = jerk_limit(robot, ACCEL_TIME, args.jerk_time)
         new = not out_csv.exists()
         self.fh = out_csv.open("a", newline="")
         self.writer = csv.DictWriter(self.fh, fieldnames=FIELDS)
@@ -315,7 +335,9 @@ class Bench:
         return energy_on_samples(self.robot, path, friction=self.friction)
 
     def limits(self, fine: Trajectory) -> Any:
-        return check_limits(self.robot, fine, friction=self.friction, acceleration_limit=self.amax)
+        return check_limits(
+            self.robot, fine, friction=self.friction, acceleration_limit=self.amax, jerk_limit=self.jmax
+        )
 
     def write(self, row: dict[str, Any]) -> None:
         self.writer.writerow({k: row.get(k, "") for k in FIELDS})
@@ -367,7 +389,7 @@ class Bench:
         if "default" not in methods:
             pass
         elif self.friction is not None:
-            cfg = OptimizeConfig(seed=seed)
+            cfg = OptimizeConfig(seed=seed, jerk_time=self.args.jerk_time)
             res, wall, cpu = run_timed(lambda: optimize_move(robot, q0, qf, T, cfg))
             s = res.summary
             fine = fine_path_of(res, q0, qf, T)
@@ -414,6 +436,7 @@ class Bench:
                     settings=settings,
                     rng=np.random.default_rng(seed),
                     acceleration_limit=self.amax,
+                    jerk_limit=self.jmax,
                     dt=SAMPLE_PERIOD,
                 )
             )
@@ -439,7 +462,8 @@ class Bench:
                 ("reference-mj", {"continuation": REF_CONTINUATION}),
                 ("reference-ours", {"initial": default_path, "continuation": REF_WARM_CONTINUATION}),
             )
-            if ("reference" in methods or label in methods) and (label == "reference-mj" or default_path is not None)
+            if ("reference" in methods or label in methods)
+            and (label == "reference-mj" or default_path is not None)
         ]
         if starts:
             refs = []
@@ -452,6 +476,7 @@ class Bench:
                         T,
                         friction=self.friction,
                         acceleration_limit=self.amax,
+                        jerk_limit=self.jmax,
                         substeps=4,
                         **kw,
                     )
@@ -482,14 +507,20 @@ class Bench:
         budget = 6000
         if "cmaes" in methods and self.friction is not None:
             res, wall, cpu = run_timed(
-                lambda: optimize_move(robot, q0, qf, T, OptimizeConfig(algorithm="cmaes", seed=seed))
+                lambda: optimize_move(
+                    robot,
+                    q0,
+                    qf,
+                    T,
+                    OptimizeConfig(algorithm="cmaes", seed=seed, jerk_time=self.args.jerk_time),
+                )
             )
             budget = res.summary.evaluations
             self._package_row(res, "cmaes", row, wall, cpu, q0, qf, T)
         for name, runner in (("scipy-de", run_scipy_de), ("pymoo-ga", run_pymoo_ga)):
             if name not in methods:
                 continue
-            obj = SplineObjective(robot, q0, qf, T, self.amax, self.friction)
+            obj = SplineObjective(robot, q0, qf, T, self.amax, self.friction, self.jmax)
             cap = WALL_CAP_FACTOR * default_wall
             (x, nfev, nit), wall, cpu = run_timed(lambda r=runner, o=obj, c=cap: r(o, budget, c, seed))
             path, fine = obj.paths(x)
@@ -512,7 +543,13 @@ class Bench:
             if name not in methods or self.friction is None:
                 continue
             cfg = OptimizeConfig(
-                algorithm=name, pop_size=100, max_gen=200, n_stagnant=200, inject_default=False, seed=seed
+                algorithm=name,
+                pop_size=100,
+                max_gen=200,
+                n_stagnant=200,
+                inject_default=False,
+                seed=seed,
+                jerk_time=self.args.jerk_time,
             )
             res, wall, cpu = run_timed(lambda c=cfg: optimize_move(robot, q0, qf, T, c))
             self._package_row(res, name, row, wall, cpu, q0, qf, T)
@@ -912,6 +949,12 @@ def main() -> None:
     parser.add_argument("--friction", choices=("nominal", "none"), default="nominal")
     parser.add_argument("--fixed", action="store_true", help="run the issue's fixed task first")
     parser.add_argument(
+        "--jerk-time",
+        type=float,
+        default=JERK_TIME,
+        help="s: jerk limits v_max / ACCEL_TIME / this for every method (0: none, as before jerk limits)",
+    )
+    parser.add_argument(
         "--time-cap-min", type=float, default=60.0, help="start no new task after this many minutes"
     )
     parser.add_argument("--deadline", type=float, default=None, help="epoch seconds; start no task after it")
@@ -940,9 +983,12 @@ def main() -> None:
     if args.deadline is not None:
         deadline = min(deadline, args.deadline)
     robot = joulepath.load_robot("irb120")
-    all_tasks = random_tasks(robot, args.first + args.tasks, seed=args.seed, range_set="lab")
+    # the draw as it was before jerk limits (same task numbers); a task whose minimum-jerk move
+    # breaks the jerk limit is skipped below
+    all_tasks = random_tasks(robot, args.first + args.tasks, seed=args.seed, range_set="lab", jerk_time=0)
     span = f"{args.first:02d}-{args.first + args.tasks - 1:02d}" if args.tasks > 0 else "none"
-    tag = f"{args.friction}_{'fixed_' if args.fixed else ''}{span}_{'-'.join(methods)}"
+    jerk_tag = f"jerk{args.jerk_time:g}_" if args.jerk_time > 0 else ""  # untagged: no jerk limit
+    tag = f"{args.friction}_{jerk_tag}{'fixed_' if args.fixed else ''}{span}_{'-'.join(methods)}"
     out_csv = args.out / f"{args.prefix}_{tag}.csv"
     commit = subprocess.run(
         ["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True
@@ -958,6 +1004,7 @@ def main() -> None:
         "tasks": args.tasks,
         "methods": methods,
         "friction": args.friction,
+        "jerk_time": args.jerk_time,
         "nproc": os.cpu_count(),
         "machine": machine(),
         "started": time.strftime("%Y-%m-%d %H:%M:%S"),
@@ -977,6 +1024,11 @@ def main() -> None:
         if now + 0.5 * longest > deadline:
             print(f"time cap: stopping before task {name} ({done} done)", flush=True)
             break
+        try:
+            check_default_feasible(robot, q0, qf, T, jerk_time=args.jerk_time)
+        except LimitViolation as err:
+            print(f"task {name}: skipped, its default move breaks the jerk limit ({err})", flush=True)
+            continue
         print(f"task {name}: T = {T:.3f} s", flush=True)
         t0 = time.time()
         bench.task(name, q0, qf, T, methods)

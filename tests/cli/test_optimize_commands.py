@@ -1,5 +1,7 @@
 import json
 
+import pytest
+
 from joulepath.cli import main
 
 
@@ -69,6 +71,28 @@ def test_optimize_user_errors(tmp_path, capsys):
         == 2
     )
     assert "outside its range" in capsys.readouterr().err
+
+
+FIXED = ["--start", "0.3,0.2,-0.4,0.5,-0.6,1.0", "--end", "-0.9,0.6,0.3,-1.2,0.8,-1.5", "--duration", "1.6"]
+
+
+def test_optimize_jerk_time_refused_in_one_line(tmp_path, capsys):
+    for bad in ("-0.1", "11", "nan"):
+        assert main(["optimize", *FIXED, "--jerk-time", bad, "--out", str(tmp_path / "run")]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and "jerk_time must be 0..10 s (0: no jerk limit)" in err
+    assert not (tmp_path / "run").exists()
+
+
+def test_optimize_jerk_time_zero_runs_without_a_jerk_limit(tmp_path, capsys):
+    """``--jerk-time 0``: the optimizer as it was before jerk limits (fixed task: 10.540 J, BENCHMARKS.md)."""
+    out = tmp_path / "run"
+    assert main(["optimize", *FIXED, "--jerk-time", "0", "--out", str(out)]) == 0
+    data = json.loads((out / "result.json").read_text())
+    assert data["jerk_limit_rad_s3"] is None and data["config"]["jerk_time"] == 0
+    assert data["energy_optimized_J"] == pytest.approx(10.540, abs=1e-3)
+    assert data["max_jerk_rad_s3"] > 1000  # what a jerk limit would have removed
+    assert "largest jerk" in capsys.readouterr().out
 
 
 def test_bench_optimizers_quick_physics(tmp_path, capsys, monkeypatch):

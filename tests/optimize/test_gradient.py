@@ -9,11 +9,14 @@ from scipy.interpolate import BSpline
 from joulepath.dynamics import NOMINAL_FRICTION, inverse_dynamics_derivatives
 from joulepath.errors import LimitViolation
 from joulepath.optimize import (
+    ACCEL_TIME,
+    JERK_TIME,
     OptimizeConfig,
     SplineProblem,
     acceleration_limit,
     check_default_feasible,
     check_limits,
+    jerk_limit,
     optimize_move,
     random_tasks,
     shortest_feasible_duration,
@@ -165,7 +168,7 @@ def test_corridor_keeps_the_tcp_near_the_default(irb120):
 
 def test_infeasible_default_is_refused_with_the_shortest_feasible_duration(irb120):
     with pytest.raises(
-        LimitViolation, match=r"infeasible task: .*joint \d (speed|acceleration).*shortest duration"
+        LimitViolation, match=r"infeasible task: .*joint \d (speed|acceleration|jerk).*shortest duration"
     ):
         optimize_move(irb120, Q0, QF, 0.5, OptimizeConfig())
     T = shortest_feasible_duration(
@@ -174,7 +177,8 @@ def test_infeasible_default_is_refused_with_the_shortest_feasible_duration(irb12
         QF,
         dt=0.025,
         friction=NOMINAL_FRICTION,
-        acceleration_limit=acceleration_limit(irb120, 0.25),
+        acceleration_limit=acceleration_limit(irb120, ACCEL_TIME),
+        jerk_limit=jerk_limit(irb120, ACCEL_TIME, JERK_TIME),
     )
     assert T is not None
     check_default_feasible(irb120, Q0, QF, T)
@@ -183,11 +187,15 @@ def test_infeasible_default_is_refused_with_the_shortest_feasible_duration(irb12
 
 
 def test_random_tasks_are_feasible(irb120):
-    amax = acceleration_limit(irb120, 0.25)
+    amax = acceleration_limit(irb120, ACCEL_TIME)
+    jmax = jerk_limit(irb120, ACCEL_TIME, JERK_TIME)
     tasks = random_tasks(irb120, 20, seed=3, durations=(0.5, 1.5))
     for q0, qf, T in tasks:
         fine = minimum_jerk(q0, qf, T, dt=0.0025)
-        assert check_limits(irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok
+        report = check_limits(
+            irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=jmax
+        )
+        assert report.ok
 
 
 QW = np.array([-0.2, 0.1, 0.1, -0.3, 0.2, -0.2])
@@ -236,3 +244,132 @@ def test_a_move_through_a_waypoint_passes_it_at_speed_within_every_limit(irb120)
         SplineProblem(
             irb120, Q0, QF, 1.2, NOMINAL_FRICTION, SplineBasis(1.2, knot_spacing=0.1), waypoints=((1.2, QW),)
         )
+
+
+# ------------------------------------------------------------------ jerk limits
+def _independent_fine(basis, C, q0, qf, T, dt):
+    """q̈ and the jerk on a grid, from SciPy's B-spline of the control points and the quintic's own formula."""
+    t = np.arange(round(T / dt) + 1) * dt
+    ctrl = basis.minimum_jerk_control(q0, qf)[0] + basis.control_maps[0] @ C
+    spline = BSpline(basis.knots, ctrl, basis.degree)
+    return t, spline.derivative(2)(t), spline.derivative(3)
+
+
+def test_jerk_rows_are_the_differences_of_the_fine_grid_accelerations(irb120, rng):
+    """Rows against an independent evaluation: SciPy's spline, differences of its q̈ on the fine grid."""
+    T = 1.2
+    basis = SplineBasis(T, knot_spacing=0.1)
+    jmax = jerk_limit(irb120, ACCEL_TIME, JERK_TIME)
+    problem = SplineProblem(irb120, Q0, QF, T, NOMINAL_FRICTION, basis, jerk_limit=jmax)
+    x = rng.standard_normal(problem.n_var) * 0.05
+    t, qdd, third = _independent_fine(basis, problem.coefficients(x), Q0, QF, T, 0.0025)
+    jerk = np.diff(qdd, axis=0) / 0.0025
+    K = jerk.shape[0]
+    idx = np.arange(2 * K * 6)
+    A, b = problem._jerk_rows(idx)
+    slack = (A @ x + b).reshape(2 * K, 6)
+    lim = jmax * (1 - 1e-6)
+    np.testing.assert_allclose(slack[:K], lim - jerk, rtol=0, atol=1e-6 * jmax.max())
+    np.testing.assert_allclose(slack[K:], lim + jerk, rtol=0, atol=1e-6 * jmax.max())
+    np.testing.assert_allclose(problem.jerk_slack(x), slack, atol=1e-9 * jmax.max())
+    # the mean jerk over each 2.5 ms step agrees with the analytic third derivative at its midpoint
+    mid = third(0.5 * (t[1:] + t[:-1]))
+    assert np.abs(jerk - mid).max() <= 1e-3 * np.abs(mid).max()
+
+
+@pytest.fixture(scope="module")
+def fixed_no_jerk(irb120):
+    return optimize_move(irb120, Q0, QF, 1.6, OptimizeConfig(seed=1, jerk_time=0))
+
+
+def test_fixed_task_keeps_the_jerk_limit_on_the_ten_times_finer_grid(fixed, irb120):
+    """The default (jerk-limited) result, evaluated independently by SciPy on the 10x grid."""
+    s = fixed.summary
+    jmax = jerk_limit(irb120, ACCEL_TIME, JERK_TIME)
+    assert s.jerk_limit_rad_s3 == pytest.approx(tuple(jmax))
+    spline = _result_spline(fixed)
+    t = np.arange(641) * 0.0025
+    jerk = np.diff(spline.derivative(2)(t), axis=0) / 0.0025
+    assert np.all(np.abs(jerk) <= jmax * (1 + 1e-7))
+    assert s.max_jerk_rad_s3 == pytest.approx(np.abs(jerk).max(), rel=1e-6)
+    # pointwise, the spline's own jerk: between grid points within a sliver of the limit (the
+    # checked quantity is each 2.5 ms step's mean jerk); in the first and last half step, which no
+    # step's midpoint is nearer than 1.25 ms to, up to a few % above it (measured: 4.3 % at t = T)
+    t_dense = np.linspace(0, 1.6, 64001)
+    dense = np.abs(spline.derivative(3)(t_dense)) / jmax
+    inner = (t_dense >= 0.0025) & (t_dense <= 1.6 - 0.0025)
+    assert dense[inner].max() <= 1.005
+    assert dense[~inner].max() <= 1.06
+
+
+def test_jerk_limit_costs_saving_but_keeps_some(fixed, fixed_no_jerk, irb120):
+    """Adding a constraint cannot improve the optimum: checked from the other side, where it holds for
+    any local search too: the jerk-limited optimum is feasible without the jerk limit, so a search
+    without it started there ends no higher (to solver tolerance)."""
+    with_jerk, without = fixed.summary, fixed_no_jerk.summary
+    assert without.jerk_limit_rad_s3 is None and without.limits_ok and with_jerk.limits_ok
+    assert 0 < with_jerk.saved_pct < without.saved_pct
+    assert without.max_jerk_rad_s3 > 2 * max(with_jerk.jerk_limit_rad_s3)  # what the limit removes
+    from joulepath.optimize import GradientSettings, optimize_spline
+
+    start = fixed.parameters  # on the fine knots, or the coarse ones when those won
+    spacing = next(
+        k * OptimizeConfig().knot_spacing
+        for k in (1, 2)
+        if SplineBasis(1.6, knot_spacing=k * OptimizeConfig().knot_spacing).n_free == start.shape[0]
+    )
+    basis = SplineBasis(1.6, knot_spacing=spacing)
+    relaxed = SplineProblem(
+        irb120,
+        Q0,
+        QF,
+        1.6,
+        irb120.friction,
+        basis,
+        acceleration_limit=acceleration_limit(irb120, ACCEL_TIME),
+    )
+    assert relaxed.violation(start.ravel()) == 0.0
+    settings = GradientSettings(continuation=GradientSettings().continuation[-1:])
+    again = optimize_spline(relaxed, settings, rng=np.random.default_rng(0), initial=start)
+    assert again.feasible
+    assert again.energy_J <= with_jerk.energy_optimized_J * (1 + 1e-6)
+
+
+def test_jerk_time_zero_is_the_search_without_a_jerk_limit(fixed_no_jerk, irb120):
+    """``jerk_time=0`` runs exactly the search as it was before jerk limits (no jerk argument at all)."""
+    from joulepath.optimize import GradientSettings
+    from joulepath.optimize._gradient import solve_move
+
+    res, _ = solve_move(
+        irb120,
+        Q0,
+        QF,
+        1.6,
+        friction=irb120.friction,
+        settings=GradientSettings(knot_spacing=OptimizeConfig().knot_spacing, check_factor=10),
+        rng=np.random.default_rng(1),
+        acceleration_limit=acceleration_limit(irb120, ACCEL_TIME),
+    )
+    np.testing.assert_array_equal(res.path.q, fixed_no_jerk.optimized.q)
+
+
+def test_infeasible_jerk_alone_is_refused_with_the_shortest_duration(irb120):
+    """A move within its speed and acceleration limits but not its jerk limit: the message names jerk."""
+    q0, qf = np.zeros(6), np.array([0.0, 0.0, 0.0, 0.0, 0.0, 2.0])
+    T = 0.95  # 60 |Δq| / T³ = 140 rad/s³ > 98 rad/s³, joint 6's jerk limit at jerk_time 0.3 s
+    check_default_feasible(irb120, q0, qf, T, jerk_time=0)
+    with pytest.raises(LimitViolation, match=r"joint 6 jerk .* deg/s³ .*shortest duration .* is (\d\.\d+) s"):
+        check_default_feasible(irb120, q0, qf, T, jerk_time=0.3)
+    shortest = shortest_feasible_duration(
+        irb120,
+        q0,
+        qf,
+        dt=0.025,
+        friction=irb120.friction,
+        acceleration_limit=acceleration_limit(irb120, ACCEL_TIME),
+        jerk_limit=jerk_limit(irb120, ACCEL_TIME, 0.3),
+    )
+    assert shortest is not None and shortest > T
+    check_default_feasible(irb120, q0, qf, shortest, jerk_time=0.3)
+    with pytest.raises(LimitViolation, match="jerk"):
+        check_default_feasible(irb120, q0, qf, round(shortest - 0.025, 3), jerk_time=0.3)

@@ -80,3 +80,37 @@ def test_cmaes_fine_grid_penalty_agrees_with_limit_violation(irb120):
     slow = limit_violation(irb120, fine, None, acceleration_limit=amax).total
     assert fast[0] < fast[-1] and fast[-1] > 0.1  # small shapes pass, large ones break limits
     np.testing.assert_allclose(fast, slow, rtol=1e-12, atol=1e-12)
+    # with the jerk limit: the same agreement, and the jerk adds to the penalty
+    from joulepath.optimize import JERK_TIME, jerk_limit
+
+    jmax = jerk_limit(irb120, ACCEL_TIME, JERK_TIME)
+    jerky = SearchTask(irb120, q0, qf, T, amax, (), (), SAMPLE_PERIOD, jerk_limit=jmax)
+    fast_j = _FineKinematics(jerky, basis)(C)
+    slow_j = limit_violation(irb120, fine, None, acceleration_limit=amax, jerk_limit=jmax).total
+    np.testing.assert_allclose(fast_j, slow_j, rtol=1e-12, atol=1e-12)
+    assert np.all(fast_j >= fast) and fast_j[-1] > fast[-1]
+
+
+def test_jerk_penalty_of_the_evolutionary_fitness_is_measured_on_the_fine_grid(irb120):
+    """The GA's chromosomes are penalized for a jerk the samples' differences average away."""
+    from joulepath.optimize import ACCEL_TIME, FINE_FACTOR, JERK_TIME, acceleration_limit, jerk_limit
+
+    amax, jmax = acceleration_limit(irb120, ACCEL_TIME), jerk_limit(irb120, ACCEL_TIME, JERK_TIME)
+    plain = TrajectoryProblem(robot=irb120, q_start=Q0, q_end=QF, duration=1.5, acceleration_limit=amax)
+    jerky = TrajectoryProblem(
+        robot=irb120, q_start=Q0, q_end=QF, duration=1.5, acceleration_limit=amax, jerk_limit=jmax
+    )
+    X = np.random.default_rng(7).uniform(-5, 5, (40, plain.n_var))  # half the GA's box
+    f_plain, f_jerk = plain.evaluate(X), jerky.evaluate(X)
+    assert np.all(f_jerk >= f_plain - 1e-9)
+    fine = jerky.trajectory(X, dt=jerky.dt / FINE_FACTOR)
+    samples = jerky.trajectory(X)
+    jerk_fine = (
+        limit_violation(irb120, fine, None, jerk_limit=jmax).speed - limit_violation(irb120, fine).speed
+    )
+    jerk_samples = (
+        limit_violation(irb120, samples, None, jerk_limit=jmax).speed - limit_violation(irb120, samples).speed
+    )
+    # fine-grid excesses include the samples' (the samples are points of the fine grid)
+    np.testing.assert_array_less(f_plain + PENALTY * jerk_fine * (1 - 1e-9) - 1e-9, f_jerk)
+    assert np.any(jerk_fine > jerk_samples + 1e-6)  # a jerk the samples alone would miss

@@ -43,6 +43,10 @@ SMALL = """MODULE Small
 ENDMODULE
 """
 FAST = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), max_iter=60, coarse_factor=1)
+REACHABLE = 4.0
+"""s: a cycle time SMALL's optimized moves reach within the controller's jerk limits. Its own cycle,
+3.552 s, is out of their reach (shortest 3.734 s): a minimum-jerk move under the jerk limit, which
+each optimized move starts from, is slower than the controller's own sin² ramps."""
 
 
 @pytest.fixture(scope="module")
@@ -92,7 +96,7 @@ def test_zone_shortens_the_cycle(robot):
 
 
 def test_optimized_cycle_invariants(spec, robot, tmp_path):
-    settings = CycleSettings(gradient=FAST, table_points=3, use_waits=True)
+    settings = CycleSettings(gradient=FAST, table_points=3, use_waits=True, cycle_time=REACHABLE)
     result, opt = optimize_cycle(spec, settings)
     assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
     assert result.limits_ok
@@ -110,6 +114,13 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
     tau = r.inverse_dynamics(s.fine.q, s.fine.qd, s.fine.qdd, friction=NOMINAL_FRICTION)
     assert s.energy_J == pytest.approx(float(path_energy(tau, s.fine.qd, s.fine.dt).total))
     assert s.fine.dt == pytest.approx(FINE_DT)
+    # every optimized move keeps the jerk limit (the controller's default) on the 2.5 ms grid
+    from joulepath.optimize import jerk_limit, path_jerk
+
+    jmax = jerk_limit(r, settings.accel_time, settings.jerk_time)
+    assert jmax is not None
+    for p in result.paths.values():
+        assert np.all(np.abs(path_jerk(p.fine)[1]) <= jmax * (1 + 1e-7))
     # a result outside a limit is refused: no module, the reason in cycle.json, a stale module removed
     from dataclasses import replace
 
@@ -128,6 +139,30 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
     e = [p.energy_J for p in front]
     assert all(b <= a + 1e-9 for a, b in zip(e, e[1:], strict=False))
     assert front[0].cycle_time_s == pytest.approx(opt.shortest_cycle + opt.wait_total)
+
+
+def test_jerk_limits_lengthen_the_shortest_cycle(spec):
+    """The program's own cycle time is refused under the jerk limit, with the shortest reachable one."""
+    from joulepath.errors import LimitViolation
+
+    loose = CycleOptimizer(spec, CycleSettings(gradient=FAST, jerk_time=0))
+    tight = CycleOptimizer(spec, CycleSettings(gradient=FAST))
+    assert tight.shortest_cycle > loose.shortest_cycle
+    assert loose.shortest_cycle <= loose.plan.cycle_time < tight.shortest_cycle <= REACHABLE
+    with pytest.raises(
+        LimitViolation, match=r"shorter than the shortest .*optimized moves at their shortest"
+    ):
+        optimize_cycle(spec, CycleSettings(gradient=FAST))
+
+
+def test_cycle_settings_refuse_a_negative_jerk_time(tmp_path):
+    from joulepath.errors import InvalidInput
+
+    with pytest.raises(InvalidInput, match=r"jerk_time must be in \[0, 10\] s"):
+        CycleSettings(jerk_time=-0.1)
+    prog = tmp_path / "small.mod"
+    prog.write_text(SMALL)
+    assert main(["cycle", str(prog), "--out", str(tmp_path / "run"), "--jerk-time", "-1"]) == 2
 
 
 def test_cycle_time_too_short_refused(spec):
@@ -251,7 +286,9 @@ def test_written_program_check_is_reported(tmp_path, robot):
     from joulepath.program._output import check_written, optimized_module
 
     spec = resolve_module(parse_module(SMALL, path="small.mod"), robot)
-    r, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, use_waits=True))
+    r, _ = optimize_cycle(
+        spec, CycleSettings(gradient=FAST, table_points=2, use_waits=True, cycle_time=REACHABLE)
+    )
     check = check_written(r, optimized_module(r))
     tol = check["tolerances"]
     expected = (
@@ -279,7 +316,8 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):
     the target as a timed fly-by point; with --stop-at-targets each move runs rest to rest."""
     from joulepath.program import optimized_module
 
-    result, opt = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True))
+    settings = CycleSettings(gradient=FAST, table_points=3, use_waits=True, cycle_time=REACHABLE)
+    result, opt = optimize_cycle(spec, settings)
     assert result.limits_ok
     labels = {tuple(spec.steps[j].label for j in c) for c in result.chains.values()}
     assert ("MoveAbsJ jA", "MoveJ pUp") in labels
@@ -303,7 +341,7 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):
     assert via and via[-1].rstrip().endswith("z20, tool0;")  # the program's own zone at the target
     resolve_module(parse_module(text, path="o.mod"), robot)  # reads back
     rest, opt_rest = optimize_cycle(
-        spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, fly_by=False)
+        spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, fly_by=False, cycle_time=REACHABLE)
     )
     assert rest.chains == {}
     assert opt.shortest_cycle <= opt_rest.shortest_cycle + 1e-9

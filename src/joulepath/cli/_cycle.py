@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import typer
@@ -46,6 +47,13 @@ def cycle(
         max=10.0,
         help="s: each joint's acceleration limit is its speed limit divided by this (longer: gentler moves "
         "that the controller can follow through via points, at a longer cycle time).",
+    ),
+    jerk_time: float = typer.Option(
+        None,
+        "--jerk-time",
+        help="s for the acceleration to reach its limit at full jerk: each joint's jerk limit is its "
+        "acceleration limit divided by this (0: no jerk limit; default: the emulated controller's, "
+        "joulepath.sim.JERK_TIME, 0.125 s).",
     ),
     write_anyway: bool = typer.Option(
         False,
@@ -112,6 +120,8 @@ def cycle(
         corridor_mm=corridor or None,
         gradient=GradientSettings(knot_spacing=knot_spacing),
     )
+    if jerk_time is not None:  # else the controller's default (CycleSettings')
+        settings = replace(settings, jerk_time=jerk_time)
     with console.status("optimizing the cycle...") as status:
         result, opt = optimize_cycle(spec, settings, progress=lambda msg: status.update(msg))
         front = None

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -92,6 +93,12 @@ def optimize(
         "--accel-time",
         help="s to reach the speed limit at full acceleration (0: no acceleration limit).",
     ),
+    jerk_time: float = typer.Option(
+        None,
+        "--jerk-time",
+        help="s for the acceleration to reach its limit at full jerk: jerk limit = acceleration limit / this "
+        "(0: no jerk limit; default: the emulated controller's, joulepath.sim.JERK_TIME, 0.125 s).",
+    ),
     generations: int = typer.Option(200, min=1, help="Generation cap (ga, de, ma-*)."),
     population: int = typer.Option(100, min=4, help="Population (ga, de, ma-*)."),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
@@ -140,6 +147,8 @@ def optimize(
         seed=seed,
         follow=exporter.follows,
     )
+    if jerk_time is not None:  # else the controller's default (OptimizeConfig's)
+        config = replace(config, jerk_time=jerk_time)
     if np.isfinite(duration) and 0 < duration <= MAX_DURATION:
         sample_times(duration)  # a whole number of samples: checked before any model is loaded
     models, joints = _models(model, fitness, family, r.name, r.n_joints, robot)
@@ -168,7 +177,8 @@ def optimize(
         f"default path {s.energy_default_J:.3f} J, optimized {s.energy_optimized_J:.3f} J "
         f"on physics: {s.saved_pct:.1f} % saved at equal cycle time "
         f"({s.algorithm}, {s.iterations} iterations, {s.evaluations:,} evaluations, {s.wall_s:.2f} s); "
-        f"within every limit; largest TCP deviation {s.max_tcp_deviation_mm:.1f} mm"
+        f"within every limit; largest TCP deviation {s.max_tcp_deviation_mm:.1f} mm, "
+        f"largest jerk {s.max_jerk_rad_s3:.0f} rad/s³"
     )
     if exporter.follows == "via-points":
         import json

@@ -777,14 +777,23 @@ def _optimum(robot: Any, res: Any) -> dict[str, Any]:
     reference starts from the minimum-jerk move (``benchmarks/optimizer_peers.py`` also
     starts it from the optimized path and keeps the better of the two).
     """
-    from joulepath.optimize import acceleration_limit
+    from joulepath.optimize import acceleration_limit, jerk_limit
     from joulepath.optimize._reference import reference_optimum
 
     s = res.summary
     amax = acceleration_limit(robot, s.config["accel_time"])
+    jmax = jerk_limit(robot, s.config["accel_time"], s.config["jerk_time"])
     q0, qf = np.asarray(s.start_rad), np.asarray(s.end_rad)
     solves = [
-        reference_optimum(robot, q0, qf, s.duration_s, friction=robot.friction, acceleration_limit=amax)
+        reference_optimum(
+            robot,
+            q0,
+            qf,
+            s.duration_s,
+            friction=robot.friction,
+            acceleration_limit=amax,
+            jerk_limit=jmax,
+        )
     ]
     ok = [r for r in solves if r.max_violation < 1e-6]
     best = min(ok or solves, key=lambda r: r.energy_fine_J)

@@ -362,7 +362,10 @@ def _consistent(
     f0 = np.maximum(start_f, lower_f + 1e-9)
     z0 = np.concatenate([theta0, f0])
     lo = np.concatenate([np.full(theta0.size, -np.inf), lower_f])
-    sol = least_squares(residual, z0, bounds=(lo, np.inf), method="trf", x_scale="jac", max_nfev=300)
+    # a trial step the residual marks with its 1e150 sentinel overflows in the solver's cost
+    # (0.5 f·f); the solver rejects that step, so the overflow is no error
+    with np.errstate(over="ignore"):
+        sol = least_squares(residual, z0, bounds=(lo, np.inf), method="trf", x_scale="jac", max_nfev=300)
     return phi_of(sol.x), sol.x[10 * links :]
 
 

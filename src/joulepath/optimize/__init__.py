@@ -24,14 +24,12 @@ from joulepath.optimize._problem import (
     register_fitness,
 )
 from joulepath.optimize._run import (
-    ACCEL_TIME,
     FOLLOW,
     MAX_DURATION,
     RUN_FILES,
     MoveResult,
     MoveSummary,
     OptimizeConfig,
-    acceleration_limit,
     check_default_feasible,
     optimize_move,
     rank_joints_by_energy,
@@ -44,8 +42,10 @@ from joulepath.optimize._verify import (
     LimitExcess,
     LimitReport,
     check_limits,
+    path_jerk,
     shortest_feasible_duration,
 )
+from joulepath.sim import ACCEL_TIME, JERK_TIME, acceleration_limit, jerk_limit
 
 __all__ = [
     "ACCEL_TIME",
@@ -61,6 +61,7 @@ __all__ = [
     "FitnessKind",
     "GradientResult",
     "GradientSettings",
+    "JERK_TIME",
     "LimitExcess",
     "LimitReport",
     "MAX_DURATION",
@@ -80,10 +81,12 @@ __all__ = [
     "check_limits",
     "default_configuration",
     "fitness_kind",
+    "jerk_limit",
     "limit_violation",
     "optimize_move",
     "optimize_spline",
     "path_features",
+    "path_jerk",
     "physics_energy",
     "random_tasks",
     "rank_joints_by_energy",

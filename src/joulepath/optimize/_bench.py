@@ -12,7 +12,8 @@ import pandas as pd
 from joulepath.description import DEFAULT_ROBOT
 from joulepath.dynamics import Robot, load_robot
 from joulepath.errors import InvalidInput, LimitViolation
-from joulepath.optimize._run import ACCEL_TIME, OptimizeConfig, check_default_feasible, optimize_move
+from joulepath.optimize._run import OptimizeConfig, check_default_feasible, optimize_move
+from joulepath.sim import ACCEL_TIME, JERK_TIME
 
 MAX_DRAWS_PER_TASK = 1000
 """Draws :func:`random_tasks` may spend on one feasible task before it gives up."""
@@ -25,13 +26,14 @@ def random_tasks(
     seed: int,
     range_set: str = "lab",
     accel_time: float = ACCEL_TIME,
+    jerk_time: float = JERK_TIME,
     durations: tuple[float, float] = (1.0, 3.0),
 ) -> list[tuple[np.ndarray, np.ndarray, float]]:
     """Feasible random tasks: start, end (uniform in the range set), duration (uniform, whole samples).
 
     A draw whose default (minimum-jerk) move breaks a limit — range, speed,
-    acceleration (``v_max / accel_time``) or effort — is redrawn, so every task can be
-    done within the limits and every saving is measured against a feasible move.
+    acceleration (``v_max / accel_time``), jerk (that over ``jerk_time``) or effort — is
+    redrawn, so every task can be done within the limits and every saving is measured against a feasible move.
     """
     rng = np.random.default_rng(seed)
     _, lo, hi = robot.ranges_for(range_set)
@@ -42,7 +44,7 @@ def random_tasks(
             qf = lo + rng.random(lo.size) * (hi - lo)
             T = round(rng.uniform(*durations) / 0.025) * 0.025
             try:
-                check_default_feasible(robot, q0, qf, float(T), accel_time=accel_time)
+                check_default_feasible(robot, q0, qf, float(T), accel_time=accel_time, jerk_time=jerk_time)
             except LimitViolation:
                 continue
             tasks.append((q0, qf, float(T)))

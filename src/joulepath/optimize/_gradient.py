@@ -12,8 +12,10 @@ derivative, chained through the linear spline basis.
 
 Constraints (not penalties), solved by SLSQP:
 
-* joint ranges and speed limits — linear in ``x`` — on a grid ``check_factor``
-  times finer than the samples, so they also hold between samples;
+* joint ranges, speed, acceleration and jerk limits — linear in ``x`` — on a grid
+  ``check_factor`` times finer than the samples, so they also hold between samples
+  (the jerk is the difference of consecutive accelerations over the grid step, the
+  quantity :func:`joulepath.optimize._verify.path_jerk` checks);
 * effort limits (where the robot states them) on the same fine grid;
 * optionally a corridor: the TCP stays within ``max_deviation_m`` of the default
   move's TCP at every sample;
@@ -134,6 +136,7 @@ class SplineProblem:
     max_deviation_m: float | None = None
     acceleration_limit: FloatArray | None = None
     waypoints: tuple[tuple[float, FloatArray], ...] = ()
+    jerk_limit: FloatArray | None = None
     n_evaluations: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -153,6 +156,13 @@ class SplineProblem:
         )
         amax = self.acceleration_limit
         self.amax = np.full(self.n, 1e9) if amax is None else np.where(np.isfinite(amax), amax, 1e9)
+        jmax = self.jerk_limit
+        self.has_jerk = jmax is not None and bool(np.any(np.isfinite(jmax)))
+        self.jmax = np.full(self.n, 1e12) if jmax is None else np.where(np.isfinite(jmax), jmax, 1e12)
+        # jerk on the fine grid: (qdd[k+1] - qdd[k]) / h, linear in x like the acceleration
+        h = self.basis.dt / self.check_factor
+        self.fine_Bddd: FloatArray = np.diff(self.fine.Bdd, axis=0) / h
+        self.default_fine_qddd: FloatArray = np.diff(self.default_fine.qdd, axis=0) / h
         self.emax = np.asarray(self.robot.effort_limit, dtype=float)
         self.has_effort = bool(np.any(np.isfinite(self.emax)))
         self.dt = self.basis.dt
@@ -279,6 +289,25 @@ class SplineProblem:
         b = self.amax[i] * (1.0 - RATE_MARGIN) + sign * self.default_fine.qdd[k, i]
         return A, b
 
+    def jerk_slack(self, x: FloatArray) -> FloatArray:
+        """Jerk slack on the fine grid's steps: ``jmax - qddd`` then ``qddd + jmax``, shape (2(K-1), n)."""
+        qddd = self.default_fine_qddd + self.fine_Bddd @ self.coefficients(x)
+        j = self.jmax * (1.0 - RATE_MARGIN)
+        return np.concatenate([j - qddd, qddd + j])
+
+    def _jerk_rows(self, idx: np.ndarray) -> tuple[FloatArray, FloatArray]:
+        """``A x + b ≥ 0`` for flat indices into :meth:`jerk_slack` (linear in ``x``)."""
+        K, n, m = self.fine_Bddd.shape[0], self.n, self.m
+        half, i = np.divmod(idx, n)
+        upper = half < K
+        k = np.where(upper, half, half - K)
+        sign = np.where(upper, -1.0, 1.0)
+        A = np.zeros((idx.size, m * n))
+        cols = np.arange(m)[None, :] * n + i[:, None]
+        np.put_along_axis(A, cols, sign[:, None] * self.fine_Bddd[k], axis=1)
+        b = self.jmax[i] * (1.0 - RATE_MARGIN) + sign * self.default_fine_qddd[k, i]
+        return A, b
+
     def hull_slack(self, x: FloatArray) -> FloatArray:
         A, b = self.hull
         out: FloatArray = A @ x + b
@@ -312,6 +341,10 @@ class SplineProblem:
         if acc is not None and acc.size:
             Aa, ba = self._accel_rows(acc)
             cons.append({"type": "ineq", "fun": lambda x: Aa @ x + ba, "jac": lambda x: Aa})
+        jer = active.get("qddd")
+        if jer is not None and jer.size:
+            Aj, bj = self._jerk_rows(jer)
+            cons.append({"type": "ineq", "fun": lambda x: Aj @ x + bj, "jac": lambda x: Aj})
         eff = active.get("tau")
         if eff is not None and eff.size:
             cons.append(
@@ -376,6 +409,8 @@ class SplineProblem:
             "hull": np.flatnonzero(self.hull_slack(x) < band * self.hull_scale),
             "qdd": np.flatnonzero((self.accel_slack(x) < band * np.tile(self.amax, 1)).ravel()),
         }
+        if self.has_jerk:
+            out["qddd"] = np.flatnonzero((self.jerk_slack(x) < band * self.jmax).ravel())
         if self.has_effort:
             e = self.effort_slack(x)
             lim = np.where(np.isfinite(self.emax), self.emax, np.inf)
@@ -387,6 +422,8 @@ class SplineProblem:
     def violation(self, x: FloatArray) -> float:
         """Largest constraint violation on the fine grid (rad, rad/s, N·m or m; 0 when feasible)."""
         worst = max(0.0, float(-self.hull_slack(x).min()) - 1e-9, float(-self.accel_slack(x).min()) - 1e-9)
+        if self.has_jerk:
+            worst = max(worst, float(-self.jerk_slack(x).min()) - 1e-9)
         if self.has_effort:
             worst = max(worst, float(-self.effort_slack(x).min()))
         if self.max_deviation_m is not None:
@@ -536,6 +573,7 @@ def solve_move(
     max_deviation_m: float | None = None,
     dt: float = SAMPLE_PERIOD,
     waypoints: tuple[tuple[float, FloatArray], ...] = (),
+    jerk_limit: FloatArray | None = None,
 ) -> tuple[GradientResult, SplineProblem]:
     """Coarse-to-fine gradient search of one move; the result and the problem it lives in.
 
@@ -556,6 +594,7 @@ def solve_move(
             max_deviation_m=max_deviation_m,
             acceleration_limit=acceleration_limit,
             waypoints=waypoints,
+            jerk_limit=jerk_limit,
         )
 
     fine = make(settings.knot_spacing)
@@ -576,7 +615,7 @@ def solve_move(
     target = coarse.fine.B @ first.coefficients
     start: FloatArray = np.asarray(np.linalg.lstsq(fine.fine.B, target, rcond=None)[0], dtype=float)
     refine = replace(settings, n_starts=1, continuation=settings.continuation[-settings.refine_stages :])
-    # the limit grids (accelerations, efforts, corridor) are the same in both bases;
+    # the limit grids (accelerations, jerks, efforts, corridor) are the same in both bases;
     # the control-point (hull) rows are not
     known = {kind: rows for kind, rows in first.active.items() if kind != "hull"}
     second = optimize_spline(fine, refine, rng=rng, initial=start, known=known)

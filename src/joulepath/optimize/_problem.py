@@ -110,11 +110,14 @@ def limit_violation(
     tau: FloatArray | None = None,
     *,
     acceleration_limit: FloatArray | None = None,
+    jerk_limit: FloatArray | None = None,
 ) -> Violation:
     """Violations of paths q, qd (and torques tau) of shape (P, n_steps, n).
 
     With ``acceleration_limit`` (rad/s², one per joint) the relative over-acceleration
-    counts with the overspeed.
+    counts with the overspeed, and so does with ``jerk_limit`` (rad/s³) the relative
+    over-jerk, the jerk being the difference of consecutive accelerations over the
+    sample period (as the limit check measures it, on its grid).
     """
     q = traj.q if traj.q.ndim == 3 else traj.q[None]
     qd = traj.qd if traj.qd.ndim == 3 else traj.qd[None]
@@ -131,6 +134,12 @@ def limit_violation(
         amax = np.asarray(acceleration_limit, dtype=float)
         acc = np.abs(qdd) / np.where(np.isfinite(amax) & (amax > 0), amax, np.inf)
         spd_v = spd_v + np.maximum(acc.max(axis=1) - 1.0, 0.0).sum(axis=1)
+    if jerk_limit is not None and traj.t.size > 1:
+        qdd = traj.qdd if traj.qdd.ndim == 3 else traj.qdd[None]
+        jmax = np.asarray(jerk_limit, dtype=float)
+        jerk = np.abs(np.diff(qdd, axis=1)) / traj.dt
+        jer = jerk / np.where(np.isfinite(jmax) & (jmax > 0), jmax, np.inf)
+        spd_v = spd_v + np.maximum(jer.max(axis=1) - 1.0, 0.0).sum(axis=1)
     trq_v = np.zeros_like(rng_v)
     emax = robot.effort_limit
     if tau is not None and np.any(np.isfinite(emax)):
@@ -174,6 +183,7 @@ class TrajectoryProblem:
     parametrization: str = "rest_to_rest"
     dt: float = 0.025
     acceleration_limit: FloatArray | None = None
+    jerk_limit: FloatArray | None = None
     n_evaluated: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -200,11 +210,11 @@ class TrajectoryProblem:
     def xu(self) -> FloatArray:
         return np.full(self.n_var, GRID_HIGH)
 
-    def trajectory(self, X: FloatArray) -> Trajectory:
-        """Paths of chromosomes X (P, 6·n) or (6·n,)."""
+    def trajectory(self, X: FloatArray, *, dt: float | None = None) -> Trajectory:
+        """Paths of chromosomes X (P, 6·n) or (6·n,), on the samples (or every ``dt`` s)."""
         chrom = np.asarray(X, dtype=float).reshape(-1, self.robot.n_joints, N_COEFFICIENTS)
         build = rest_to_rest if self.parametrization == "rest_to_rest" else thesis_quintic
-        return build(chrom, self.q_start, self.q_end, self.duration, dt=self.dt)
+        return build(chrom, self.q_start, self.q_end, self.duration, dt=self.dt if dt is None else dt)
 
     def energy(self, traj: Trajectory) -> tuple[FloatArray, FloatArray | None]:
         """Unpenalized fitness energy of paths (J) and torques where computed."""
@@ -221,9 +231,25 @@ class TrajectoryProblem:
         return total, None
 
     def evaluate(self, X: FloatArray) -> FloatArray:
+        """Penalized energy; with a jerk limit the kinematic limits are penalized on the fine grid.
+
+        A jerk that peaks between samples (at the ends of a polynomial path) is averaged
+        away by the samples' differences, so with ``jerk_limit`` the ranges, speeds,
+        accelerations and jerks are measured on the grid results are checked on
+        (``FINE_FACTOR`` times finer), the efforts on the samples.
+        """
         traj = self.trajectory(X)
         energy, tau = self.energy(traj)
         self.n_evaluated += energy.size
-        viol = limit_violation(self.robot, traj, tau, acceleration_limit=self.acceleration_limit)
-        out: FloatArray = energy + PENALTY * viol.total
+        amax, jmax = self.acceleration_limit, self.jerk_limit
+        if jmax is None:
+            viol = limit_violation(self.robot, traj, tau, acceleration_limit=amax)
+            total = viol.total
+        else:
+            from joulepath.optimize._verify import FINE_FACTOR  # _verify imports this module
+
+            fine = self.trajectory(X, dt=self.dt / FINE_FACTOR)
+            kin = limit_violation(self.robot, fine, None, acceleration_limit=amax, jerk_limit=jmax)
+            total = kin.range + kin.speed + limit_violation(self.robot, traj, tau).torque
+        out: FloatArray = energy + PENALTY * total
         return out

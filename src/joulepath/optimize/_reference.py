@@ -12,7 +12,10 @@ Independent of the default optimizer on every count that matters:
   differentiation.
 
 Same problem: start and end at rest, joint ranges, speed limits and effort limits
-at every sample, the energy ``Σ |tau qd| dt`` on the samples with friction. ``|p|``
+at every sample, the acceleration limits and the jerk limits when given (the jerk of
+each interval is one unknown, so its limit is a bound on it: the same mean jerk over
+each step that the limit check measures on any grid finer than the samples), the
+energy ``Σ |tau qd| dt`` on the samples with friction. ``|p|``
 is smoothed as ``sqrt(p² + ε²) - ε`` with ``ε`` driven towards zero; the reported
 energy is the true metric of the final samples. Used by the benchmarks and the tests
 to state "% of the optimum reached"; it needs the ``reference`` extra (``casadi``).
@@ -157,7 +160,11 @@ def _between_samples(
 
 @dataclass(frozen=True, slots=True)
 class ReferenceResult:
-    """The transcription's optimum: its sampled path, true energy, largest violation and cost."""
+    """The transcription's optimum: its sampled path, true energy, largest violation and cost.
+
+    ``max_violation``: the largest excess over a limit at the samples, in SI units (rad,
+    rad/s, rad/s², N·m), the jerk's as a share of its limit.
+    """
 
     path: Trajectory
     energy_J: float
@@ -178,6 +185,7 @@ def reference_optimum(
     continuation: tuple[float, ...] = (0.1, 0.003),
     dt: float = SAMPLE_PERIOD,
     acceleration_limit: FloatArray | None = None,
+    jerk_limit: FloatArray | None = None,
     substeps: int = 4,
     tol: float = 1e-9,
     max_iter: int = 3000,
@@ -202,6 +210,7 @@ def reference_optimum(
     vmax = np.asarray(robot.velocity_limit, dtype=float)
     emax = np.asarray(robot.effort_limit, dtype=float)
     amax = None if acceleration_limit is None else np.asarray(acceleration_limit, dtype=float)
+    jmax = None if jerk_limit is None else np.asarray(jerk_limit, dtype=float)
 
     opti = cs.Opti()
     Q = opti.variable(n, K)
@@ -239,6 +248,8 @@ def reference_optimum(
             opti.subject_to(opti.bounded(-vmax[i], Vf[i, :], vmax[i]))
         if amax is not None and np.isfinite(amax[i]):
             opti.subject_to(opti.bounded(-amax[i], Af[i, :], amax[i]))
+        if jmax is not None and np.isfinite(jmax[i]):
+            opti.subject_to(opti.bounded(-jmax[i], U[i, :], jmax[i]))
     tau = rnea.map(Kf)(Qf, Vf, Af)
     if friction is not None:
         v_sym = cs.SX.sym("v", n)
@@ -290,6 +301,8 @@ def reference_optimum(
         float(np.max(np.where(np.isfinite(lo), lo - sol_q, 0.0))),
         float(np.max(np.where(np.isfinite(vmax), np.abs(sol_v) - vmax, 0.0))),
         float(np.max(np.abs(sol_a) - amax)) if amax is not None else 0.0,
+        # relative: IPOPT relaxes each bound by 1e-8 of its size, and jerk limits are ~100 rad/s³
+        float(np.max(np.abs(np.diff(sol_a, axis=0)) / h / jmax - 1.0)) if jmax is not None else 0.0,
         float(np.max(np.where(np.isfinite(emax), np.abs(tau_s) - np.nan_to_num(emax, nan=0.0), 0.0))),
     )
     tau_f = robot.inverse_dynamics(fq, fv, fa, friction=friction)

@@ -28,16 +28,13 @@ from joulepath.optimize._verify import (
     check_limits,
     default_fine,
     energy_on_samples,
+    path_jerk,
     shortest_feasible_duration,
     tcp_deviation_mm,
 )
+from joulepath.sim import ACCEL_TIME, JERK_TIME, acceleration_limit, jerk_limit
 from joulepath.trajectory import DEFAULT_KNOT_SPACING, Trajectory, minimum_jerk, sample_times
 from joulepath.units import SAMPLE_PERIOD
-
-ACCEL_TIME = 0.25
-"""s for a joint to reach its speed limit at full acceleration: the acceleration limit
-``v_max / ACCEL_TIME`` that the emulated controller also assumes (ABB publishes none)."""
-
 
 FOLLOW = ("samples", "via-points")
 """How a program's controller runs a path (:attr:`joulepath.export.Exporter.follows`)."""
@@ -52,8 +49,11 @@ class OptimizeConfig:
     ``knot_spacing``, ``n_starts`` and ``evaluations`` set the B-spline searches;
     ``pop_size`` … ``informed_joints`` the thesis' evolutionary ones (defaults: its
     best GA settings, §4.5). ``accel_time`` sets the acceleration limits
-    (``v_max / accel_time``; 0 disables them). ``max_deviation_mm`` keeps the TCP
-    within that distance of the default move's TCP at every sample (gradient search).
+    (``v_max / accel_time``; 0 disables them) and ``jerk_time`` the jerk limits
+    (``v_max / accel_time / jerk_time``; 0 disables them, as does ``accel_time = 0``):
+    the emulated controller's, :mod:`joulepath.sim` (defaults ``ACCEL_TIME``, ``JERK_TIME``).
+    ``max_deviation_mm`` keeps the TCP within that distance of the default move's TCP
+    at every sample (gradient search).
 
     ``inject_default`` puts the all-zero chromosome (the minimum-jerk default path of
     ``rest_to_rest``) into the initial population of the evolutionary searches, so
@@ -75,6 +75,7 @@ class OptimizeConfig:
     n_starts: int = 1
     evaluations: int = 6000
     accel_time: float = ACCEL_TIME
+    jerk_time: float = JERK_TIME
     max_deviation_mm: float | None = None
     pop_size: int = 100
     max_gen: int = 200
@@ -109,6 +110,8 @@ class OptimizeConfig:
             raise InvalidInput(
                 f"accel_time must be 0..10 s (0: no acceleration limit), got {self.accel_time}"
             )
+        if not (np.isfinite(self.jerk_time) and 0 <= self.jerk_time <= 10):
+            raise InvalidInput(f"jerk_time must be 0..10 s (0: no jerk limit), got {self.jerk_time}")
         if self.max_deviation_mm is not None and not (
             np.isfinite(self.max_deviation_mm) and self.max_deviation_mm > 0
         ):
@@ -134,7 +137,9 @@ class MoveSummary:
     times finer (the integral the samples approximate). ``saved_pct`` compares the
     optimized path with the controller-like minimum-jerk move of the same duration.
     Limits are checked on the fine grid. ``saved_vs_initial_best_pct`` is the thesis'
-    metric (evolutionary searches only).
+    metric (evolutionary searches only). ``jerk_limit_rad_s3`` is the jerk limit the
+    search and the check used (None: none), ``max_jerk_rad_s3`` the optimized path's
+    largest jerk on the fine grid (:func:`joulepath.optimize._verify.path_jerk`, any joint).
     """
 
     robot: str
@@ -160,6 +165,8 @@ class MoveSummary:
     limit_violation: dict[str, float]
     limit_excess: tuple[str, ...]
     acceleration_limit_rad_s2: tuple[float, ...] | None
+    jerk_limit_rad_s3: tuple[float, ...] | None
+    max_jerk_rad_s3: float
     max_tcp_deviation_mm: float
     max_deviation_mm: float | None
     iterations: int
@@ -202,14 +209,6 @@ MAX_DURATION = 60.0
 """Longest move :func:`optimize_move` accepts, s (2,400 samples at 40 Hz)."""
 
 
-def acceleration_limit(robot: Robot, accel_time: float) -> FloatArray | None:
-    """``v_max / accel_time`` per joint (rad/s²), or None when ``accel_time`` is 0."""
-    if accel_time <= 0:
-        return None
-    out: FloatArray = np.asarray(robot.velocity_limit, dtype=float) / accel_time
-    return out
-
-
 def _check_ends(robot: Robot, q0: FloatArray, qf: FloatArray, duration: float) -> None:
     lo, hi = robot.joint_ranges()
     for name, q in (("start", q0), ("end", qf)):
@@ -237,7 +236,13 @@ def _check_ends(robot: Robot, q0: FloatArray, qf: FloatArray, duration: float) -
 
 
 def check_default_feasible(
-    robot: Robot, q0: FloatArray, qf: FloatArray, duration: float, *, accel_time: float = ACCEL_TIME
+    robot: Robot,
+    q0: FloatArray,
+    qf: FloatArray,
+    duration: float,
+    *,
+    accel_time: float = ACCEL_TIME,
+    jerk_time: float = JERK_TIME,
 ) -> None:
     """Refuse a move whose default (minimum-jerk) path already breaks a limit.
 
@@ -246,13 +251,25 @@ def check_default_feasible(
     """
     dt = SAMPLE_PERIOD
     amax = acceleration_limit(robot, accel_time)
+    jmax = jerk_limit(robot, accel_time, jerk_time)
     report = check_limits(
-        robot, default_fine(q0, qf, duration, dt), friction=robot.friction, acceleration_limit=amax
+        robot,
+        default_fine(q0, qf, duration, dt),
+        friction=robot.friction,
+        acceleration_limit=amax,
+        jerk_limit=jmax,
     )
     if report.ok:
         return
     shortest = shortest_feasible_duration(
-        robot, q0, qf, dt=dt, friction=robot.friction, acceleration_limit=amax, longest=MAX_DURATION
+        robot,
+        q0,
+        qf,
+        dt=dt,
+        friction=robot.friction,
+        acceleration_limit=amax,
+        jerk_limit=jmax,
+        longest=MAX_DURATION,
     )
     hint = (
         f"the shortest duration whose default move respects every limit is {shortest:.3f} s: "
@@ -287,7 +304,7 @@ def optimize_move(
     qf = np.asarray(q_end, dtype=float)
     _check_ends(robot, q0, qf, duration)
     sample_times(duration, SAMPLE_PERIOD)
-    check_default_feasible(robot, q0, qf, duration, accel_time=config.accel_time)
+    check_default_feasible(robot, q0, qf, duration, accel_time=config.accel_time, jerk_time=config.jerk_time)
     default = minimum_jerk(q0, qf, duration)
     if any(j > robot.n_joints for j in config.informed_joints):
         raise InvalidInput(
@@ -309,6 +326,7 @@ def optimize_move(
         models=models,
         joints=joints,
         dt=SAMPLE_PERIOD,
+        jerk_limit=jerk_limit(robot, config.accel_time, config.jerk_time),
     )
     spec = config.search
     outcome, wall = timed(spec.run, task, config, np.random.default_rng(config.seed))
@@ -333,7 +351,10 @@ def verify_move(
     fine_def = default_fine(task.q_start, task.q_end, task.duration, task.dt)
     e_def_fine = energy_on_samples(robot, fine_def, friction=friction)
     e_opt_fine = energy_on_samples(robot, outcome.fine_path, friction=friction)
-    report = check_limits(robot, outcome.fine_path, friction=friction, acceleration_limit=amax)
+    jmax = task.jerk_limit
+    report = check_limits(
+        robot, outcome.fine_path, friction=friction, acceleration_limit=amax, jerk_limit=jmax
+    )
     e_sur_def = e_sur_opt = None
     if task.models:
         stack = Trajectory(
@@ -389,6 +410,8 @@ def verify_move(
         },
         limit_excess=tuple(w.describe() for w in report.worst),
         acceleration_limit_rad_s2=None if amax is None else tuple(float(a) for a in amax),
+        jerk_limit_rad_s3=None if jmax is None else tuple(float(j) for j in jmax),
+        max_jerk_rad_s3=float(np.abs(path_jerk(outcome.fine_path)[1]).max(initial=0.0)),
         max_tcp_deviation_mm=tcp_deviation_mm(robot, optimized, default),
         max_deviation_mm=config.max_deviation_mm,
         iterations=outcome.iterations,

@@ -65,6 +65,7 @@ class SearchTask:
     models: tuple[Any, ...]
     joints: tuple[int, ...]
     dt: float
+    jerk_limit: FloatArray | None = None
 
 
 Search = Callable[["SearchTask", "OptimizeConfig", np.random.Generator], SearchOutcome]
@@ -96,6 +97,7 @@ def _gradient(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator
         acceleration_limit=task.acceleration_limit,
         max_deviation_m=None if config.max_deviation_mm is None else config.max_deviation_mm / 1000.0,
         dt=task.dt,
+        jerk_limit=task.jerk_limit,
     )
     x = res.coefficients.ravel()
     return SearchOutcome(
@@ -121,16 +123,18 @@ def _fitness_problem(task: SearchTask, config: OptimizeConfig, parametrization: 
         parametrization=parametrization,
         dt=task.dt,
         acceleration_limit=task.acceleration_limit,
+        jerk_limit=task.jerk_limit,
     )
 
 
 class _FineKinematics:
-    """Range, speed and acceleration excess of spline paths on the grid results are checked on.
+    """Range, speed, acceleration and jerk excess of spline paths on the grid results are checked on.
 
-    The same relative measure as :func:`limit_violation` (range excess in rad, speed and
-    acceleration excess as shares of the limit, worst instant per joint, summed over the
-    joints), on a grid ``FINE_FACTOR`` times finer than the samples; linear in the
-    coefficients, so it costs three matrix products per population.
+    The same relative measure as :func:`limit_violation` (range excess in rad, speed,
+    acceleration and jerk excess as shares of the limit, worst instant per joint, summed
+    over the joints), on a grid ``FINE_FACTOR`` times finer than the samples, the jerk as
+    :func:`joulepath.optimize._verify.path_jerk` measures it there; linear in the
+    coefficients, so it costs four matrix products per population.
     """
 
     def __init__(self, task: SearchTask, basis: SplineBasis) -> None:
@@ -145,6 +149,12 @@ class _FineKinematics:
         amax = task.acceleration_limit
         a = np.full(vmax.shape, np.inf) if amax is None else np.asarray(amax, dtype=float)
         self.a_inv = np.where(np.isfinite(a) & (a > 0), 1.0 / np.where(a > 0, a, 1.0), 0.0)
+        jmax = task.jerk_limit
+        j = np.full(vmax.shape, np.inf) if jmax is None else np.asarray(jmax, dtype=float)
+        self.j_inv = np.where(np.isfinite(j) & (j > 0), 1.0 / np.where(j > 0, j, 1.0), 0.0)
+        self.has_jerk = bool(np.any(self.j_inv > 0))
+        self.Bddd = np.diff(self.grid.Bdd, axis=0) / dt
+        self.base_qddd = np.diff(self.base.qdd, axis=0) / dt
 
     def __call__(self, C: FloatArray) -> FloatArray:
         g, b = self.grid, self.base
@@ -166,6 +176,10 @@ class _FineKinematics:
             + np.maximum(speed - 1.0, 0.0).sum(axis=1)
             + np.maximum(accel - 1.0, 0.0).sum(axis=1)
         )
+        if self.has_jerk:
+            j_hi, j_lo = extremes(self.Bddd, self.base_qddd)
+            jerk = np.maximum(j_hi, -j_lo) * self.j_inv
+            out = out + np.maximum(jerk - 1.0, 0.0).sum(axis=1)
         return out
 
 
@@ -190,7 +204,9 @@ def _cmaes(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -
         C = X.reshape(-1, m, n)
         traj = basis.trajectory(C, task.q_start, task.q_end)
         energy, tau = fit.energy(traj)
-        viol = limit_violation(task.robot, traj, tau, acceleration_limit=task.acceleration_limit)
+        viol = limit_violation(
+            task.robot, traj, tau, acceleration_limit=task.acceleration_limit, jerk_limit=task.jerk_limit
+        )
         out: FloatArray = energy + PENALTY * (viol.total + between(C))
         return out
 

@@ -3,8 +3,12 @@
 Everything a result claims is measured here, independently of the search that found
 it: the physics energy ``Σ |tau qd| dt`` on the samples (the reported metric) and on
 a grid ``FINE_FACTOR`` times finer (the integral it approximates, which a path
-cannot game by moving between samples), the joint ranges, speed and effort limits on
-the fine grid, and the TCP's largest distance from the default move's.
+cannot game by moving between samples), the joint ranges, speed, acceleration, jerk and
+effort limits on the fine grid, and the TCP's largest distance from the default move's.
+
+Jerk is the difference of consecutive accelerations over the grid step
+(:func:`path_jerk`): the exact mean jerk over each step of the fine grid, for any
+path whatever its representation; the gradient search constrains the same quantity.
 """
 
 from __future__ import annotations
@@ -28,15 +32,21 @@ TOLERANCE = 1e-7
 class LimitExcess:
     """The worst excess of one kind of limit: which joint, where, by how much."""
 
-    kind: str  # "range", "speed", "acceleration" or "effort"
+    kind: str  # "range", "speed", "acceleration", "jerk" or "effort"
     joint: int  # 1-based
     t_s: float
-    value: float  # SI: rad, rad/s or N·m
+    value: float  # SI: rad, rad/s, rad/s², rad/s³ or N·m
     limit: float
     excess: float  # relative for speed and effort (0.19 = 19 % over), rad for range
 
     def describe(self) -> str:
-        unit = {"range": "deg", "speed": "deg/s", "acceleration": "deg/s²", "effort": "N·m"}[self.kind]
+        unit = {
+            "range": "deg",
+            "speed": "deg/s",
+            "acceleration": "deg/s²",
+            "jerk": "deg/s³",
+            "effort": "N·m",
+        }[self.kind]
         conv = np.degrees if self.kind != "effort" else (lambda v: v)
         over = (
             f"{np.degrees(self.excess):.2f} deg past it"
@@ -63,14 +73,36 @@ class LimitReport:
         return not self.worst
 
 
+def path_jerk(path: Trajectory) -> tuple[FloatArray, FloatArray]:
+    """Jerk of a path on its grid: ``(qdd[k+1] - qdd[k]) / dt`` at the midpoints of its steps.
+
+    The exact mean jerk over each step (rad/s³), for any path whose acceleration is
+    continuous. Returns the midpoint times (n_steps - 1,) and the jerk (..., n_steps - 1, n).
+
+    Examples
+    --------
+    >>> from joulepath.trajectory import minimum_jerk
+    >>> t, jerk = path_jerk(minimum_jerk([0.0], [1.0], 1.0, dt=0.001))
+    >>> round(float(abs(jerk).max()), 1)  # 60 |dq| / T³ at the ends, less a sliver
+    59.8
+    """
+    out: FloatArray = np.diff(path.qdd, axis=-2) / path.dt
+    return 0.5 * (path.t[1:] + path.t[:-1]), out
+
+
 def check_limits(
     robot: Robot,
     fine: Trajectory,
     *,
     friction: Friction | None,
     acceleration_limit: FloatArray | None = None,
+    jerk_limit: FloatArray | None = None,
 ) -> LimitReport:
-    """Ranges, speed, acceleration (if given) and effort limits (if stated) of a path, on its grid."""
+    """Ranges, speed, acceleration and jerk (if given) and effort limits (if stated) of a path, on its grid.
+
+    The jerk is :func:`path_jerk` on the path's grid; its relative excess counts, like the
+    acceleration's, in ``overspeed``.
+    """
     lo, hi = robot.joint_ranges()
     vmax = np.asarray(robot.velocity_limit, dtype=float)
     emax = np.asarray(robot.effort_limit, dtype=float)
@@ -78,14 +110,23 @@ def check_limits(
     over_q = np.maximum(q - hi, 0.0) + np.maximum(lo - q, 0.0)
     worst: list[LimitExcess] = []
 
-    def note(kind: str, excess: FloatArray, value: FloatArray, limit: FloatArray, tol: float) -> float:
+    def note(
+        kind: str,
+        excess: FloatArray,
+        value: FloatArray,
+        limit: FloatArray,
+        tol: float,
+        t: FloatArray = fine.t,
+    ) -> float:
+        if not excess.size:
+            return 0.0
         k, j = np.unravel_index(int(np.argmax(excess)), excess.shape)
         if excess[k, j] > tol:
             worst.append(
                 LimitExcess(
                     kind=kind,
                     joint=int(j) + 1,
-                    t_s=float(fine.t[k]),
+                    t_s=float(t[k]),
                     value=float(value[k, j]),
                     limit=float(np.broadcast_to(limit, excess.shape)[k, j]),
                     excess=float(excess[k, j]),
@@ -99,6 +140,10 @@ def check_limits(
     if acceleration_limit is not None:
         a_lim = np.where(np.isfinite(acceleration_limit), acceleration_limit, np.inf)
         s += note("acceleration", np.abs(fine.qdd) / a_lim - 1.0, fine.qdd, a_lim, TOLERANCE)
+    if jerk_limit is not None:
+        j_lim = np.where(np.isfinite(jerk_limit), jerk_limit, np.inf)
+        t_mid, jerk = path_jerk(fine)
+        s += note("jerk", np.abs(jerk) / j_lim - 1.0, jerk, j_lim, TOLERANCE, t_mid)
     e = 0.0
     if np.any(np.isfinite(emax)):
         tau = robot.inverse_dynamics(q, qd, fine.qdd, friction=friction)
@@ -133,12 +178,14 @@ def shortest_feasible_duration(
     dt: float,
     friction: Friction | None,
     acceleration_limit: FloatArray | None = None,
+    jerk_limit: FloatArray | None = None,
     longest: float = 60.0,
 ) -> float | None:
     """Shortest whole-sample duration whose minimum-jerk move respects every limit (None: none ≤ ``longest``).
 
-    Starts at the speed bound (``1.875 |Δq| / v_max``, the minimum-jerk peak) and steps
-    up one sample at a time while an effort limit is exceeded.
+    Starts at the speed bound (``1.875 |Δq| / v_max``, the minimum-jerk peak), the
+    acceleration bound (``10/sqrt(3) |Δq| / T²``) and the jerk bound (``60 |Δq| / T³``)
+    and steps up one sample at a time while a limit is exceeded on the fine grid.
     """
     vmax = np.asarray(robot.velocity_limit, dtype=float)
     v_lim = np.where(np.isfinite(vmax) & (vmax > 0), vmax, np.inf)
@@ -147,12 +194,19 @@ def shortest_feasible_duration(
     if acceleration_limit is not None:  # minimum-jerk peak acceleration 10/sqrt(3) |Δq| / T²
         a_lim = np.where(np.isfinite(acceleration_limit), acceleration_limit, np.inf)
         need = max(need, float(np.max(np.sqrt(10 / np.sqrt(3) * travel / a_lim))))
+    if jerk_limit is not None:  # minimum-jerk peak jerk 60 |Δq| / T³ (at the ends), less a
+        # margin: the checked jerk is the mean over the fine grid's first step, a little lower
+        j_lim = np.where(np.isfinite(jerk_limit), jerk_limit, np.inf)
+        need = max(need, 0.95 * float(np.max(np.cbrt(60 * travel / j_lim))))
     steps = max(1, int(np.ceil(need / dt - 1e-9)))
     while steps * dt <= longest + 1e-9:
         T = steps * dt
         sample_times(T, dt)
         fine = default_fine(q_start, q_end, T, dt)
-        if check_limits(robot, fine, friction=friction, acceleration_limit=acceleration_limit).ok:
+        report = check_limits(
+            robot, fine, friction=friction, acceleration_limit=acceleration_limit, jerk_limit=jerk_limit
+        )
+        if report.ok:
             return round(T, 9)
         steps += 1 if steps < 400 else steps // 50
     return None

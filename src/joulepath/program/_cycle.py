@@ -38,7 +38,14 @@ from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Robot
 from joulepath.energy import joint_energy, path_energy
 from joulepath.errors import InvalidInput, LimitViolation
-from joulepath.optimize import ACCEL_TIME, GradientSettings, acceleration_limit, check_limits
+from joulepath.optimize import (
+    ACCEL_TIME,
+    JERK_TIME,
+    GradientSettings,
+    acceleration_limit,
+    check_limits,
+    jerk_limit,
+)
 from joulepath.optimize._gradient import SplineProblem, optimize_spline, solve_move
 from joulepath.optimize._verify import shortest_feasible_duration, tcp_deviation_mm
 from joulepath.program._cell import Cell, clearance
@@ -69,7 +76,9 @@ class CycleSettings:
     move; ``via_every``: average spacing, in 25 ms samples, of the via points written per
     optimized move (:func:`joulepath.sim._via.layout`). ``corridor_mm``: tool0 stays
     within this distance of the joint-interpolated taught move (the path ``MoveJ`` itself
-    follows) at every sample (None: none).
+    follows) at every sample (None: none). ``accel_time`` and ``jerk_time`` set the
+    optimized moves' acceleration and jerk limits (:mod:`joulepath.sim`'s; ``jerk_time``
+    0: no jerk limit).
     ``cell``: obstacles every optimized move must clear (a move too close is solved
     again in corridors of 1/2, 1/4, 1/8 of ``corridor_mm``, else not used).
     ``warm_start``: start each solve of a move from its nearest solved duration
@@ -85,6 +94,7 @@ class CycleSettings:
     table_points: int = 4
     via_every: int = 2
     accel_time: float = ACCEL_TIME
+    jerk_time: float = JERK_TIME
     corridor_mm: float | None = 100.0
     cell: Cell | None = None
     warm_start: bool = False
@@ -104,6 +114,8 @@ class CycleSettings:
             raise InvalidInput(f"corridor must be a positive number of mm, got {self.corridor_mm}")
         if not 0 < self.accel_time <= 10:
             raise InvalidInput(f"accel_time must be in (0, 10] s, got {self.accel_time}")
+        if not 0 <= self.jerk_time <= 10:
+            raise InvalidInput(f"jerk_time must be in [0, 10] s (0: no jerk limit), got {self.jerk_time}")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -286,6 +298,7 @@ class CycleOptimizer:
                     dt=STEP,
                     friction=NOMINAL_FRICTION,
                     acceleration_limit=self._amax(robot),
+                    jerk_limit=self._jmax(robot),
                 )
                 if shortest is None:
                     raise LimitViolation(
@@ -346,6 +359,7 @@ class CycleOptimizer:
             check_factor=g.check_factor,
             acceleration_limit=self._amax(robot),
             waypoints=self.waypoints(i, T),
+            jerk_limit=self._jmax(robot),
         )
 
     def _chain_shortest(self, i: int, upper: float) -> float:
@@ -360,7 +374,10 @@ class CycleOptimizer:
             T = units * STEP
             problem = self._chain_problem(i, T)
             fine = problem.path(problem.origin, fine=True)
-            if check_limits(robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok:
+            report = check_limits(
+                robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=self._jmax(robot)
+            )
+            if report.ok:
                 return round(T, 9)
             units += 1
         return round(upper, 9)
@@ -418,6 +435,9 @@ class CycleOptimizer:
     def _amax(self, robot: Robot) -> FloatArray | None:
         return acceleration_limit(robot, self.settings.accel_time)
 
+    def _jmax(self, robot: Robot) -> FloatArray | None:
+        return jerk_limit(robot, self.settings.accel_time, self.settings.jerk_time)
+
     def plant(self, robot: Robot) -> Plant:
         key = id(robot)
         if key not in self._plants:
@@ -468,6 +488,7 @@ class CycleOptimizer:
             check_factor=g.check_factor,
             max_deviation_m=None if corridor is None else corridor / 1000,
             acceleration_limit=self._amax(robot),
+            jerk_limit=self._jmax(robot),
         )
         t_old = problem.fine.t * (warm.duration / T)
         q_old = np.column_stack(
@@ -500,11 +521,14 @@ class CycleOptimizer:
                 acceleration_limit=amax,
                 max_deviation_m=None if corridor is None else corridor / 1000,
                 waypoints=self.waypoints(m.index, T),
+                jerk_limit=self._jmax(robot),
             )
         self.n_solves += 1
         x = res.coefficients.ravel()
         fine = problem.path(x, fine=True)
-        report = check_limits(robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax)
+        report = check_limits(
+            robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=self._jmax(robot)
+        )
         e, e_lab = _energy(robot, self.plant(robot), fine)
         samples = problem.path(x)
         # the taught move: the joint-interpolated move, or through a chain's targets the smoothest path

@@ -15,6 +15,7 @@ from joulepath.sim._controller import (
     log_times,
     plan_moves,
 )
+from joulepath.sim._limits import ACCEL_TIME, JERK_TIME, acceleration_limit, jerk_limit
 from joulepath.sim._plants import PLANTS, LabFriction, Measured, Plant, make_plant, run_plant
 from joulepath.sim._run import (
     THESIS_PLAN,
@@ -30,8 +31,10 @@ from joulepath.sim._timing import PlannedCycle, evaluate_cycle, plan_cycle
 from joulepath.sim._via import RAPID_ACCEL_SHARE, FollowedPath, follow_path, timed_move
 
 __all__ = [
+    "ACCEL_TIME",
     "ControllerConfig",
     "FollowedPath",
+    "JERK_TIME",
     "LabFriction",
     "Measured",
     "MotionPlan",
@@ -45,9 +48,11 @@ __all__ = [
     "Step",
     "StepSequence",
     "THESIS_PLAN",
+    "acceleration_limit",
     "evaluate_cycle",
     "evaluate_plan",
     "follow_path",
+    "jerk_limit",
     "log_text",
     "log_times",
     "make_plant",

@@ -6,9 +6,10 @@ joints start and arrive together. The move's duration is the shortest that keeps
 
 * the TCP speed along the path at or below the speeddata's ``v_tcp`` (mm/s) and the
   reorientation speed at or below ``v_ori`` (deg/s);
-* every joint's speed at or below its limit and its acceleration at or below
-  ``velocity_limit / accel_time`` (ABB publishes no acceleration limits; this is our
-  assumption, see :class:`ControllerConfig`).
+* every joint's speed at or below its limit, its acceleration at or below
+  ``velocity_limit / accel_time`` and its jerk at or below that over ``jerk_time``
+  (ABB publishes no acceleration or jerk limits; these are our assumptions, defined
+  once in :mod:`joulepath.sim._limits`, see :class:`ControllerConfig`).
 
 Zones: ``fine`` stops at the target (and dwells ``fine_dwell``); ``zX`` starts the
 next move while the TCP is still X mm from the corner, the two profiles overlap
@@ -29,6 +30,7 @@ from joulepath.abb import SPEEDS, V_ORI_DEG_S, ZONES
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.export import Move
+from joulepath.sim._limits import ACCEL_TIME, JERK_TIME, acceleration_limit, jerk_limit
 from joulepath.sim._profile import Profile, evaluate_profile, plan_profile, time_at_fraction
 
 
@@ -45,7 +47,13 @@ class ControllerConfig:
         standard deviation of its (half-normal) random part.
     accel_time : float
         Time for a joint to reach its speed limit at full acceleration: joint
-        acceleration limit = velocity limit / accel_time (an assumption).
+        acceleration limit = velocity limit / accel_time (an assumption;
+        :data:`joulepath.sim.ACCEL_TIME`).
+    jerk_time : float
+        Time for a joint's acceleration to reach its limit at full jerk: joint jerk
+        limit = acceleration limit / jerk_time (an assumption;
+        :data:`joulepath.sim.JERK_TIME`, the peak jerk of a sin² ramp to full speed).
+        0 disables the jerk limit (ramps as short as the acceleration limit allows).
     fine_dwell : float
         Stand-still at a ``fine`` point before the next move starts.
     idle : float
@@ -57,7 +65,8 @@ class ControllerConfig:
     sample_period: float = 0.025
     loop_overhead: float = 0.0008
     loop_jitter: float = 0.0006
-    accel_time: float = 0.25
+    accel_time: float = ACCEL_TIME
+    jerk_time: float = JERK_TIME
     fine_dwell: float = 0.048
     idle: float = 0.5
     path_points: int = 16
@@ -66,7 +75,7 @@ class ControllerConfig:
         for name in ("sample_period", "accel_time"):
             if not getattr(self, name) > 0:
                 raise InvalidInput(f"ControllerConfig.{name} must be positive")
-        for name in ("loop_overhead", "loop_jitter", "fine_dwell", "idle"):
+        for name in ("loop_overhead", "loop_jitter", "jerk_time", "fine_dwell", "idle"):
             if not getattr(self, name) >= 0:
                 raise InvalidInput(f"ControllerConfig.{name} must be ≥ 0")
         if self.path_points < 2:
@@ -137,7 +146,10 @@ def plan_moves(
     vmax = robot.velocity_limit
     if not np.all(np.isfinite(vmax)):
         raise InvalidInput(f"robot {robot.name!r} has no joint speed limits; the controller needs them")
-    amax = vmax / config.accel_time
+    amax = acceleration_limit(robot, config.accel_time)
+    jmax = jerk_limit(robot, config.accel_time, config.jerk_time)
+    assert amax is not None  # accel_time > 0 (ControllerConfig)
+    jmax = np.full(vmax.shape, np.inf) if jmax is None else jmax
     q = np.asarray(start, dtype=float).copy()
     plans: list[tuple[FloatArray, FloatArray, Profile, Move, float]] = []
     for k, move in enumerate(moves):
@@ -153,7 +165,11 @@ def plan_moves(
             bounds.append(SPEEDS[move.speed] / length)
         if angle > 1e-6:
             bounds.append(V_ORI_DEG_S / angle)
-        profile = plan_profile(min(bounds), float(np.min(amax[moving] / np.abs(dq[moving]))))
+        profile = plan_profile(
+            min(bounds),
+            float(np.min(amax[moving] / np.abs(dq[moving]))),
+            float(np.min(jmax[moving] / np.abs(dq[moving]))),
+        )
         radius = ZONES[move.zone]
         fraction = 0.0 if radius is None or length <= 0 else min(radius / length, 0.5)
         plans.append((q.copy(), dq, profile, move, fraction))

@@ -7,7 +7,8 @@ constant-speed cruise between them::
     ds/dt = v                              ta <= tau < ta + tc   (cruise)
     symmetric deceleration;                T = 2 ta + tc
 
-The peak acceleration is ``pi v / (2 ta)``.
+The peak acceleration is ``pi v / (2 ta)`` and the peak jerk ``pi² v / (2 ta²)``
+(the peak acceleration times ``pi / ta``).
 """
 
 from __future__ import annotations
@@ -32,13 +33,18 @@ class Profile:
         return 2.0 * self.ta + self.tc
 
 
-def plan_profile(v_max: float, a_max: float) -> Profile:
-    """Fastest profile with ``ds/dt <= v_max`` and ``d²s/dt² <= a_max``."""
-    ta = np.pi * v_max / (2.0 * a_max)
+def plan_profile(v_max: float, a_max: float, j_max: float = np.inf) -> Profile:
+    """Fastest profile with ``ds/dt <= v_max``, ``d²s/dt² <= a_max`` and ``d³s/dt³ <= j_max``.
+
+    A ramp to speed ``v`` needs ``ta ≥ pi v / (2 a_max)`` (acceleration) and
+    ``ta ≥ pi sqrt(v / (2 j_max))`` (jerk). Without room to cruise, the move is two
+    ramps (``v ta = 1``) at the highest speed both allow.
+    """
+    ta = max(np.pi * v_max / (2.0 * a_max), np.pi * np.sqrt(v_max / (2.0 * j_max)))
     if v_max * ta <= 1.0:
-        return Profile(ta=ta, tc=1.0 / v_max - ta, v=v_max)
-    v = np.sqrt(2.0 * a_max / np.pi)
-    return Profile(ta=1.0 / v, tc=0.0, v=v)
+        return Profile(ta=float(ta), tc=float(1.0 / v_max - ta), v=v_max)
+    v = min(np.sqrt(2.0 * a_max / np.pi), np.cbrt(2.0 * j_max / np.pi**2))
+    return Profile(ta=float(1.0 / v), tc=0.0, v=float(v))
 
 
 def evaluate_profile(p: Profile, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:

@@ -45,6 +45,7 @@ from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
 from joulepath.kinematics._ik import solve_ik
 from joulepath.sim._controller import ControllerConfig
+from joulepath.sim._limits import jerk_limit
 from joulepath.sim._profile import Profile, evaluate_profile, plan_profile, time_at_fraction
 from joulepath.sim._steps import Step, StepSequence
 from joulepath.trajectory import Trajectory
@@ -202,6 +203,8 @@ def fastest_profile(step: Step, path: SegmentPath, config: ControllerConfig) -> 
     robot = step.robot
     vmax = np.asarray(robot.velocity_limit, dtype=float)
     amax = vmax / config.accel_time
+    jerk = jerk_limit(robot, config.accel_time, config.jerk_time)
+    jmax = np.full(vmax.shape, np.inf) if jerk is None else jerk
     _, dqds, _ = path.at(np.linspace(0.0, 1.0, 33))
     peak = np.abs(dqds).max(axis=0)
     moving = peak > 1e-9
@@ -210,7 +213,9 @@ def fastest_profile(step: Step, path: SegmentPath, config: ControllerConfig) -> 
         bounds.append(step.speed.v_tcp / path.length_mm)
     if path.angle_deg > 1e-6:
         bounds.append(step.speed.v_ori / path.angle_deg)
-    profile = plan_profile(min(bounds), float(np.min(amax[moving] / peak[moving])))
+    profile = plan_profile(
+        min(bounds), float(np.min(amax[moving] / peak[moving])), float(np.min(jmax[moving] / peak[moving]))
+    )
     if step.time_s is not None and step.time_s > profile.duration:
         k = step.time_s / profile.duration
         profile = Profile(ta=profile.ta * k, tc=profile.tc * k, v=profile.v / k)
