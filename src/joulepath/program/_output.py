@@ -220,7 +220,28 @@ def cycle_json(
     check: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     b = result.breakdown
+    executed: dict[str, Any] = {
+        "executed_cycle_s": None,
+        "executed_energy_J": None,
+        "executed_saved_pct": None,
+        "executed_energy_lab_J": None,
+        "executed_saved_lab_pct": None,
+        "executed_note": "the written optimized.mod as the controller emulation runs it (its cycle time and "
+        "energy per cycle on physics and the lab robot), against the taught program run by the same "
+        "emulation (energy_default_J, energy_default_lab_J); null when no module was written",
+    }
+    if check is not None and rapid is not None:
+        e, lab = check["emulated_energy_J"], check["emulated_energy_lab_J"]
+        e0, lab0 = result.default_energy_J, result.default_lab_J
+        executed.update(
+            executed_cycle_s=check["emulated_cycle_s"],
+            executed_energy_J=e,
+            executed_saved_pct=100.0 * (1.0 - e / e0) if e0 else None,
+            executed_energy_lab_J=lab,
+            executed_saved_lab_pct=100.0 * (1.0 - lab / lab0) if lab0 else None,
+        )
     return {
+        **executed,
         "source": result.spec.source,
         "default_cycle_s": result.default_cycle_s,
         "target_cycle_s": result.target_cycle_s,
