@@ -26,7 +26,7 @@ def robot():
 @pytest.fixture(scope="module")
 def run_folder(tmp_path_factory, robot):
     out = tmp_path_factory.mktemp("run")
-    write_run(optimize_move(robot, START, END, 1.6, OptimizeConfig()), robot, out)
+    write_run(optimize_move(robot, START, END, 1.6, OptimizeConfig(follow="via-points")), robot, out)
     return out
 
 
@@ -78,7 +78,9 @@ def test_measured_energies_match_the_commanded_motion_on_the_plant(measured, run
     reps = measured.measurement.repetitions
     assert [k for k, _, _ in truth] == [r.kind for r in reps]
     for r, (_, duration, energy) in zip(reps, truth, strict=True):
-        assert r.energy_J == pytest.approx(energy, rel=0.02)
+        # the 40 Hz log samples a timed via chain whose acceleration steps at its corners: the
+        # log's rectangle rule misses part of the inertial power there (a few % of a move)
+        assert r.energy_J == pytest.approx(energy, rel=0.05)
         assert r.duration_s == pytest.approx(duration, abs=3 * measured.measurement.sample_period_s)
 
 
@@ -177,3 +179,14 @@ def test_saving_interval_by_hand():
     )
     with pytest.raises(InvalidInput, match="at least 2 repetitions"):
         saving_interval(d[:1], o)
+
+
+def test_lab_rehearsal_measures_the_saving_result_json_predicts(run_folder, robot, tmp_path):
+    """simulate --program on the lab plant, then measure: the realized saving agrees with the executed
+    lab saving that write_run predicted from the commanded motion (two independent routes: the noisy
+    40 Hz log's torques and speeds against the commanded motion on the plant's drive model)."""
+    predicted = json.loads((run_folder / "result.json").read_text())["executed_saved_lab_pct"]
+    log = simulate_program(run_folder / "path.mod", tmp_path / "lab.csv", robot=robot, plant="lab", seed=2)
+    m = measure_run(log.log, run_folder).measurement
+    assert m.default.n == 5 and m.optimized.n == 5
+    assert abs(m.saving.pct - predicted) <= 1.0
