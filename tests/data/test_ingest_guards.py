@@ -101,7 +101,7 @@ def test_read_log_fast_log_in_milliseconds_caught_by_speeds(tmp_path, signals):
     t, q, qd, tau = signals
     fast = t / 50.0  # the same motion 50x faster: speeds x50, period about 0.5 ms
     p = _generic(tmp_path / "ms2k.csv", fast * 1000, q, qd * 50.0, tau)
-    with pytest.raises(InvalidLog, match=r"1000 times the rate.*milliseconds"):
+    with pytest.raises(InvalidLog, match=r"about (999|1000|1001) times the rate.*milliseconds"):
         read_log(p)
 
 

@@ -21,7 +21,7 @@ from joulepath.program import (
     resolve_module,
 )
 from joulepath.program._cycle import CycleOptimizer
-from joulepath.sim import ControllerConfig
+from joulepath.sim import JERK_TIME, ControllerConfig
 from joulepath.sim._timing import FINE_DT, evaluate_cycle, standalone
 
 SMALL = """MODULE Small
@@ -96,7 +96,9 @@ def test_zone_shortens_the_cycle(robot):
 
 
 def test_optimized_cycle_invariants(spec, robot, tmp_path):
-    settings = CycleSettings(gradient=FAST, table_points=3, use_waits=True, cycle_time=REACHABLE)
+    settings = CycleSettings(
+        gradient=FAST, table_points=3, use_waits=True, cycle_time=REACHABLE, jerk_time=JERK_TIME
+    )
     result, opt = optimize_cycle(spec, settings)
     assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
     assert result.limits_ok
@@ -142,17 +144,19 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
 
 
 def test_jerk_limits_lengthen_the_shortest_cycle(spec):
-    """The program's own cycle time is refused under the jerk limit, with the shortest reachable one."""
+    """Under the controller's jerk limit the program's own cycle time is refused (the shortest is given)."""
     from joulepath.errors import LimitViolation
 
     loose = CycleOptimizer(spec, CycleSettings(gradient=FAST, jerk_time=0))
-    tight = CycleOptimizer(spec, CycleSettings(gradient=FAST))
+    tight = CycleOptimizer(spec, CycleSettings(gradient=FAST, jerk_time=JERK_TIME))
     assert tight.shortest_cycle > loose.shortest_cycle
     assert loose.shortest_cycle <= loose.plan.cycle_time < tight.shortest_cycle <= REACHABLE
     with pytest.raises(
         LimitViolation, match=r"shorter than the shortest .*optimized moves at their shortest"
     ):
-        optimize_cycle(spec, CycleSettings(gradient=FAST))
+        optimize_cycle(spec, CycleSettings(gradient=FAST, jerk_time=JERK_TIME))
+    # the default (no jerk limit yet for whole cycles) reaches the program's own cycle time
+    assert CycleSettings().jerk_time == 0.0
 
 
 def test_cycle_settings_refuse_a_negative_jerk_time(tmp_path):

@@ -52,8 +52,8 @@ def cycle(
         None,
         "--jerk-time",
         help="s for the acceleration to reach its limit at full jerk: each joint's jerk limit is its "
-        "acceleration limit divided by this (0: no jerk limit; default: the emulated controller's, "
-        "joulepath.sim.JERK_TIME, 0.125 s).",
+        "acceleration limit divided by this (default 0: no jerk limit, so that the program's own cycle "
+        "time stays reachable; the emulated controller's is joulepath.sim.JERK_TIME, 0.125 s).",
     ),
     write_anyway: bool = typer.Option(
         False,

@@ -40,7 +40,6 @@ from joulepath.energy import joint_energy, path_energy
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize import (
     ACCEL_TIME,
-    JERK_TIME,
     GradientSettings,
     acceleration_limit,
     check_limits,
@@ -78,7 +77,9 @@ class CycleSettings:
     within this distance of the joint-interpolated taught move (the path ``MoveJ`` itself
     follows) at every sample (None: none). ``accel_time`` and ``jerk_time`` set the
     optimized moves' acceleration and jerk limits (:mod:`joulepath.sim`'s; ``jerk_time``
-    0: no jerk limit).
+    0, the default for now: no jerk limit — under the controller's jerk limit,
+    :data:`joulepath.sim.JERK_TIME`, an optimized move starts from a minimum-jerk move, slower
+    than the controller's own ramps, and a program's own cycle time is out of reach).
     ``cell``: obstacles every optimized move must clear (a move too close is solved
     again in corridors of 1/2, 1/4, 1/8 of ``corridor_mm``, else not used).
     ``warm_start``: start each solve of a move from its nearest solved duration
@@ -94,7 +95,7 @@ class CycleSettings:
     table_points: int = 4
     via_every: int = 2
     accel_time: float = ACCEL_TIME
-    jerk_time: float = JERK_TIME
+    jerk_time: float = 0.0
     corridor_mm: float | None = 100.0
     cell: Cell | None = None
     warm_start: bool = False
