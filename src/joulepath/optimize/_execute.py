@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from joulepath.dynamics import Robot
-from joulepath.energy import path_energy
+from joulepath.optimize._verify import energy_on_samples, plant_energy
 from joulepath.trajectory import Trajectory
 
 EXECUTION_TOLERANCES = {"duration_pct": 2.0, "tcp_mm": 5.0}
@@ -81,16 +81,6 @@ class Execution:
         )
 
 
-def _energy(robot: Robot, traj: Trajectory) -> float:
-    tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=robot.friction)
-    return float(path_energy(tau, traj.qd, traj.dt).total)
-
-
-def _lab_energy(lab: Any, traj: Trajectory) -> float:
-    tau = lab.drive_torque(traj.q, traj.qd, traj.qdd)
-    return float(path_energy(tau, traj.qd, traj.dt).total)
-
-
 def rapid_execution(robot: Robot, planned: Trajectory, planned_fine_J: float) -> tuple[Execution, Trajectory]:
     """Lay out the via points of ``planned`` and measure the written program on the emulation.
 
@@ -105,8 +95,9 @@ def rapid_execution(robot: Robot, planned: Trajectory, planned_fine_J: float) ->
     followed = follow_path(robot, planned)
     d_end, default = timed_move(robot, planned.q[0], planned.q[-1], duration)
     lab = make_plant("lab", robot)
-    e_opt, e_def = _energy(robot, followed.executed), _energy(robot, default)
-    l_opt, l_def = _lab_energy(lab, followed.executed), _lab_energy(lab, default)
+    e_opt = energy_on_samples(robot, followed.executed, friction=robot.friction)
+    e_def = energy_on_samples(robot, default, friction=robot.friction)
+    l_opt, l_def = plant_energy(lab, followed.executed), plant_energy(lab, default)
     from scipy.spatial import cKDTree
 
     pos_plan = robot.fk(_at(planned, np.minimum(followed.executed.t, duration))).position_mm

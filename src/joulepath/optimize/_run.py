@@ -29,6 +29,7 @@ from joulepath.optimize._verify import (
     default_fine,
     energy_on_samples,
     path_jerk,
+    plant_energy,
     shortest_feasible_duration,
     tcp_deviation_mm,
 )
@@ -198,11 +199,6 @@ def rank_joints_by_energy(robot: Robot, path: Trajectory) -> tuple[int, ...]:
     tau = robot.inverse_dynamics(path.q, path.qd, path.qdd)
     per_joint = path_energy(tau, path.qd, path.dt).per_joint
     return tuple(int(j) + 1 for j in np.argsort(-per_joint))
-
-
-def _plant_energy(plant: Any, traj: Trajectory) -> float:
-    tau = plant.drive_torque(traj.q, traj.qd, traj.qdd)
-    return float(path_energy(tau, traj.qd, traj.dt).total)
 
 
 MAX_DURATION = 60.0
@@ -381,7 +377,7 @@ def verify_move(
     from joulepath.sim import make_plant
 
     lab = make_plant("lab", robot)  # a twin: the lab robot it twins
-    e_lab_def, e_lab_opt = _plant_energy(lab, default), _plant_energy(lab, optimized)
+    e_lab_def, e_lab_opt = plant_energy(lab, default), plant_energy(lab, optimized)
     summary = MoveSummary(
         robot=robot.name,
         start_rad=tuple(float(v) for v in task.q_start),

@@ -14,11 +14,13 @@ path whatever its representation; the gradient search constrains the same quanti
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Friction, Robot
+from joulepath.energy import path_energy
 from joulepath.optimize._problem import physics_energy
 from joulepath.trajectory import Trajectory, minimum_jerk, sample_times
 
@@ -156,6 +158,12 @@ def energy_on_samples(robot: Robot, path: Trajectory, *, friction: Friction | No
     """The reported metric: ``Σ |tau qd| dt`` over the path's samples (J)."""
     energy, _ = physics_energy(robot, path, friction=friction)
     return float(energy[0])
+
+
+def plant_energy(plant: Any, path: Trajectory) -> float:
+    """``Σ |tau qd| dt`` of a plant's drive torque (``plant.drive_torque``) over the path's samples (J)."""
+    tau = plant.drive_torque(path.q, path.qd, path.qdd)
+    return float(path_energy(tau, path.qd, path.dt).total)
 
 
 def tcp_deviation_mm(robot: Robot, path: Trajectory, reference: Trajectory) -> float:
