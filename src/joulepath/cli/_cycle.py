@@ -32,13 +32,38 @@ def cycle(
     out: Path = typer.Option(..., "--out", help="Run folder."),
     cycle_time: str = typer.Option("same", "--cycle-time", help="'same' (the default program's) or seconds."),
     use_waits: bool = typer.Option(
-        False, "--use-waits", help="Spend WaitTime slack on the moves (waits set to 0)."
+        False,
+        "--use-waits",
+        help="Spend the waits declared idle (a `! joulepath: idle` comment on the WaitTime, or --idle-wait "
+        "LINE) on the moves; every other wait is process time and keeps its length.",
+    ),
+    idle_wait: list[int] = typer.Option(
+        [], "--idle-wait", min=1, help="Line of a WaitTime that is idle time (repeatable); see --use-waits."
     ),
     stop_at_targets: bool = typer.Option(
         False,
         "--stop-at-targets",
-        help="Run every optimized move rest to rest; default: consecutive MoveJ/MoveAbsJ joined by a zone "
-        "form one fly-by chain that passes their targets exactly without stopping.",
+        help="Optimize only moves that run from rest to rest on their own; default: consecutive "
+        "MoveJ/MoveAbsJ joined by zones are optimized as one fly-by chain through their targets.",
+    ),
+    exact_targets: bool = typer.Option(
+        False,
+        "--exact-targets",
+        help="A fly-by chain passes its targets exactly; default: within each target's zone, as the "
+        "controller does.",
+    ),
+    export: str = typer.Option(
+        "rapid",
+        "--export",
+        help="rapid: optimized.mod (where the controller emulation runs it as the checks ask); egm: also "
+        "egm.mod and EGM_SETUP.md, to stream cycle_path.csv with `joulepath stream OUT --repeat K`.",
+    ),
+    max_time: float = typer.Option(
+        None,
+        "--max-time",
+        min=1.0,
+        help="s of wall time at most for the optimization: then the best verified result so far (the "
+        "taught motion for the units not yet solved).",
     ),
     accel_time: float = typer.Option(
         0.25,
@@ -101,11 +126,18 @@ def cycle(
     from joulepath.program import pareto as run_pareto
 
     target = _cycle_time(cycle_time)
+    if export not in ("rapid", "egm"):
+        raise typer.BadParameter(f"{export!r}: give rapid or egm", param_hint="--export")
     check_out_folder(out, files=CYCLE_FILES, inputs=[program, *([cell] if cell else [])])
     if not program.is_file():
         raise typer.BadParameter(f"{program}: no such file", param_hint="PROGRAM")
     r = load_robot_for_cli(robot, unchecked=unchecked)
-    spec, rapid = read_cycle_program(program, r)
+    spec, rapid = read_cycle_program(program, r, idle_waits=idle_wait)
+    if use_waits and not any(s.idle for s in spec.steps if s.kind == "wait"):
+        console.print(
+            "note: --use-waits: no wait is declared idle (`! joulepath: idle` on its line, or --idle-wait "
+            "LINE); every wait is process time and keeps its length"
+        )
     from joulepath.program._cell import read_cell
 
     cell_data = read_cell(cell) if cell is not None else None
@@ -114,6 +146,8 @@ def cycle(
         cycle_time=target,
         use_waits=use_waits,
         fly_by=not stop_at_targets,
+        zones=not exact_targets,
+        max_time_s=max_time,
         accel_time=accel_time,
         seed=seed,
         table_points=table_points,
@@ -135,6 +169,7 @@ def cycle(
         write_rapid=rapid,
         cell=cell_data,
         write_anyway=write_anyway,
+        egm=export == "egm",
     )
     saved = json.loads(files["cycle.json"].read_text())
     if not result.limits_ok or (

@@ -27,6 +27,8 @@ PLAN_FILES = ("path.csv", "cycle_path.csv")
 """The plan files a run folder may hold, in the order they are looked for."""
 RESULT_FILE = "result.json"
 """The optimize run's summary: ``robot``, ``energy_default_J``, ``energy_optimized_J``, ``saved_pct``."""
+CYCLE_RESULT_FILE = "cycle.json"
+"""A cycle run's summary (``joulepath cycle``), read where there is no ``result.json``."""
 CHECK_PERIOD = 0.004
 """s between the instants at which the interpolated plan is checked against the limits (EGM's 4 ms)."""
 
@@ -207,7 +209,8 @@ def read_plan(path: str | os.PathLike[str]) -> Plan:
 
 
 def read_run_result(folder: str | os.PathLike[str]) -> dict[str, Any]:
-    """The run folder's ``result.json`` as a dict, or ``{}`` when it has none.
+    """The run folder's ``result.json`` (or a cycle folder's ``cycle.json``) as a dict, or ``{}``
+    when it has neither.
 
     Raises
     ------
@@ -215,6 +218,8 @@ def read_run_result(folder: str | os.PathLike[str]) -> dict[str, Any]:
         ``result.json`` exists but is not a JSON object.
     """
     p = Path(folder) / RESULT_FILE
+    if not p.is_file():
+        p = Path(folder) / CYCLE_RESULT_FILE
     if not p.is_file():
         return {}
     try:

@@ -19,9 +19,10 @@ Constraints (not penalties), solved by SLSQP:
 * effort limits (where the robot states them) on the same fine grid;
 * optionally a corridor: the TCP stays within ``max_deviation_m`` of the default
   move's TCP at every sample;
-* optionally waypoints (equalities, linear in ``x``): the path passes through given
-  joint positions at given interior times with whatever velocity the search finds
-  best — a chain of fly-by targets solved as one move.
+* optionally waypoints (linear in ``x``): the path passes through given joint
+  positions at given interior times with whatever velocity the search finds best —
+  a chain of fly-by targets solved as one move; exactly (equalities), or within a
+  box of given half-widths per joint (``waypoint_radius``: a zone, inequalities).
 
 Fine-grid constraints are generated lazily (active-set style): each solve includes
 the grid points whose value is within ``SCREEN_BAND`` of its limit at the start
@@ -137,6 +138,8 @@ class SplineProblem:
     acceleration_limit: FloatArray | None = None
     waypoints: tuple[tuple[float, FloatArray], ...] = ()
     jerk_limit: FloatArray | None = None
+    waypoint_radius: tuple[FloatArray, ...] = ()
+    base: Trajectory | None = None
     n_evaluations: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -146,10 +149,22 @@ class SplineProblem:
         self.m = self.basis.n_free
         self.samples: GridBasis = self.basis.samples
         self.fine: GridBasis = self.basis.grid(self.basis.dt / self.check_factor)
-        self.default = minimum_jerk(self.q_start, self.q_end, self.duration, dt=self.basis.dt)
-        self.default_fine = minimum_jerk(
-            self.q_start, self.q_end, self.duration, dt=self.basis.dt / self.check_factor
-        )
+        if self.base is None:
+            self.default = minimum_jerk(self.q_start, self.q_end, self.duration, dt=self.basis.dt)
+            self.default_fine = minimum_jerk(
+                self.q_start, self.q_end, self.duration, dt=self.basis.dt / self.check_factor
+            )
+        else:  # a given motion (on the fine grid) the shape is added to: its ends are kept
+            fine_t = self.fine.t
+            b = self.base
+            if b.t.shape != fine_t.shape or np.abs(b.t - fine_t).max() > 1e-9:
+                raise InvalidInput(
+                    f"base must be sampled on the fine grid: {fine_t.size} samples 0..{self.duration:g} s "
+                    f"every {self.basis.dt / self.check_factor:g} s"
+                )
+            self.default_fine = b
+            every = self.check_factor
+            self.default = Trajectory(t=b.t[::every], q=b.q[::every], qd=b.qd[::every], qdd=b.qdd[::every])
         self.lo, self.hi = self.robot.joint_ranges()
         self.vmax = np.where(
             np.isfinite(self.robot.velocity_limit), np.asarray(self.robot.velocity_limit, dtype=float), 1e9
@@ -181,6 +196,7 @@ class SplineProblem:
         """
         self.way_A: FloatArray = np.zeros((0, self.n_var))
         self.way_b: FloatArray = np.zeros(0)
+        self.way_r: FloatArray = np.zeros(0)
         if not self.waypoints:
             return
         times = np.array([float(t) for t, _ in self.waypoints])
@@ -192,12 +208,28 @@ class SplineProblem:
         if q_way.shape[1] != self.n or not np.all(np.isfinite(q_way)):
             raise InvalidInput(f"waypoints must be finite joint vectors of {self.n} joints")
         Bw = self.basis.free_basis(times)  # (w, m)
-        s = times / self.duration  # the minimum-jerk move at the waypoint times
-        blend = 10 * s**3 - 15 * s**4 + 6 * s**5
-        base_at = self.q_start + blend[:, None] * (self.q_end - self.q_start)
+        if self.base is None:
+            s = times / self.duration  # the minimum-jerk move at the waypoint times
+            blend = 10 * s**3 - 15 * s**4 + 6 * s**5
+            base_at = self.q_start + blend[:, None] * (self.q_end - self.q_start)
+        else:
+            b = self.default_fine
+            base_at = np.column_stack([np.interp(times, b.t, b.q[:, j]) for j in range(self.n)])
         d = q_way - base_at  # (w, n)
         self.way_A = np.asarray(np.kron(Bw, np.eye(self.n)), dtype=float)  # rows w * n + i
         self.way_b = d.ravel()
+        if self.waypoint_radius:
+            r = np.stack(
+                [np.broadcast_to(np.asarray(v, dtype=float), (self.n,)) for v in self.waypoint_radius]
+            )
+            if r.shape != q_way.shape or not np.all(np.isfinite(r)) or np.any(r < 0.0):
+                raise InvalidInput(
+                    f"waypoint_radius must give {len(self.waypoints)} non-negative finite radii of "
+                    f"{self.n} joints (rad), one per waypoint"
+                )
+            self.way_r = r.ravel()
+        else:
+            self.way_r = np.zeros_like(self.way_b)
         # the smoothest shape through the waypoints: min |Bdd C|² + ridge s.t. Bw C = d
         H = self.samples.Bdd.T @ self.samples.Bdd
         H = H + 1e-9 * np.trace(H) / H.shape[0] * np.eye(self.m)
@@ -207,10 +239,12 @@ class SplineProblem:
         self.origin = sol[: self.m].ravel()
 
     def waypoint_error(self, x: FloatArray) -> float:
-        """Largest distance (rad) of the path from a waypoint at its time (0 without waypoints)."""
+        """Largest distance (rad) of the path beyond a waypoint's box at its time (0 without waypoints;
+        the box of an exact waypoint has no width)."""
         if not self.way_b.size:
             return 0.0
-        return float(np.abs(self.way_A @ np.asarray(x, dtype=float) - self.way_b).max())
+        miss = np.abs(self.way_A @ np.asarray(x, dtype=float) - self.way_b) - self.way_r
+        return float(max(miss.max(), 0.0))
 
     @property
     def n_var(self) -> int:
@@ -249,7 +283,10 @@ class SplineProblem:
 
     # ------------------------------------------------------------- constraints
     def _hull(self) -> tuple[FloatArray, FloatArray]:
-        """``A x + b ≥ 0``: every control point of q, qd, qdd inside its bounds (holds at every instant)."""
+        """``A x + b ≥ 0``: every control point of q, qd, qdd inside its bounds (holds at every instant);
+        with a given ``base``, q and qd inside their bounds at every point of the fine grid."""
+        if self.base is not None:
+            return self._grid_hull()
         maps = self.basis.control_maps[:2]
         offsets = self.basis.minimum_jerk_control(self.q_start, self.q_end)[:2]
         upper = (self.hi - RANGE_MARGIN, self.vmax * (1 - RATE_MARGIN))
@@ -261,6 +298,30 @@ class SplineProblem:
         for M, P, hi, lo, sc in zip(maps, offsets, upper, lower, scales, strict=True):
             # control point (r, i) = P[r, i] + Σ_j M[r, j] C[j, i];  x[j * n + i] = C[j, i]
             full = np.kron(M, eye)  # rows r * n + i
+            for sign, bound in ((-1.0, hi), (1.0, lo)):
+                finite = np.isfinite(np.broadcast_to(bound, P.shape)).ravel()
+                b = (sign * (P - bound)).ravel()
+                rows_a.append(sign * full[finite])
+                rows_b.append(b[finite])
+                rows_s.append(np.broadcast_to(sc, P.shape).ravel()[finite])
+        self.hull_scale = np.concatenate(rows_s)
+        return np.concatenate(rows_a), np.concatenate(rows_b)
+
+    def _grid_hull(self) -> tuple[FloatArray, FloatArray]:
+        rows_a, rows_b, rows_s = [], [], []
+        eye = np.eye(self.n)
+        span = np.where(np.isfinite(self.hi - self.lo), self.hi - self.lo, 2 * np.pi)
+        for M, P, hi, lo, sc in (
+            (self.fine.B, self.default_fine.q, self.hi - RANGE_MARGIN, self.lo + RANGE_MARGIN, span),
+            (
+                self.fine.Bd,
+                self.default_fine.qd,
+                self.vmax * (1 - RATE_MARGIN),
+                -self.vmax * (1 - RATE_MARGIN),
+                self.vmax,
+            ),
+        ):
+            full = np.kron(M, eye)
             for sign, bound in ((-1.0, hi), (1.0, lo)):
                 finite = np.isfinite(np.broadcast_to(bound, P.shape)).ravel()
                 b = (sign * (P - bound)).ravel()
@@ -331,8 +392,16 @@ class SplineProblem:
         """SLSQP constraint dicts for the active fine-grid points ``active[kind]`` (flat indices)."""
         cons: list[dict[str, Any]] = []
         if self.way_b.size:
-            Aw, bw = self.way_A, self.way_b
-            cons.append({"type": "eq", "fun": lambda x: Aw @ x - bw, "jac": lambda x: Aw})
+            exact = self.way_r <= 0.0
+            if exact.any():
+                Aw, bw = self.way_A[exact], self.way_b[exact]
+                cons.append({"type": "eq", "fun": lambda x: Aw @ x - bw, "jac": lambda x: Aw})
+            if (~exact).any():  # a zone: -r <= A x - b <= r
+                Az = np.vstack([-self.way_A[~exact], self.way_A[~exact]])
+                bz = np.concatenate(
+                    [self.way_r[~exact] + self.way_b[~exact], self.way_r[~exact] - self.way_b[~exact]]
+                )
+                cons.append({"type": "ineq", "fun": lambda x: Az @ x + bz, "jac": lambda x: Az})
         rows = active.get("hull")
         if rows is not None and rows.size:
             A, b = self.hull[0][rows], self.hull[1][rows]
@@ -574,11 +643,16 @@ def solve_move(
     dt: float = SAMPLE_PERIOD,
     waypoints: tuple[tuple[float, FloatArray], ...] = (),
     jerk_limit: FloatArray | None = None,
+    waypoint_radius: tuple[FloatArray, ...] = (),
+    base: Trajectory | None = None,
 ) -> tuple[GradientResult, SplineProblem]:
     """Coarse-to-fine gradient search of one move; the result and the problem it lives in.
 
     ``waypoints``: (time s, joint vector) pairs inside the move that the path passes
-    through exactly, at any speed (a chain of fly-by targets solved as one move).
+    through exactly, at any speed (a chain of fly-by targets solved as one move), or
+    within ``waypoint_radius`` (rad per joint, one per waypoint) of each: a zone.
+    ``base``: the motion (on the fine grid) the shape is added to instead of the
+    minimum-jerk move; its start and end states (q, qd, qdd) are kept.
     """
 
     def make(spacing: float) -> SplineProblem:
@@ -595,6 +669,8 @@ def solve_move(
             acceleration_limit=acceleration_limit,
             waypoints=waypoints,
             jerk_limit=jerk_limit,
+            waypoint_radius=waypoint_radius,
+            base=base,
         )
 
     fine = make(settings.knot_spacing)

@@ -54,9 +54,9 @@ from joulepath.sim._timing import (
     FINE_DT,
     PlannedCycle,
     PlannedMove,
+    _tcp,
     evaluate_cycle,
     plan_cycle,
-    standalone,
 )
 from joulepath.sim._via import layout as via_layout
 from joulepath.trajectory import SplineBasis, Trajectory
@@ -85,9 +85,13 @@ class CycleSettings:
     ``warm_start``: start each solve of a move from its nearest solved duration
     (time-scaled) and run only the last continuation stages; measured not faster and
     slightly worse (BENCHMARKS.md), so off by default. ``fly_by``: consecutive
-    optimizable moves joined by a zone (a fly-by target) are solved as one chain that
-    passes each such target exactly, at whatever speed saves most, instead of stopping
-    there; False: every optimized move runs rest to rest.
+    optimizable moves joined by a zone (a fly-by target) are solved as one chain through
+    those targets, at whatever speed saves most; False: only a move that runs from rest
+    to rest on its own is optimized (the taught chains are kept). ``zones``: a chain
+    passes each fly-by target within its zone (the controller's zone: its radius,
+    reduced to half of either move's TCP length), False: exactly. ``max_time_s``: a
+    bound on the wall time; when it is reached no further move is solved and the best
+    verified allocation of what was solved is returned (taught motion elsewhere).
     """
 
     cycle_time: float | None = None
@@ -100,6 +104,8 @@ class CycleSettings:
     cell: Cell | None = None
     warm_start: bool = False
     fly_by: bool = True
+    zones: bool = True
+    max_time_s: float | None = None
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     seed: int = 0
@@ -117,6 +123,12 @@ class CycleSettings:
             raise InvalidInput(f"accel_time must be in (0, 10] s, got {self.accel_time}")
         if not 0 <= self.jerk_time <= 10:
             raise InvalidInput(f"jerk_time must be in [0, 10] s (0: no jerk limit), got {self.jerk_time}")
+        if self.max_time_s is not None and not (np.isfinite(self.max_time_s) and self.max_time_s > 0):
+            raise InvalidInput(f"max_time_s must be a positive number of seconds, got {self.max_time_s}")
+
+
+class TimeBudgetSpent(Exception):
+    """Internal: the wall-time bound was reached before a solve (never leaves this module)."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -133,6 +145,7 @@ class Solved:
     corridor_dev_mm: float  # tool0 from the joint-interpolated taught move, largest
     clearance_mm: float | None = None  # smallest distance to the cell's obstacles (None: no cell)
     corridor_used_mm: float | None = None
+    taught: bool = False  # the taught motion of the unit, as the controller runs it (not re-solved)
 
     @property
     def usable(self) -> bool:
@@ -171,6 +184,7 @@ class Allocation:
     energy_J: float
     energy_lab_J: float
     cycle_time_s: float
+    choice: dict[int, Solved] = field(default_factory=dict)  # by unit: the entry chosen
 
 
 @dataclass(frozen=True, slots=True)
@@ -221,6 +235,12 @@ class CycleResult:
     spec: CycleSpec
     chains: dict[int, tuple[int, ...]] = field(default_factory=dict)  # fly-by chains (step indices)
     vias: dict[int, tuple[int, ...]] = field(default_factory=dict)  # per optimized move: indices into .fine
+    planned: Trajectory | None = None  # the whole optimized cycle, 2.5 ms grid
+    taught_units: tuple[int, ...] = ()  # first lines of the units kept as taught
+    timed_out: bool = False  # max_time_s was reached before every solve
+    zone_miss_mm: float = 0.0  # largest TCP distance beyond a fly-by target's zone (0: within all)
+    open_ends: frozenset[int] = frozenset()  # optimized moves whose piece ends blended into a kept move
+    rapid_plan: CycleResult | None = None  # the same with the units inside MoveL segments as taught
 
     @property
     def saved_pct(self) -> float:
@@ -241,14 +261,60 @@ class ParetoPoint:
     durations: tuple[float, ...]
 
 
-def _energy(robot: Robot, plant: Plant, traj: Trajectory) -> tuple[float, float]:
+def _energy(robot: Robot, plant: Plant, traj: Trajectory, *, half_open: bool = False) -> tuple[float, float]:
+    """Physics and lab J of ``traj``; ``half_open``: without its last sample (a window that the
+    rest of the cycle continues from, so that windows and their surroundings add up)."""
+    if half_open:
+        k = traj.t.size - 1
+        traj = Trajectory(t=traj.t[:k], q=traj.q[:k], qd=traj.qd[:k], qdd=traj.qdd[:k])
     tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
     lab = plant.drive_torque(traj.q, traj.qd, traj.qdd)
     return float(path_energy(tau, traj.qd, traj.dt).total), float(path_energy(lab, traj.qd, traj.dt).total)
 
 
+@dataclass(frozen=True, slots=True)
+class Segment:
+    """Moves of the default cycle from rest to rest: the robot stands still before the first
+    (at the cycle's start, or after a stop point's dwell or a wait) and after the last."""
+
+    moves: tuple[int, ...]  # step indices, in order
+    t0: float  # s, in the default cycle
+    t1: float
+
+    @property
+    def span(self) -> float:
+        return self.t1 - self.t0
+
+
+def segments(plan: PlannedCycle) -> list[Segment]:
+    """The default cycle cut at every stop of the robot (:class:`Segment`)."""
+    out: list[Segment] = []
+    run: list[PlannedMove] = []
+    for m in plan.moves:
+        run.append(m)
+        if m.stops:
+            out.append(Segment(tuple(x.index for x in run), run[0].t0, max(x.t_end for x in run)))
+            run = []
+    if run:
+        out.append(Segment(tuple(x.index for x in run), run[0].t0, max(x.t_end for x in run)))
+    return out
+
+
+TIME_UNIT = FINE_DT
+"""s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
+
+
 class CycleOptimizer:
-    """Default cycle, duration table, allocations and verification of one program on one robot."""
+    """Default cycle, duration table, allocations and verification of one program on one robot.
+
+    The default cycle is cut into rest-to-rest :class:`Segment` s. A segment of ``MoveJ`` /
+    ``MoveAbsJ`` only (each occurring once in the cycle, clear of the cell) is a *unit*: it
+    is optimized as one move through its targets (within each target's zone, or exactly),
+    and its own taught motion stays a candidate at its taught duration, so the taught cycle
+    time is always reachable. Every other segment runs as taught, blended as the controller
+    blends it; dwells and waits keep their time (``use_waits``: the waits declared idle are
+    spent on the units).
+    """
 
     def __init__(
         self,
@@ -256,12 +322,17 @@ class CycleOptimizer:
         settings: CycleSettings,
         *,
         progress: Callable[[str], None] | None = None,
+        deadline: float | None = None,
     ) -> None:
         self.spec = spec
         self.settings = settings
         self.progress = progress or (lambda msg: None)
+        self.deadline = deadline  # time.perf_counter() after which no new move is solved
+        self.timed_out = False
         self.plan: PlannedCycle = plan_cycle(spec, settings.controller)
         self._plants: dict[int, Plant] = {}
+        self._default_motion: Trajectory | None = None
+        self._default_energies: dict[int, tuple[float, float, float]] | None = None
         self.cache: dict[tuple[int, int], Solved] = {}
         self.n_solves = 0
         moves = self.plan.moves
@@ -269,25 +340,37 @@ class CycleOptimizer:
         self.default_clearance: dict[int, float] = {}
         if settings.cell is not None:
             self._default_clearance()
-        self.optimizable = [
-            m.index
-            for m in moves
-            if not m.step.linear
-            and not m.step.repeated
-            and m.profile.duration > 0
-            and self.default_clearance.get(m.index, np.inf) >= 0.0
-        ]
-        self.kept = [m.index for m in moves if m.index not in self.optimizable]
-        self.chains = self._chains() if settings.fly_by else {i: (i,) for i in self.optimizable}
-        self.optimizable = list(self.chains)  # one unit per chain, keyed by its first move
+        self.segments = segments(self.plan)
+        self.chains: dict[int, tuple[int, ...]] = {}
+        self.span: dict[int, float] = {}
+        self.segment_of: dict[int, Segment] = {}  # by unit: the window of the default cycle it replaces
+        self.within: set[int] = set()  # units inside a segment with MoveL: fixed duration, taught ends
+        for seg in self.segments:
+            for members, window, inner in self._units_of(seg):
+                self.chains[members[0]] = members
+                self.span[members[0]] = window.span
+                self.segment_of[members[0]] = window
+                if inner:
+                    self.within.add(members[0])
+        self.optimizable = list(self.chains)  # one unit per window, keyed by its first moving move
+        in_units = {j for i in self.chains for j in self.segment_of[i].moves}
+        self.kept = [m.index for m in moves if m.index not in in_units]
         self.dwell = settings.controller.fine_dwell
         self.wait_total = float(sum(s for _, _, s in self.plan.waits))
-        self.kept_time = float(sum(self.by_index[i].profile.duration for i in self.kept))
+        self.idle_total = float(sum(s for i, _, s in self.plan.waits if spec.steps[i].idle))
+        # everything but the units and the waits: the rest as taught (blended), dwells
+        self.fixed_time = self.plan.cycle_time - sum(self.span.values()) - self.wait_total
+        self.kept_time = self.fixed_time - self.dwell * sum(
+            1 for m in moves if m.stops and m.profile.duration
+        )
         self.n_stops = sum(1 for m in moves if m.stops)
-        self.fixed_time = self.n_stops * self.dwell + self.kept_time
         self.t_lo: dict[int, float] = {}
         self.leg_lo: dict[int, tuple[float, ...]] = {}  # each move's shortest rest-to-rest duration
         for i, members in self.chains.items():
+            if i in self.within:  # its ends are the taught motion's: its duration stays
+                self.leg_lo[i] = ()
+                self.t_lo[i] = self.span[i]
+                continue
             single: list[float] = []
             for j in members:
                 m = self.by_index[j]
@@ -308,25 +391,52 @@ class CycleOptimizer:
                 single.append(shortest)
             self.leg_lo[i] = tuple(single)
             self.t_lo[i] = single[0] if len(members) == 1 else self._chain_shortest(i, sum(single))
-        self.shortest_cycle = self.fixed_time + sum(self.t_lo.values())
+        # each unit at its shortest optimized duration, or as taught where that is shorter
+        self.shortest_cycle = self.fixed_time + sum(min(self.t_lo[i], self.span[i]) for i in self.chains)
 
-    # ------------------------------------------------------------ chains
-    def _chains(self) -> dict[int, tuple[int, ...]]:
-        """Runs of consecutive optimizable moves joined by fly-by targets (zones), by first move."""
-        ok = set(self.optimizable)
-        out: dict[int, tuple[int, ...]] = {}
+    def _units_of(self, seg: Segment) -> list[tuple[tuple[int, ...], Segment, bool]]:
+        """The units of one segment: (moving members, window of the default cycle, inside a MoveL
+        segment). A segment of joint moves only is one unit from rest to rest; in a segment with
+        a MoveL, each run of consecutive joint moves is one unit over the time only it moves the
+        robot (from the end of the blend before it to the start of the blend after it, in whole
+        25 ms samples), its ends the taught motion's states."""
+        by = self.by_index
+        moving = [i for i in seg.moves if by[i].profile.duration > 0]
+        if not moving:
+            return []
+        if all(self._can_optimize(by[i]) for i in seg.moves):
+            if len(moving) > 1 and not self.settings.fly_by:
+                return []
+            return [(tuple(moving), seg, False)]
+        if not self.settings.fly_by:
+            return []
+        out: list[tuple[tuple[int, ...], Segment, bool]] = []
         run: list[int] = []
-        for m in self.plan.moves:
-            if m.index in ok and run and not self.by_index[run[-1]].stops:
-                run.append(m.index)
+        for k, i in enumerate([*moving, -1]):
+            if i >= 0 and self._can_optimize(by[i]):
+                run.append(i)
                 continue
             if run:
-                out[run[0]] = tuple(run)
-            run = [m.index] if m.index in ok else []
-        if run:
-            out[run[0]] = tuple(run)
+                first, last = moving.index(run[0]), moving.index(run[-1])
+                a = by[moving[first - 1]].t_end if first > 0 else seg.t0
+                b = by[moving[last + 1]].t0 if last + 1 < len(moving) else seg.t1
+                n = int(np.floor((b - a) / STEP + 1e-9))
+                if n >= 6:  # at least 0.15 s to reshape
+                    out.append((tuple(run), Segment(tuple(run), a, a + n * STEP), True))
+            run = []
+            del k
         return out
 
+    def _can_optimize(self, m: PlannedMove) -> bool:
+        return (
+            not m.step.linear and not m.step.repeated and self.default_clearance.get(m.index, np.inf) >= 0.0
+        )
+
+    def waits_kept(self, use_waits: bool) -> float:
+        """s of waits the cycle keeps: all, or (``use_waits``) all but the idle ones."""
+        return self.wait_total - (self.idle_total if use_waits else 0.0)
+
+    # ------------------------------------------------------------ chains
     def waypoints(self, i: int, T: float) -> tuple[tuple[float, FloatArray], ...]:
         """The chain's inner targets and when it passes them: ``T`` shared in proportion to each
         move's shortest rest-to-rest duration, in whole 25 ms samples, each leg at least two
@@ -334,6 +444,8 @@ class CycleOptimizer:
         members = self.chains[i]
         if len(members) == 1:
             return ()
+        if i in self.within:
+            return self._taught_passes(i)
         base = np.array(self.leg_lo[i])
         units = int(round(T / STEP))
         edges = np.round(np.cumsum(base)[:-1] / base.sum() * units).astype(int)
@@ -344,6 +456,87 @@ class CycleOptimizer:
         return tuple(
             (float(e * STEP), self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
         )
+
+    def _taught_passes(self, i: int) -> tuple[tuple[float, FloatArray], ...]:
+        """Inner targets of a unit inside a MoveL segment, at the times (from the window's start, on
+        the 2.5 ms grid) the taught motion comes closest to each (TCP)."""
+        win = self.segment_of[i]
+        traj = self.base(i)
+        step = self.by_index[i].step
+        assert step.robot is not None and step.tcp is not None
+        p, _ = _tcp(step.robot, traj.q, step.tcp)
+        out: list[tuple[float, FloatArray]] = []
+        lo = 2
+        members = self.chains[i]
+        for j in members[:-1]:
+            q = self.by_index[j].path.q1
+            p0, _ = _tcp(step.robot, q[None, :], step.tcp)
+            d = np.linalg.norm(p - p0, axis=1)
+            k = lo + int(np.argmin(d[lo : d.size - 2]))
+            out.append((float(traj.t[k]), q))
+            lo = k + 2
+        del win
+        return tuple(out)
+
+    def base(self, i: int) -> Trajectory:
+        """The taught motion over unit ``i``'s window, on the optimizer's fine grid (from 0)."""
+        win = self.segment_of[i]
+        h = STEP / self.settings.gradient.check_factor
+        n = int(round(win.span / h)) + 1
+        t = np.linspace(0.0, (n - 1) * h, n)
+        tr = evaluate_cycle(self.plan, win.t0 + t)
+        return Trajectory(t=t, q=tr.q, qd=tr.qd, qdd=tr.qdd)
+
+    def zone_mm(self, j: int) -> float:
+        """The zone (mm) the controller keeps at move ``j``'s target inside a chain: its zone radius,
+        reduced to half the TCP length of this move and of the next (0: exactly)."""
+        if not self.settings.zones:
+            return 0.0
+        members = next(c for c in self.chains.values() if j in c)
+        k = members.index(j)
+        z = self.by_index[j].step.zone_mm
+        if z is None or k + 1 >= len(members):
+            return 0.0
+        here, nxt = self.by_index[j].path, self.by_index[members[k + 1]].path
+        return float(max(0.0, min(z, 0.5 * here.length_mm, 0.5 * nxt.length_mm)))
+
+    def zone_radius(self, i: int) -> tuple[FloatArray, ...]:
+        """Per inner target of chain ``i``, the joint box (rad, the same for every joint) whose
+        every point keeps the TCP within :meth:`zone_mm` of the target, to first order with a
+        margin of 1/4: ``r = 0.75 R / Σ_j |dp/dq_j|`` (the TCP moves at most Σ_j |dp/dq_j| |dq_j|)."""
+        members = self.chains[i]
+        out: list[FloatArray] = []
+        for j in members[:-1]:
+            step = self.by_index[j].step
+            R = self.zone_mm(j) / 1000.0
+            if R <= 0.0:
+                out.append(np.zeros(step.q.size if step.q is not None else 0))
+                continue
+            assert step.q is not None and step.robot is not None and step.tcp is not None
+            h = 1e-6
+            n = step.q.size
+            eye = np.eye(n) * h
+            plus, _ = _tcp(step.robot, step.q[None, :] + eye, step.tcp)
+            minus, _ = _tcp(step.robot, step.q[None, :] - eye, step.tcp)
+            norm = float(np.linalg.norm((plus - minus) / (2 * h), axis=1).sum())
+            out.append(np.full(n, 0.75 * R / max(norm, 1e-9)))
+        return tuple(out)
+
+    def zone_miss_mm(self, i: int, s: Solved) -> float:
+        """Largest TCP distance (mm) beyond its zone of the chain's path from an inner target, at
+        the time it passes it (0: within every zone)."""
+        members = self.chains[i]
+        if len(members) == 1:
+            return 0.0
+        step = self.by_index[i].step
+        assert step.robot is not None and step.tcp is not None
+        worst = 0.0
+        for (t, q), j in zip(self.waypoints(i, s.duration), members[:-1], strict=True):
+            k = int(np.argmin(np.abs(s.fine.t - t)))
+            p, _ = _tcp(step.robot, s.fine.q[k][None, :], step.tcp)
+            p0, _ = _tcp(step.robot, q[None, :], step.tcp)
+            worst = max(worst, 1000.0 * float(np.linalg.norm(p - p0)) - self.zone_mm(j))
+        return worst
 
     def _chain_problem(self, i: int, T: float) -> SplineProblem:
         """The chain's problem at ``T``: fine knots, no corridor (its smoothest path is ``origin``)."""
@@ -361,6 +554,7 @@ class CycleOptimizer:
             acceleration_limit=self._amax(robot),
             waypoints=self.waypoints(i, T),
             jerk_limit=self._jmax(robot),
+            waypoint_radius=self.zone_radius(i),
         )
 
     def _chain_shortest(self, i: int, upper: float) -> float:
@@ -451,6 +645,9 @@ class CycleOptimizer:
         key = (i, units)
         if key in self.cache:
             return self.cache[key]
+        if self.deadline is not None and time.perf_counter() > self.deadline:
+            self.timed_out = True
+            raise TimeBudgetSpent(f"{self.spec.source}: --max-time reached")
         m = self.by_index[i]
         T = units * STEP
         corridors: list[float | None] = [self.settings.corridor_mm]
@@ -505,7 +702,11 @@ class CycleOptimizer:
         amax = self._amax(robot)
         seq = np.random.SeedSequence([self.settings.seed, m.index, units])
         rng = np.random.default_rng(seq)
-        if warm is not None:  # from the nearest solved duration: the last continuation stages only
+        inner = m.index in self.within
+        base = self.base(m.index) if inner else None
+        q0 = m.path.q0 if base is None else base.q[0]
+        q1 = self.by_index[self.chains[m.index][-1]].path.q1 if base is None else base.q[-1]
+        if warm is not None and not inner:  # from the nearest solved duration: the last stages only
             problem, start = self._warm_problem(m, T, corridor, warm)
             g = self.settings.gradient
             refine = replace(g, n_starts=1, continuation=g.continuation[-g.refine_stages :])
@@ -513,8 +714,8 @@ class CycleOptimizer:
         else:
             res, problem = solve_move(
                 robot,
-                m.path.q0,
-                self.by_index[self.chains[m.index][-1]].path.q1,
+                q0,
+                q1,
                 T,
                 friction=NOMINAL_FRICTION,
                 settings=self.settings.gradient,
@@ -523,6 +724,8 @@ class CycleOptimizer:
                 max_deviation_m=None if corridor is None else corridor / 1000,
                 waypoints=self.waypoints(m.index, T),
                 jerk_limit=self._jmax(robot),
+                waypoint_radius=self.zone_radius(m.index),
+                base=base,
             )
         self.n_solves += 1
         x = res.coefficients.ravel()
@@ -530,7 +733,7 @@ class CycleOptimizer:
         report = check_limits(
             robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=self._jmax(robot)
         )
-        e, e_lab = _energy(robot, self.plant(robot), fine)
+        e, e_lab = _energy(robot, self.plant(robot), fine, half_open=inner)
         samples = problem.path(x)
         # the taught move: the joint-interpolated move, or through a chain's targets the smoothest path
         taught = problem.path(problem.origin)
@@ -548,12 +751,22 @@ class CycleOptimizer:
         )
 
     # ------------------------------------------------------------ default
+    def default_motion(self) -> Trajectory:
+        """The default cycle on its 2.5 ms grid (cached)."""
+        if self._default_motion is None:
+            plan = self.plan
+            n = int(np.ceil(plan.cycle_time / FINE_DT)) + 1
+            self._default_motion = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
+        return self._default_motion
+
     def default_energies(self) -> dict[int, tuple[float, float, float]]:
-        """Per move (step index): (slot duration s, physics J, lab J) of the default cycle."""
+        """Per move (step index): (slot duration s, physics J, lab J) of the default cycle; a move's
+        slot runs from its start to the next move's start, so the slots add up to the cycle."""
+        if self._default_energies is not None:
+            return dict(self._default_energies)
         plan = self.plan
-        n = int(np.ceil(plan.cycle_time / FINE_DT)) + 1
-        t = np.linspace(0.0, plan.cycle_time, n)
-        traj = evaluate_cycle(plan, t)
+        traj = self.default_motion()
+        t = traj.t
         starts = [m.t0 for m in plan.moves] + [plan.cycle_time]
         out: dict[int, tuple[float, float, float]] = {}
         for k, m in enumerate(plan.moves):
@@ -567,87 +780,153 @@ class CycleOptimizer:
             robot = self._robot(m)
             e, e_lab = _energy(robot, self.plant(robot), part)
             out[m.index] = (m.profile.duration, e, e_lab)
-        return out
+        self._default_energies = out
+        return dict(out)
 
     def kept_energies(self) -> dict[int, tuple[float, float]]:
-        """Kept moves run on their own (rest to rest): physics and lab J."""
-        out = {}
-        for i in self.kept:
-            m = self.by_index[i]
-            if m.profile.duration == 0:
-                out[i] = (0.0, 0.0)
-                continue
-            robot = self._robot(m)
-            out[i] = _energy(robot, self.plant(robot), standalone(m))
+        """Moves outside the units, run as taught within the default cycle: physics and lab J."""
+        default = self.default_energies()
+        return {i: (default[i][1], default[i][2]) for i in self.kept}
+
+    def taught(self, i: int) -> Solved:
+        """Unit ``i`` as taught: the default cycle's motion over its window (2.5 ms grid)."""
+        key = (i, -1)
+        if key in self.cache:
+            return self.cache[key]
+        win = self.segment_of[i]
+        fine = self.base(i)
+        every = self.settings.gradient.check_factor
+        samples = Trajectory(t=fine.t[::every], q=fine.q[::every], qd=fine.qd[::every], qdd=fine.qdd[::every])
+        robot = self._robot(self.by_index[i])
+        e, e_lab = _energy(robot, self.plant(robot), fine, half_open=True)
+        out = Solved(
+            win.span,
+            e,
+            e_lab,
+            True,
+            (),
+            samples,
+            fine,
+            0.0,
+            None
+            if self.settings.cell is None
+            else min(self.default_clearance.get(j, np.inf) for j in win.moves),
+            None,
+            taught=True,
+        )
+        self.cache[key] = out
         return out
+
+    def kept_energy(self) -> tuple[float, float]:
+        """Physics and lab J of everything outside the units (the default cycle's, less the units'
+        taught motion): what the cycle spends besides its units."""
+        default = self.default_energies()
+        e0 = sum(v[1] for v in default.values())
+        e0_lab = sum(v[2] for v in default.values())
+        units = [self.taught(i) for i in self.optimizable]
+        return e0 - sum(s.energy_J for s in units), e0_lab - sum(s.energy_lab_J for s in units)
 
     # ------------------------------------------------------------ allocation
     def budget(self, cycle_time: float, use_waits: bool) -> float:
-        return cycle_time - self.fixed_time - (0.0 if use_waits else self.wait_total)
+        """s the units may take in a cycle of ``cycle_time``."""
+        return cycle_time - self.fixed_time - self.waits_kept(use_waits)
 
-    def table(self, extra: float) -> dict[int, list[Solved]]:
-        """Each optimized move solved at ``table_points`` durations, shortest to shortest + ``extra``."""
+    def table(self, budget: float) -> dict[int, list[Solved]]:
+        """Each unit: its taught motion, then solved at ``table_points`` durations from its shortest
+        to the most the budget leaves it (the others at their shortest), and at its taught duration."""
         k = self.settings.table_points
         shares = np.concatenate([[0.0], np.geomspace(0.06, 1.0, k - 1)])
-        out: dict[int, list[Solved]] = {}
+        floor = {i: min(self.t_lo[i], self.span[i]) for i in self.optimizable}
+        out: dict[int, list[Solved]] = {i: [self.taught(i)] for i in self.optimizable}
         for n_move, i in enumerate(self.optimizable, start=1):
-            self.progress(f"move {n_move}/{len(self.optimizable)}: solving at {k} durations")
-            units = sorted({int(round((self.t_lo[i] + s * extra) / STEP)) for s in shares})
-            units = [u for u in units if u * STEP >= self.t_lo[i] - 1e-9] or [int(round(self.t_lo[i] / STEP))]
-            out[i] = [self.solve(i, u * STEP) for u in units]
+            hi = budget - (sum(floor.values()) - floor[i])
+            if hi < self.t_lo[i] - 1e-9:
+                continue  # the optimizer's shortest does not fit: taught only
+            self.progress(f"unit {n_move}/{len(self.optimizable)}: solving at up to {k + 1} durations")
+            if i in self.within:  # its ends are the taught motion's: at its own duration only
+                try:
+                    out[i].append(self.solve(i, round(self.span[i] / STEP) * STEP))
+                except TimeBudgetSpent:
+                    return out
+                continue
+            units = {int(round((self.t_lo[i] + s * (hi - self.t_lo[i])) / STEP)) for s in shares}
+            own = int(np.floor(self.span[i] / STEP + 1e-9))
+            if own * STEP >= self.t_lo[i] - 1e-9 and own * STEP <= hi + 1e-9:
+                units.add(own)
+            lo_u = int(np.ceil(self.t_lo[i] / STEP - 1e-9))
+            units = {max(u, lo_u) for u in units if u * STEP <= hi + 1e-9} or {lo_u}
+            for u in sorted(units):
+                try:
+                    out[i].append(self.solve(i, u * STEP))
+                except TimeBudgetSpent:
+                    return out
         return out
 
-    def dp(self, table: dict[int, list[Solved]], budget: float) -> dict[int, float] | None:
-        """The least-energy choice of one solved duration per move with Σ ≤ budget (feasible solves only)."""
-        cap = int(np.floor(budget / STEP + 1e-9))
-        if cap < 0:
-            return None
-        best = np.full(cap + 1, np.inf)
-        best[0] = 0.0
-        choice: list[np.ndarray] = []
-        for i in self.optimizable:
-            new = np.full(cap + 1, np.inf)
-            pick = np.full(cap + 1, -1)
-            for k, s in enumerate(table[i]):
-                if not s.usable:
-                    continue
-                u = int(round(s.duration / STEP))
-                if u > cap:
-                    continue
-                cand = np.full(cap + 1, np.inf)
-                cand[u:] = best[: cap + 1 - u] + s.energy_J
-                better = cand < new
-                new[better] = cand[better]
-                pick[better] = k
-            choice.append(pick)
-            best = new
-        end = int(np.argmin(best))
-        if not np.isfinite(best[end]):
-            return None
-        out: dict[int, float] = {}
-        u = end
-        for i, pick in zip(reversed(self.optimizable), reversed(choice), strict=True):
-            s = table[i][int(pick[u])]
-            out[i] = s.duration
-            u -= int(round(s.duration / STEP))
-        return out
+    def dp(self, table: dict[int, list[Solved]], budget: float) -> dict[int, Solved] | None:
+        """The least-energy choice of one usable entry per unit with Σ durations ≤ budget, on a
+        grid of :data:`TIME_UNIT` (each duration rounded up; the choice is checked in exact time)."""
+        idx = self.optimizable
+        if not idx:
+            return {}
+        cap = int(np.floor(budget / TIME_UNIT + 1e-9)) + len(idx)
+        while cap >= 0:
+            best = np.full(cap + 1, np.inf)
+            best[0] = 0.0
+            choice: list[np.ndarray] = []
+            for i in idx:
+                new = np.full(cap + 1, np.inf)
+                pick = np.full(cap + 1, -1)
+                for k, s in enumerate(table[i]):
+                    if not s.usable:
+                        continue
+                    u = int(np.ceil(s.duration / TIME_UNIT - 1e-6))
+                    if u > cap:
+                        continue
+                    cand = np.full(cap + 1, np.inf)
+                    cand[u:] = best[: cap + 1 - u] + s.energy_J
+                    better = cand < new
+                    new[better] = cand[better]
+                    pick[better] = k
+                choice.append(pick)
+                best = new
+            end = int(np.argmin(best))
+            if not np.isfinite(best[end]):
+                return None
+            out: dict[int, Solved] = {}
+            u = end
+            for i, pick in zip(reversed(idx), reversed(choice), strict=True):
+                s = table[i][int(pick[u])]
+                out[i] = s
+                u -= int(np.ceil(s.duration / TIME_UNIT - 1e-6))
+            if sum(s.duration for s in out.values()) <= budget + 1e-9:
+                return out
+            cap = end - 1  # the rounding let it over the budget: a tighter grid budget
+        return None
 
-    def continuous(self, table: dict[int, list[Solved]], budget: float) -> dict[int, float]:
-        """Share the budget on the fitted curves ``a + b/T + c/T²`` (SLSQP), in 25 ms steps."""
+    def continuous(self, table: dict[int, list[Solved]], budget: float) -> dict[int, Solved] | None:
+        """Share the budget on the fitted curves ``a + b/T + c/T²`` of the solved entries (SLSQP), in
+        25 ms steps, then solve at the shares; None when a unit has no usable solved entry or the
+        budget does not reach every unit's shortest."""
         from scipy.optimize import minimize, nnls
 
         idx = self.optimizable
         coef = []
         for i in idx:
-            pts = [(s.duration, s.energy_J) for s in table[i] if s.usable]
+            pts = [(s.duration, s.energy_J) for s in table[i] if s.usable and not s.taught]
+            if not pts:
+                return None
             T = np.array([p[0] for p in pts])
             E = np.array([p[1] for p in pts])
             A = np.column_stack([np.ones_like(T), 1 / T, 1 / T**2])
             c, _ = nnls(A, E) if T.size >= 2 else (np.array([E[0], 0.0, 0.0]), 0.0)
             coef.append(c)
+        if not idx:
+            return None
         C = np.array(coef)
         lo = np.array([self.t_lo[i] for i in idx])
-        hi = np.array([max(s.duration for s in table[i]) for i in idx])
+        if lo.sum() > budget + 1e-9:
+            return None
+        hi = np.array([max(s.duration for s in table[i] if not s.taught) for i in idx])
         hi = np.maximum(hi, lo)
 
         def f(T: FloatArray) -> tuple[float, FloatArray]:
@@ -675,63 +954,102 @@ class CycleOptimizer:
             k = int(np.argmin(g))
             units[k] += 1
             spare -= 1
-        return {i: float(u * STEP) for i, u in zip(idx, units, strict=True)}
+        if units.sum() * STEP > budget + 1e-9:
+            return None
+        try:
+            return {i: self.solve(i, float(u * STEP)) for i, u in zip(idx, units, strict=True)}
+        except TimeBudgetSpent:
+            return None
 
-    def evaluate(
-        self, durations: dict[int, float], kept: dict[int, tuple[float, float]], waits: float
-    ) -> Allocation:
-        """Verified cycle energies for given durations of the optimized moves."""
-        e = e_lab = 0.0
-        for i, T in durations.items():
-            s = self.solve(i, T)
-            e += s.energy_J
-            e_lab += s.energy_lab_J
-        for a, b in kept.values():
-            e += a
-            e_lab += b
-        cycle = self.fixed_time + waits + sum(durations.values())
-        return Allocation(dict(durations), e, e_lab, cycle)
+    def evaluate(self, choice: dict[int, Solved], waits: float) -> Allocation:
+        """Cycle energies (J) and time (s) of one entry per unit, the kept moves and ``waits`` s."""
+        kept, kept_lab = self.kept_energy()
+        e = sum(s.energy_J for s in choice.values()) + kept
+        e_lab = sum(s.energy_lab_J for s in choice.values()) + kept_lab
+        cycle = self.fixed_time + waits + sum(s.duration for s in choice.values())
+        return Allocation(
+            {i: s.duration for i, s in choice.items()}, float(e), float(e_lab), cycle, dict(choice)
+        )
 
-    def proportional(self, budget: float) -> dict[int, float]:
-        """The default's durations scaled by one factor to fill the budget (never below the shortest)."""
-        base = {i: sum(self.by_index[j].profile.duration for j in self.chains[i]) for i in self.optimizable}
-
-        def total(k: float) -> float:
-            return sum(max(self.t_lo[i], k * base[i]) for i in base)
-
-        lo, hi = 0.0, 100.0
-        for _ in range(80):
-            mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if total(mid) <= budget else (lo, mid)
-        return {
-            i: max(
-                STEP * np.ceil(self.t_lo[i] / STEP - 1e-9),
-                STEP * np.floor(max(self.t_lo[i], lo * base[i]) / STEP + 1e-9),
-            )
-            for i in base
-        }
+    def at_taught_durations(self, table: dict[int, list[Solved]]) -> dict[int, Solved]:
+        """Each unit reshaped at its own taught duration (in whole samples), where that was solved
+        and is usable; else as taught."""
+        out: dict[int, Solved] = {}
+        for i in self.optimizable:
+            own = int(np.floor(self.span[i] / STEP + 1e-9))
+            same = [s for s in table[i] if not s.taught and s.usable and int(round(s.duration / STEP)) == own]
+            out[i] = min([*same, self.taught(i)], key=lambda s: s.energy_J)
+        return out
 
     def best(
         self,
         table: dict[int, list[Solved]],
         budget: float,
-        kept: dict[int, tuple[float, float]],
         waits: float,
     ) -> Allocation:
+        """The least-energy verified allocation within ``budget``: dynamic programming over the
+        table, the fitted-curve share, and every unit as taught (where the budget holds it)."""
         candidates = []
         d = self.dp(table, budget)
         if d is not None:
-            candidates.append(self.evaluate(d, kept, waits))
+            candidates.append(self.evaluate(d, waits))
         c = self.continuous(table, budget)
-        alloc = self.evaluate(c, kept, waits)
-        if all(self.solve(i, T).usable for i, T in c.items()):
-            candidates.append(alloc)
+        if c is not None and all(s.usable for s in c.values()):
+            candidates.append(self.evaluate(c, waits))
+        if sum(self.span.values()) <= budget + 1e-9:
+            candidates.append(self.evaluate({i: self.taught(i) for i in self.optimizable}, waits))
         if not candidates:
             raise LimitViolation(
                 f"{self.spec.source}: no allocation of the durations keeps every optimized move "
                 "within its limits"
             )
         return min(candidates, key=lambda a: a.energy_J)
+
+    # ------------------------------------------------------------ the whole cycle
+    def motion(self, choice: dict[int, Solved], use_waits: bool) -> Trajectory:
+        """The optimized cycle on a 2.5 ms grid: the default cycle with each unit's chosen entry in
+        place of its segment and, with ``use_waits``, the idle waits left out."""
+        plan = self.plan
+        cut: list[tuple[float, float, Solved | None]] = [
+            (self.segment_of[i].t0, self.segment_of[i].t1, s) for i, s in choice.items() if not s.taught
+        ]
+        if use_waits:
+            cut += [(t0, t0 + sec, None) for k, t0, sec in plan.waits if self.spec.steps[k].idle and sec > 0]
+        cut.sort(key=lambda c: c[0])
+        pieces: list[tuple[float, float, Solved | None, bool]] = []  # default from, to; entry; kept
+        c = 0.0
+        for a, b, s in cut:
+            if a > c + 1e-12:
+                pieces.append((c, a, None, True))
+            pieces.append((a, b, s, False))
+            c = b
+        if c < plan.cycle_time - 1e-12:
+            pieces.append((c, plan.cycle_time, None, True))
+        lengths = [(b - a) if keep else (0.0 if s is None else s.duration) for a, b, s, keep in pieces]
+        total = float(sum(lengths))
+        n = max(2, int(np.ceil(total / FINE_DT - 1e-9)) + 1)
+        t = np.linspace(0.0, total, n)
+        n_j = plan.start.size
+        q, qd, qdd = np.zeros((n, n_j)), np.zeros((n, n_j)), np.zeros((n, n_j))
+        off = 0.0
+        done = np.zeros(n, dtype=bool)
+        for (a, _, s, keep), length in zip(pieces, lengths, strict=True):
+            sel = (t >= off - 1e-12) & (t <= off + length + 1e-12) & ~done
+            if sel.any():
+                local = t[sel] - off
+                if keep:
+                    part = evaluate_cycle(plan, a + local)
+                    q[sel], qd[sel], qdd[sel] = part.q, part.qd, part.qdd
+                elif s is not None:
+                    f = s.fine
+                    for arr, src in ((q, f.q), (qd, f.qd), (qdd, f.qdd)):
+                        arr[sel] = np.column_stack([np.interp(local, f.t, src[:, j]) for j in range(n_j)])
+                else:  # a wait left out: at rest where the robot stood
+                    part = evaluate_cycle(plan, np.full(local.size, a))
+                    q[sel], qd[sel], qdd[sel] = part.q, 0.0, 0.0
+                done |= sel
+            off += length
+        return Trajectory(t=t, q=q, qd=qd, qdd=qdd)
 
 
 def optimize_cycle(
@@ -740,67 +1058,111 @@ def optimize_cycle(
     *,
     progress: Callable[[str], None] | None = None,
 ) -> tuple[CycleResult, CycleOptimizer]:
-    """Optimize a cycle at the default's cycle time (or ``settings.cycle_time``); verified."""
+    """Optimize a cycle at the default's cycle time (or ``settings.cycle_time``); verified.
+
+    Never refused at the taught cycle time: each unit's taught motion is a candidate, so
+    in the worst case the taught cycle itself is returned, 0 % saved.
+    """
     t_start = time.perf_counter()
-    opt = CycleOptimizer(spec, settings, progress=progress)
+    deadline = None if settings.max_time_s is None else t_start + settings.max_time_s
+    opt = CycleOptimizer(spec, settings, progress=progress, deadline=deadline)
     plan = opt.plan
     target = plan.cycle_time if settings.cycle_time is None else settings.cycle_time
-    if not opt.optimizable:
-        raise InvalidInput(f"{spec.source}: the cycle has no MoveJ or MoveAbsJ that can be optimized")
-    shortest = opt.shortest_cycle + (0.0 if settings.use_waits else opt.wait_total)
+    shortest = opt.shortest_cycle + opt.waits_kept(settings.use_waits)
     if target < shortest - 1e-9:
         raise LimitViolation(
             f"{spec.source}: cycle time {target:.3f} s is shorter than the shortest this program "
             "reaches with its optimized moves at their shortest "
             f"({shortest:.3f} s; the default runs {plan.cycle_time:.3f} s); "
             f"give --cycle-time {np.ceil(shortest * 1000) / 1000:.3f} or more"
-            + ("" if settings.use_waits else ", or allow --use-waits")
+            + ("" if settings.use_waits or not opt.idle_total else ", or allow --use-waits")
         )
     default = opt.default_energies()
-    kept = opt.kept_energies()
     e0 = sum(v[1] for v in default.values())
-    e0_lab = sum(v[2] for v in default.values())
     b_plain = opt.budget(target, use_waits=False)
     b_waits = opt.budget(target, use_waits=True)
-    b_max = b_waits if settings.use_waits else b_plain
-    lo_sum = sum(opt.t_lo.values())
-    table = opt.table(max(b_max - lo_sum, 0.0))
+    table = opt.table(b_waits if settings.use_waits else b_plain)
     opt.progress("sharing the cycle time")
-    shape: Allocation | None = None
-    if b_plain >= lo_sum - 1e-9:
-        shape = opt.evaluate(opt.proportional(b_plain), kept, opt.wait_total)
-        plain = opt.best(table, b_plain, kept, opt.wait_total)
-    final = plain if not settings.use_waits else opt.best(table, b_waits, kept, 0.0)
-    if settings.use_waits and shape is None:
-        shape = opt.evaluate(opt.proportional(b_waits), kept, 0.0)
+    shape = opt.evaluate(opt.at_taught_durations(table), opt.wait_total)
+    floor_plain = sum(min(opt.t_lo[i], opt.span[i]) for i in opt.optimizable)
+    plain = opt.best(table, b_plain, opt.wait_total) if b_plain >= floor_plain - 1e-9 else None
+    final = plain if not settings.use_waits else opt.best(table, b_waits, opt.waits_kept(True))
+    assert final is not None
+    if plain is None:
         plain = final
-    assert shape is not None
     breakdown = Breakdown(
         default_J=e0,
-        shape_J=shape.energy_J,
+        shape_J=shape.energy_J if shape.cycle_time_s <= target + 1e-9 else plain.energy_J,
         allocation_J=plain.energy_J,
         waits_J=final.energy_J if settings.use_waits else None,
     )
+    result = _assemble(opt, final, table, breakdown, target=target, shortest=shortest, t_start=t_start)
+    inner = [i for i, e in final.choice.items() if i in opt.within and not e.taught]
+    if inner:  # what RAPID via points follow: the units inside MoveL segments as taught
+        simple = opt.evaluate(
+            {i: (opt.taught(i) if i in inner else e) for i, e in final.choice.items()},
+            final.cycle_time_s - opt.fixed_time - sum(e.duration for e in final.choice.values()),
+        )
+        result = replace(
+            result,
+            rapid_plan=_assemble(
+                opt, simple, table, breakdown, target=target, shortest=shortest, t_start=t_start
+            ),
+        )
+    return result, opt
+
+
+def _assemble(
+    opt: CycleOptimizer,
+    final: Allocation,
+    table: dict[int, list[Solved]],
+    breakdown: Breakdown,
+    *,
+    target: float,
+    shortest: float,
+    t_start: float,
+) -> CycleResult:
+    """The verified result of one allocation: per-move outcomes, pieces, via points, the motion."""
+    spec, settings, plan = opt.spec, opt.settings, opt.plan
+    default = opt.default_energies()
+    e0 = breakdown.default_J
+    e0_lab = sum(v[2] for v in default.values())
     outcomes: list[MoveOutcome] = []
     paths: dict[int, Solved] = {}
     ok = True
     pieces: dict[int, Solved] = {}
     notes: dict[int, str] = {}
-    for i, T in final.durations.items():
-        whole = opt.solve(i, T)
+    taught_units = [i for i, s in final.choice.items() if s.taught]
+    for i, whole in final.choice.items():
+        members = opt.chains[i]
+        if whole.taught:
+            for j in opt.segment_of[i].moves:
+                notes[j] = (
+                    "kept as taught: no reshaped motion of this segment saves energy in the time it is given"
+                    if len(table[i]) > 1
+                    else "kept as taught: the optimizer's shortest motion of this segment is longer than "
+                    "the taught one" + (" (or --max-time was reached first)" if opt.timed_out else "")
+                )
+            continue
         ok = ok and whole.usable
         pieces.update(opt.split(i, whole))
-        members = opt.chains[i]
         for j in members:
+            zones = any(opt.zone_mm(k) > 0 for k in members[:-1])
             notes[j] = (
                 "reshaped and re-timed"
                 if len(members) == 1
                 else "reshaped and re-timed in one fly-by chain with lines "
                 + ", ".join(str(opt.by_index[k].step.line) for k in members)
-                + " (passes the zone targets exactly, without stopping)"
+                + (
+                    " (passes each fly-by target within its zone, without stopping)"
+                    if zones
+                    else " (passes the zone targets exactly, without stopping)"
+                )
             )
     vias: dict[int, tuple[int, ...]] = {}
-    for i in final.durations:
+    for i, whole in final.choice.items():
+        if whole.taught:
+            continue
         members = opt.chains[i]
         step = spec.steps[i]
         assert step.robot is not None and step.tcp is not None
@@ -842,43 +1204,49 @@ def optimize_cycle(
                     s.clearance_mm,
                 )
             )
-        else:
+            continue
+        if m.index in notes:
+            note = notes[m.index]
+        elif m.profile.duration == 0:
+            note = "no motion"
+        elif opt.default_clearance.get(m.index, np.inf) < 0.0:
+            note = "the default move comes closer to the cell than the margin: reported, not optimized"
+        elif m.step.repeated:
+            note = "occurs more than once in the cycle: kept as taught"
+        elif any(opt.by_index[j].step.linear for j in _segment_with(opt, m.index).moves):
             note = (
-                "MoveL: kept unchanged (straight line, controller timing)"
+                "MoveL: kept as taught (straight line, controller timing)"
                 if m.step.linear
-                else "occurs more than once in the cycle: kept unchanged"
-                if m.step.repeated
-                else "no motion"
+                else "kept as taught: blended with a MoveL (the segment runs as the controller runs it)"
             )
-            if opt.default_clearance.get(m.index, np.inf) < 0.0:
-                note = "the default move comes closer to the cell than the margin: reported, not optimized"
-            kept_clear = None
-            if settings.cell is not None and m.profile.duration > 0:
-                kept_clear = opt._clearance_mm(m, standalone(m).q)
-            a, b = kept[m.index]
-            outcomes.append(
-                MoveOutcome(
-                    m.step.line,
-                    m.step.label,
-                    False,
-                    note,
-                    d_T,
-                    m.profile.duration,
-                    d_e,
-                    a,
-                    d_lab,
-                    b,
-                    True,
-                    (),
-                    0,
-                    0.0,
-                    0.0,
-                    0.0,
-                    opt.default_clearance.get(m.index),
-                    kept_clear,
-                )
+        else:
+            note = "kept as taught: part of a fly-by chain (--stop-at-targets)"
+        outcomes.append(
+            MoveOutcome(
+                m.step.line,
+                m.step.label,
+                False,
+                note,
+                d_T,
+                m.profile.duration,
+                d_e,
+                d_e,
+                d_lab,
+                d_lab,
+                True,
+                (),
+                0,
+                0.0,
+                0.0,
+                0.0,
+                opt.default_clearance.get(m.index),
+                opt.default_clearance.get(m.index),
             )
-    waits = tuple((spec.steps[i].line, sec, 0.0 if settings.use_waits else sec) for i, _, sec in plan.waits)
+        )
+    waits = tuple(
+        (spec.steps[i].line, sec, 0.0 if settings.use_waits and spec.steps[i].idle else sec)
+        for i, _, sec in plan.waits
+    )
     result = CycleResult(
         moves=tuple(outcomes),
         default_cycle_s=plan.cycle_time,
@@ -901,10 +1269,25 @@ def optimize_cycle(
         n_solves=opt.n_solves,
         paths=paths,
         spec=spec,
-        chains={i: c for i, c in opt.chains.items() if len(c) > 1 and i in final.durations},
+        chains={i: c for i, c in opt.chains.items() if len(c) > 1 and i in pieces},
         vias=vias,
+        planned=opt.motion(final.choice, settings.use_waits),
+        taught_units=tuple(spec.steps[i].line for i in taught_units),
+        timed_out=opt.timed_out,
+        open_ends=frozenset(
+            opt.chains[i][-1]
+            for i, s in final.choice.items()
+            if not s.taught and i in opt.within and spec.steps[opt.chains[i][-1]].zone_mm is not None
+        ),
+        zone_miss_mm=max(
+            [opt.zone_miss_mm(i, s) for i, s in final.choice.items() if not s.taught], default=0.0
+        ),
     )
-    return result, opt
+    return result
+
+
+def _segment_with(opt: CycleOptimizer, index: int) -> Segment:
+    return next(seg for seg in opt.segments if index in seg.moves)
 
 
 def via_deviation(step: Step, solved: Solved, idx: Sequence[int]) -> tuple[int, float, float]:
@@ -933,17 +1316,17 @@ def pareto(
     least-energy combination of table entries within its budget (dynamic programming),
     so every point is made of verified solves.
     """
-    waits = 0.0 if use_waits else opt.wait_total
+    waits = opt.waits_kept(use_waits)
     c_min = opt.shortest_cycle + waits
-    kept = opt.kept_energies()
-    lo_sum = sum(opt.t_lo.values())
     c_max = c_min * (1 + span)
-    table = opt.table(opt.budget(c_max, use_waits) - lo_sum)
+    table = opt.table(opt.budget(c_max, use_waits))
     out = []
     for c in np.linspace(c_min, c_max, points):
         d = opt.dp(table, opt.budget(float(c), use_waits) + 1e-9)
         if d is None:
             continue
-        a = opt.evaluate(d, kept, waits)
-        out.append(ParetoPoint(float(c), a.energy_J, a.energy_lab_J, tuple(d[i] for i in opt.optimizable)))
+        a = opt.evaluate(d, waits)
+        out.append(
+            ParetoPoint(float(c), a.energy_J, a.energy_lab_J, tuple(d[i].duration for i in opt.optimizable))
+        )
     return out
