@@ -53,10 +53,11 @@ def cycle(
         "controller does.",
     ),
     export: str = typer.Option(
-        "rapid",
+        "auto",
         "--export",
-        help="rapid: optimized.mod (where the controller emulation runs it as the checks ask); egm: also "
-        "egm.mod and EGM_SETUP.md, to stream cycle_path.csv with `joulepath stream OUT --repeat K`.",
+        help="rapid: optimized.mod, written where the controller emulation runs it as the checks ask; "
+        "egm: egm.mod and EGM_SETUP.md, to stream cycle_path.csv with `joulepath stream OUT --repeat K` "
+        "(and optimized.mod where it passes); auto (default): rapid, else egm.",
     ),
     max_time: float = typer.Option(
         None,
@@ -126,8 +127,8 @@ def cycle(
     from joulepath.program import pareto as run_pareto
 
     target = _cycle_time(cycle_time)
-    if export not in ("rapid", "egm"):
-        raise typer.BadParameter(f"{export!r}: give rapid or egm", param_hint="--export")
+    if export not in ("auto", "rapid", "egm"):
+        raise typer.BadParameter(f"{export!r}: give auto, rapid or egm", param_hint="--export")
     check_out_folder(out, files=CYCLE_FILES, inputs=[program, *([cell] if cell else [])])
     if not program.is_file():
         raise typer.BadParameter(f"{program}: no such file", param_hint="PROGRAM")
@@ -169,12 +170,10 @@ def cycle(
         write_rapid=rapid,
         cell=cell_data,
         write_anyway=write_anyway,
-        egm=export == "egm",
+        egm="always" if export == "egm" else "fallback" if export == "auto" else "never",
     )
     saved = json.loads(files["cycle.json"].read_text())
-    if not result.limits_ok or (
-        rapid and "optimized.mod" not in files and saved["written_program_check"] is None
-    ):
+    if not result.limits_ok:
         console.print(
             "REFUSED: the optimized cycle breaks a limit or the cell's margin; no program was written "
             f"and no saving is claimed (default {result.default_energy_J:.2f} J; see cycle.json)"
@@ -182,16 +181,33 @@ def cycle(
         console.print(f"wrote {', '.join(sorted(files))} in {out}")
         return 1
     b = result.breakdown
+    check = saved.get("written_program_check")
+    if "optimized.mod" in files and saved.get("executed_saved_pct") is not None:
+        console.print(
+            f"optimized.mod, as the controller emulation runs it: cycle {saved['executed_cycle_s']:.3f} s "
+            f"(taught {result.default_cycle_s:.3f} s), {saved['executed_energy_J']:.2f} J per cycle on "
+            f"physics against the taught {result.default_energy_J:.2f} J: "
+            f"{saved['executed_saved_pct']:.1f} % saved ({saved['executed_saved_lab_pct']:.1f} % on the lab "
+            f"robot); its via points follow {saved['rapid_follows']}"
+        )
+    if "egm.mod" in files:
+        console.print(
+            f"egm.mod streams the plan (cycle_path.csv: {result.optimized_cycle_s:.3f} s, "
+            f"{result.optimized_energy_J:.2f} J on physics, {result.saved_pct:.1f} % saved, "
+            f"{result.saved_lab_pct:.1f} % on the lab robot): `joulepath stream {out} --repeat K`"
+        )
     console.print(
-        f"cycle {result.default_cycle_s:.3f} s -> {result.optimized_cycle_s:.3f} s; energy on physics "
-        f"{result.default_energy_J:.2f} -> {result.optimized_energy_J:.2f} J "
-        f"({result.saved_pct:.1f} % saved), "
-        f"on the lab robot {result.saved_lab_pct:.1f} % saved"
+        f"the plan: cycle {result.default_cycle_s:.3f} s -> {result.optimized_cycle_s:.3f} s; energy on "
+        f"physics {result.default_energy_J:.2f} -> {result.optimized_energy_J:.2f} J "
+        f"({result.saved_pct:.1f} % saved), on the lab robot {result.saved_lab_pct:.1f} % saved"
+        + (" (every unit kept as taught)" if len(result.taught_units) == len(opt.optimizable) else "")
     )
-    waits = "" if b.by_waits_pct is None else f", waits {b.by_waits_pct:.1f} %"
+    waits = "" if b.by_waits_pct is None else f", idle waits {b.by_waits_pct:.1f} %"
     console.print(
         f"breakdown: shape {b.by_shape_pct:.1f} %, time allocation {b.by_allocation_pct:.1f} %{waits}"
     )
+    if result.timed_out:
+        console.print("--max-time reached: the best verified result of the moves solved by then")
     if cell_data is not None:
         near = [m for m in result.moves if m.default_clearance_mm is not None and m.default_clearance_mm < 0]
         for m in near:
@@ -202,26 +218,13 @@ def cycle(
         console.print(
             f"kept verbatim, run time treated as fixed: line(s) {', '.join(map(str, result.fixed_lines))}"
         )
-    check = saved.get("written_program_check")
     if rapid and "optimized.mod" not in files:
         console.print(f"NOT WRITTEN: optimized.mod: {saved['rapid_refused']}")
-        console.print(f"wrote {', '.join(sorted(files))} in {out}")
-        return 1
-    if check is not None and not check["within_tolerances"]:
+    elif check is not None and not check["within_tolerances"]:
         console.print(
-            f"WARNING: the written program, run by the controller emulation, does not reproduce the plan: "
-            f"cycle {check['emulated_cycle_s']:.3f} s (planned {check['planned_cycle_s']:.3f} s, "
-            f"{check['cycle_diff_pct']:+.1f} %), energy {check['emulated_energy_J']:.2f} J (planned "
-            f"{check['planned_energy_J']:.2f} J, {check['energy_diff_pct']:+.1f} %), TCP path within "
-            f"{check['tcp_path_deviation_mm']:.1f} mm; the savings above are those of the planned motion "
-            "(cycle.json: written_program_check)"
-        )
-    if saved.get("executed_saved_pct") is not None:
-        console.print(
-            f"optimized.mod as the controller emulation runs it: cycle {saved['executed_cycle_s']:.3f} s, "
-            f"{saved['executed_energy_J']:.2f} J per cycle on physics "
-            f"({saved['executed_saved_pct']:.1f} % saved against the taught program), "
-            f"{saved['executed_saved_lab_pct']:.1f} % on the lab robot"
+            "WARNING (--write-anyway): optimized.mod, run by the controller emulation, does not keep the "
+            f"plan: cycle {check['emulated_cycle_s']:.3f} s, energy {check['emulated_energy_J']:.2f} J, TCP "
+            f"path within {check['tcp_path_deviation_mm']:.1f} mm (cycle.json: written_program_check)"
         )
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
-    return 0
+    return 0 if ("optimized.mod" in files or "egm.mod" in files) else 1

@@ -331,7 +331,7 @@ class CycleOptimizer:
         self.timed_out = False
         self.plan: PlannedCycle = plan_cycle(spec, settings.controller)
         self._plants: dict[int, Plant] = {}
-        self._default_motion: Trajectory | None = None
+        self._default_motion: CycleMotion | None = None
         self._default_energies: dict[int, tuple[float, float, float]] | None = None
         self.cache: dict[tuple[int, int], Solved] = {}
         self.n_solves = 0
@@ -751,37 +751,19 @@ class CycleOptimizer:
         )
 
     # ------------------------------------------------------------ default
-    def default_motion(self) -> Trajectory:
-        """The default cycle on its 2.5 ms grid (cached)."""
+    def default_motion(self) -> CycleMotion:
+        """The default cycle as :meth:`motion` samples it (cached)."""
         if self._default_motion is None:
-            plan = self.plan
-            n = int(np.ceil(plan.cycle_time / FINE_DT)) + 1
-            self._default_motion = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
+            self._default_motion = self.motion({}, False)
         return self._default_motion
 
     def default_energies(self) -> dict[int, tuple[float, float, float]]:
-        """Per move (step index): (slot duration s, physics J, lab J) of the default cycle; a move's
-        slot runs from its start to the next move's start, so the slots add up to the cycle."""
-        if self._default_energies is not None:
-            return dict(self._default_energies)
-        plan = self.plan
-        traj = self.default_motion()
-        t = traj.t
-        starts = [m.t0 for m in plan.moves] + [plan.cycle_time]
-        out: dict[int, tuple[float, float, float]] = {}
-        for k, m in enumerate(plan.moves):
-            a = int(np.searchsorted(t, starts[k], side="left"))
-            b = int(np.searchsorted(t, starts[k + 1], side="left"))
-            if b - a < 2:
-                out[m.index] = (m.profile.duration, 0.0, 0.0)
-                continue
-            sl = slice(a, b)
-            part = Trajectory(t=t[sl], q=traj.q[sl], qd=traj.qd[sl], qdd=traj.qdd[sl])
-            robot = self._robot(m)
-            e, e_lab = _energy(robot, self.plant(robot), part)
-            out[m.index] = (m.profile.duration, e, e_lab)
-        self._default_energies = out
-        return dict(out)
+        """Per move (step index): (its duration s, physics J, lab J over its slot) of the default cycle;
+        a move's slot runs from its start to the next move's start, so the slots add up to the cycle."""
+        if self._default_energies is None:
+            e = self.move_energies(self.default_motion())
+            self._default_energies = {m.index: (m.profile.duration, *e[m.index]) for m in self.plan.moves}
+        return dict(self._default_energies)
 
     def kept_energies(self) -> dict[int, tuple[float, float]]:
         """Moves outside the units, run as taught within the default cycle: physics and lab J."""
@@ -948,10 +930,12 @@ class CycleOptimizer:
         )
         T = np.clip(np.asarray(res.x, dtype=float), lo, hi)
         units = np.maximum(np.floor(T / STEP + 1e-9), np.ceil(lo / STEP - 1e-9)).astype(int)
+        fixed = np.array([i in self.within for i in idx])
+        units[fixed] = np.round(lo[fixed] / STEP).astype(int)  # their duration stays
         spare = int(np.floor(budget / STEP + 1e-9)) - int(units.sum())
-        while spare > 0:  # hand the remaining 25 ms steps to the steepest curves
+        while spare > 0 and not fixed.all():  # hand the remaining 25 ms steps to the steepest curves
             _, g = f(units * STEP)
-            k = int(np.argmin(g))
+            k = int(np.argmin(np.where(fixed, np.inf, g)))
             units[k] += 1
             spare -= 1
         if units.sum() * STEP > budget + 1e-9:
@@ -1006,9 +990,11 @@ class CycleOptimizer:
         return min(candidates, key=lambda a: a.energy_J)
 
     # ------------------------------------------------------------ the whole cycle
-    def motion(self, choice: dict[int, Solved], use_waits: bool) -> Trajectory:
-        """The optimized cycle on a 2.5 ms grid: the default cycle with each unit's chosen entry in
-        place of its segment and, with ``use_waits``, the idle waits left out."""
+    def motion(self, choice: dict[int, Solved], use_waits: bool) -> CycleMotion:
+        """The cycle with each unit's chosen entry in place of its window and, with ``use_waits``,
+        the idle waits left out: every piece sampled every 2.5 ms from its own start (the taught
+        pieces from the controller emulation, the units' from their solves), and the cycle's last
+        sample at its end; where each move starts in it."""
         plan = self.plan
         cut: list[tuple[float, float, Solved | None]] = [
             (self.segment_of[i].t0, self.segment_of[i].t1, s) for i, s in choice.items() if not s.taught
@@ -1025,31 +1011,78 @@ class CycleOptimizer:
             c = b
         if c < plan.cycle_time - 1e-12:
             pieces.append((c, plan.cycle_time, None, True))
-        lengths = [(b - a) if keep else (0.0 if s is None else s.duration) for a, b, s, keep in pieces]
-        total = float(sum(lengths))
-        n = max(2, int(np.ceil(total / FINE_DT - 1e-9)) + 1)
-        t = np.linspace(0.0, total, n)
-        n_j = plan.start.size
-        q, qd, qdd = np.zeros((n, n_j)), np.zeros((n, n_j)), np.zeros((n, n_j))
+        ts, qs, qds, qdds = [], [], [], []
+        starts: dict[int, float] = {}
         off = 0.0
-        done = np.zeros(n, dtype=bool)
-        for (a, _, s, keep), length in zip(pieces, lengths, strict=True):
-            sel = (t >= off - 1e-12) & (t <= off + length + 1e-12) & ~done
-            if sel.any():
-                local = t[sel] - off
-                if keep:
-                    part = evaluate_cycle(plan, a + local)
-                    q[sel], qd[sel], qdd[sel] = part.q, part.qd, part.qdd
-                elif s is not None:
-                    f = s.fine
-                    for arr, src in ((q, f.q), (qd, f.qd), (qdd, f.qdd)):
-                        arr[sel] = np.column_stack([np.interp(local, f.t, src[:, j]) for j in range(n_j)])
-                else:  # a wait left out: at rest where the robot stood
-                    part = evaluate_cycle(plan, np.full(local.size, a))
-                    q[sel], qd[sel], qdd[sel] = part.q, 0.0, 0.0
-                done |= sel
-            off += length
-        return Trajectory(t=t, q=q, qd=qd, qdd=qdd)
+        by_first = {self.segment_of[i].t0: i for i, s in choice.items() if not s.taught}
+        for a, b, s, keep in pieces:
+            if keep:
+                local = np.arange(0.0, b - a - 1e-9, FINE_DT)
+                part = evaluate_cycle(plan, a + local)
+                ts.append(off + local)
+                qs.append(part.q)
+                qds.append(part.qd)
+                qdds.append(part.qdd)
+                for m in plan.moves:
+                    if a - 1e-12 <= m.t0 < b - 1e-12 or (m.t0 >= b - 1e-12 and b >= plan.cycle_time - 1e-12):
+                        starts.setdefault(m.index, off + min(m.t0, b) - a)
+                off += b - a
+                continue
+            if s is None:  # a wait left out
+                continue
+            i = by_first[a]
+            f = s.fine
+            k = f.t.size - 1
+            ts.append(off + f.t[:k])
+            qs.append(f.q[:k])
+            qds.append(f.qd[:k])
+            qdds.append(f.qdd[:k])
+            cuts = [0.0, *(t for t, _ in self.waypoints(i, s.duration))]
+            for j, tc in zip(self.chains[i], cuts, strict=True):
+                starts.setdefault(j, off + tc)
+            for j in self.segment_of[i].moves:  # moves without motion inside the window
+                starts.setdefault(j, off)
+            off += s.duration
+        end = evaluate_cycle(plan, np.array([plan.cycle_time]))
+        ts.append(np.array([off]))
+        qs.append(end.q)
+        qds.append(np.zeros_like(end.q))
+        qdds.append(np.zeros_like(end.q))
+        traj = Trajectory(t=np.concatenate(ts), q=np.vstack(qs), qd=np.vstack(qds), qdd=np.vstack(qdds))
+        order = [m.index for m in plan.moves]
+        mono = np.maximum.accumulate([starts.get(j, 0.0) for j in order]) if order else np.zeros(0)
+        return CycleMotion(traj, {j: float(v) for j, v in zip(order, mono, strict=True)}, off)
+
+    def move_energies(self, motion: CycleMotion) -> dict[int, tuple[float, float]]:
+        """Physics and lab J per move over its slot of ``motion`` (its start to the next move's
+        start, the last to the cycle's end): ``Σ_k |tau_k · qd_k| (t_{k+1} - t_k)``."""
+        traj = motion.trajectory
+        robot = self.spec.robot
+        moves = self.plan.moves
+        if moves and moves[0].step.robot is not None:
+            robot = moves[0].step.robot
+        plant = self.plant(robot)
+        tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
+        lab = plant.drive_torque(traj.q, traj.qd, traj.qdd)
+        w = np.append(np.diff(traj.t), 0.0)
+        p = np.abs(tau * traj.qd).sum(axis=1) * w
+        p_lab = np.abs(lab * traj.qd).sum(axis=1) * w
+        bounds = [motion.starts[m.index] for m in moves] + [motion.cycle_time + 1.0]
+        out: dict[int, tuple[float, float]] = {}
+        for k, m in enumerate(moves):
+            sel = (traj.t >= bounds[k] - 1e-12) & (traj.t < bounds[k + 1] - 1e-12)
+            out[m.index] = (float(p[sel].sum()), float(p_lab[sel].sum()))
+        return out
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CycleMotion:
+    """A cycle's motion (``t`` from 0, strictly increasing, pieces 2.5 ms apart inside), where each
+    move starts in it (s, by step index) and its cycle time (s)."""
+
+    trajectory: Trajectory
+    starts: dict[int, float]
+    cycle_time: float
 
 
 def optimize_cycle(
@@ -1127,6 +1160,8 @@ def _assemble(
     default = opt.default_energies()
     e0 = breakdown.default_J
     e0_lab = sum(v[2] for v in default.values())
+    motion = opt.motion(final.choice, settings.use_waits)
+    spent = opt.move_energies(motion)  # the reported energies: per move, on the cycle's motion
     outcomes: list[MoveOutcome] = []
     paths: dict[int, Solved] = {}
     ok = True
@@ -1191,9 +1226,9 @@ def _assemble(
                     d_T,
                     s.duration,
                     d_e,
-                    s.energy_J,
+                    spent[m.index][0],
                     d_lab,
-                    s.energy_lab_J,
+                    spent[m.index][1],
                     s.limits_ok,
                     s.limit_excess,
                     n_via,
@@ -1230,9 +1265,9 @@ def _assemble(
                 d_T,
                 m.profile.duration,
                 d_e,
-                d_e,
+                spent[m.index][0],
                 d_lab,
-                d_lab,
+                spent[m.index][1],
                 True,
                 (),
                 0,
@@ -1251,11 +1286,11 @@ def _assemble(
         moves=tuple(outcomes),
         default_cycle_s=plan.cycle_time,
         target_cycle_s=target,
-        optimized_cycle_s=final.cycle_time_s,
+        optimized_cycle_s=motion.cycle_time,
         default_energy_J=e0,
-        optimized_energy_J=final.energy_J,
+        optimized_energy_J=float(sum(v[0] for v in spent.values())),
         default_lab_J=e0_lab,
-        optimized_lab_J=final.energy_lab_J,
+        optimized_lab_J=float(sum(v[1] for v in spent.values())),
         breakdown=breakdown,
         waits=waits,
         fixed_lines=spec.fixed_lines,
@@ -1271,7 +1306,7 @@ def _assemble(
         spec=spec,
         chains={i: c for i, c in opt.chains.items() if len(c) > 1 and i in pieces},
         vias=vias,
-        planned=opt.motion(final.choice, settings.use_waits),
+        planned=motion.trajectory,
         taught_units=tuple(spec.steps[i].line for i in taught_units),
         timed_out=opt.timed_out,
         open_ends=frozenset(

@@ -432,13 +432,16 @@ def write_cycle_run(
     write_rapid: bool,
     cell: Cell | None = None,
     write_anyway: bool = False,
-    egm: bool = False,
+    egm: str = "never",
 ) -> dict[str, Path]:
     """Write the run folder; the module only when every limit holds, the controller emulation
     runs it as the checks ask (:data:`CHECK_TOLERANCES`; ``write_anyway``: written all the same,
     with a warning in its header) and, with a cell, its emulated motion keeps the margin
-    (else cycle.json says why). Always ``cycle_path.csv`` (the planned cycle); with ``egm``
-    also ``egm.mod`` and ``EGM_SETUP.md`` to stream it (``joulepath stream``)."""
+    (else cycle.json says why). Always ``cycle_path.csv`` (the planned cycle); ``egm``
+    "always", or "fallback" when no module is written: also ``egm.mod`` and ``EGM_SETUP.md``
+    to stream it (``joulepath stream``); "never": not."""
+    if egm not in ("always", "fallback", "never"):
+        raise ValueError(f"egm must be always, fallback or never, got {egm!r}")
     files: dict[str, Path] = {}
     text = refused = check = None
     follows = None
@@ -460,7 +463,12 @@ def write_cycle_run(
         stale.unlink()
     files["optimized_cycle.csv"] = atomic_write_text(out / "optimized_cycle.csv", optimized_cycle_csv(result))
     files["cycle_path.csv"] = atomic_write_text(out / "cycle_path.csv", cycle_path_csv(result))
-    egm_files = egm_cycle_files(result) if egm else {}
+    stream = egm == "always" or (egm == "fallback" and text is None)
+    egm_files = egm_cycle_files(result) if stream else {}
+    for name in ("egm.mod", "EGM_SETUP.md"):
+        old = out / name
+        if name not in egm_files and old.is_file() and not old.is_symlink():
+            old.unlink()
     for name, body in egm_files.items():
         files[name] = atomic_write_text(out / name, body)
     if pareto is not None:

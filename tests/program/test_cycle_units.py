@@ -1,0 +1,224 @@
+"""Whole cycles as the controller runs them: units cut at rest, the taught motion as a candidate,
+zones as zones, joint runs inside MoveL segments, idle waits, --max-time, the streamed cycle."""
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import joulepath
+from joulepath.optimize import GradientSettings
+from joulepath.program import CycleSettings, optimize_cycle, parse_module, read_cycle_program, resolve_module
+from joulepath.program._cycle import CycleOptimizer, segments
+from joulepath.program._output import cycle_path_csv, write_cycle_run
+from joulepath.sim._timing import _tcp
+
+FAST = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), max_iter=60, coarse_factor=1)
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "pick_and_place.mod"
+
+BLENDED = """MODULE Blended
+    CONST jointtarget jHome := [[0, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pA := [[400, -150, 250], [0, 0, 1, 0], [-1, 0, -1, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pAUp := [[400, -150, 350], [0, 0, 1, 0], [-1, 0, -1, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pB := [[350, 200, 250], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pBUp := [[350, 200, 350], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    PROC main()
+        MoveAbsJ jHome, v1000, fine, tool0;
+        MoveJ pAUp, v1000, z50, tool0;
+        MoveL pA, v300, fine, tool0;
+        WaitTime 0.3;
+        MoveL pAUp, v300, z20, tool0;
+        MoveJ pBUp, v1000, z20, tool0;
+        MoveL pB, v300, fine, tool0;
+        WaitTime 1.0;
+        MoveL pBUp, v300, z20, tool0;
+        MoveAbsJ jHome, v1000, fine, tool0;
+    ENDPROC
+ENDMODULE
+"""
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return joulepath.load_robot("irb120")
+
+
+@pytest.fixture(scope="module")
+def blended(robot):
+    return resolve_module(parse_module(BLENDED, path="blended.mod"), robot)
+
+
+@pytest.fixture(scope="module")
+def solved(blended):
+    return optimize_cycle(blended, CycleSettings(gradient=FAST, table_points=2))
+
+
+def test_segments_partition_the_default_cycle(blended):
+    """Segments follow one another in time, each ends where the robot stands still, and the spans,
+    dwells and waits add up to the cycle time."""
+    opt = CycleOptimizer(blended, CycleSettings(gradient=FAST))
+    segs = segments(opt.plan)
+    assert [j for s in segs for j in s.moves] == [m.index for m in opt.plan.moves]
+    for a, b in zip(segs, segs[1:], strict=False):
+        assert b.t0 >= a.t1 - 1e-12
+    motion = opt.default_motion().trajectory
+    for s in segs:  # at rest at the end of every segment
+        k = int(np.argmin(np.abs(motion.t - s.t1)))
+        assert np.abs(motion.qd[k]).max() < 0.05
+    assert opt.fixed_time + sum(opt.span.values()) + opt.wait_total == pytest.approx(opt.plan.cycle_time)
+
+
+def test_units_inside_moveL_segments_keep_the_taught_ends(blended, solved):
+    """The MoveJ between two blended MoveL is a unit over the time only it moves the robot; its
+    optimized motion starts and ends in the taught motion's states, so the cycle stays continuous."""
+    result, opt = solved
+    inner = [i for i in opt.within]
+    assert inner, "the MoveJ between the MoveL moves is a unit"
+    for i in inner:
+        base = opt.base(i)
+        for (unit, _), s in opt.cache.items():
+            if unit != i or s.taught or int(round(s.duration / 0.025)) != int(round(opt.span[i] / 0.025)):
+                continue
+            if s.fine.t.size != base.t.size:
+                continue
+            for a, b in ((s.fine.q, base.q), (s.fine.qd, base.qd), (s.fine.qdd, base.qdd)):
+                np.testing.assert_allclose(a[[0, -1]], b[[0, -1]], atol=1e-9)
+    traj = result.planned
+    step = np.abs(np.diff(traj.q, axis=0)).max(axis=0)
+    dt = np.diff(traj.t).max()
+    robot = blended.robot
+    assert np.all(step <= robot.velocity_limit * dt * 1.01)  # no jump anywhere in the cycle
+
+
+def test_same_cycle_time_is_never_refused_nor_slower(blended, solved):
+    result, _ = solved
+    assert result.target_cycle_s == result.default_cycle_s
+    assert result.optimized_cycle_s <= result.default_cycle_s + 1e-9
+    assert result.optimized_energy_J <= result.default_energy_J * (1 + 1e-9)
+    assert result.limits_ok
+
+
+def test_reported_energies_are_the_planned_motion_s(blended, solved):
+    """One definition: the cycle's energy is that of its planned motion, and the moves' add up to it."""
+    result, opt = solved
+    assert sum(m.optimized_energy_J for m in result.moves) == pytest.approx(result.optimized_energy_J)
+    assert sum(m.default_energy_J for m in result.moves) == pytest.approx(result.default_energy_J)
+    assert result.planned.t[-1] == pytest.approx(result.optimized_cycle_s)
+    # the allocation's sum of entries agrees with the motion's energy
+    alloc = opt.evaluate(opt.at_taught_durations(opt.table(opt.budget(result.target_cycle_s, False))), 0.0)
+    assert alloc.energy_J > 0
+    default = opt.evaluate({i: opt.taught(i) for i in opt.optimizable}, opt.wait_total)
+    assert default.energy_J == pytest.approx(result.default_energy_J, rel=1e-9)
+
+
+def test_max_time_returns_the_taught_cycle_when_nothing_was_solved(blended):
+    """A wall-time bound spent before the first solve: the taught cycle, 0 % saved, stated."""
+    result, opt = optimize_cycle(blended, CycleSettings(gradient=FAST, max_time_s=1e-9))
+    assert result.timed_out
+    assert opt.n_solves == 0
+    assert result.saved_pct == pytest.approx(0.0, abs=1e-9)
+    assert result.optimized_cycle_s == pytest.approx(result.default_cycle_s)
+    assert len(result.taught_units) == len(opt.optimizable)
+    assert not result.paths
+
+
+def test_waits_are_process_time_unless_declared_idle(blended):
+    """--use-waits spends only the waits declared idle; the others keep their length."""
+    settings = CycleSettings(gradient=FAST, table_points=2, use_waits=True)
+    plain, _ = optimize_cycle(blended, settings)
+    assert [w[1] for w in plain.waits] == [w[2] for w in plain.waits]  # nothing is idle
+    steps = tuple(
+        replace(s, idle=True) if s.kind == "wait" and s.seconds == 1.0 else s for s in blended.steps
+    )
+    idle_spec = replace(blended, steps=steps)
+    idle, opt = optimize_cycle(idle_spec, settings)
+    kept = {line: after for line, _, after in idle.waits}
+    assert sorted(kept.values()) == [0.0, 0.3]
+    assert idle.optimized_cycle_s <= idle.target_cycle_s + 1e-9
+    assert idle.optimized_energy_J <= plain.optimized_energy_J * (1 + 1e-4)  # the same moves, resampled
+
+
+def test_zones_let_a_chain_pass_near_its_targets(robot):
+    """Three MoveAbsJ in zones: with zones the chain passes every target within its zone (TCP), at
+    no more energy than through them exactly (the same start, more freedom)."""
+    text = """MODULE Z
+    CONST jointtarget j1 := [[-40, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST jointtarget j2 := [[0, 30, -10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST jointtarget j3 := [[40, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    PROC main()
+        MoveAbsJ j1, v1000, fine, tool0;
+        MoveAbsJ j2, v1000, z50, tool0;
+        MoveAbsJ j3, v1000, fine, tool0;
+    ENDPROC
+ENDMODULE
+"""
+    spec = resolve_module(parse_module(text, path="z.mod"), robot)
+    base = CycleSettings(gradient=FAST, table_points=2, cycle_time=3.0)
+    exact, _ = optimize_cycle(spec, replace(base, zones=False))
+    zoned, opt = optimize_cycle(spec, base)
+    chain = next(i for i, c in opt.chains.items() if len(c) == 2)
+    j = opt.chains[chain][0]
+    assert 0 < opt.zone_mm(j) <= 50.0
+    assert zoned.zone_miss_mm <= 1e-3
+    assert zoned.optimized_energy_J <= exact.optimized_energy_J * 1.01
+    # the radius is a joint box that keeps the TCP within the zone to first order
+    (r,) = opt.zone_radius(chain)
+    step = spec.steps[j]
+    rng = np.random.default_rng(0)
+    corners = step.q + r[0] * rng.choice([-1.0, 1.0], size=(64, step.q.size))
+    p, _ = _tcp(robot, corners, step.tcp)
+    p0, _ = _tcp(robot, step.q[None, :], step.tcp)
+    assert 1000 * np.linalg.norm(p - p0, axis=1).max() <= opt.zone_mm(j)
+
+
+def test_cycle_folder_streams_the_plan(blended, solved, tmp_path):
+    """cycle_path.csv is the planned cycle (t, q, qd, qdd); with egm the folder holds egm.mod."""
+    from joulepath.egm import read_plan
+
+    result, _ = solved
+    files = write_cycle_run(tmp_path, result, pareto=None, write_rapid=True, egm="always")
+    assert {"cycle_path.csv", "egm.mod", "EGM_SETUP.md", "cycle.json"} <= set(files)
+    plan = read_plan(files["cycle_path.csv"])
+    assert plan.duration == pytest.approx(result.optimized_cycle_s, abs=1e-6)
+    np.testing.assert_allclose(plan.q, result.planned.q, atol=1e-8)
+    text = files["egm.mod"].read_text()
+    assert "EGMRunJoint" in text and "DefaultMove" not in text
+    data = json.loads(files["cycle.json"].read_text())
+    assert data["robot"] == "IRB 120"
+    assert cycle_path_csv(result).splitlines()[0].startswith("t,q1,")
+    # without egm and with a module written, no stale egm.mod stays
+    files2 = write_cycle_run(tmp_path, result, pareto=None, write_rapid=True, egm="never")
+    assert "egm.mod" not in files2 and not (tmp_path / "egm.mod").exists()
+
+
+def test_streamed_cycle_executes_its_planned_saving(blended, solved, tmp_path, background):
+    """`joulepath stream` plays the cycle folder to the emulated controller on 127.0.0.1, cycle
+    after cycle: the executed saving is the planned one, the duration the planned cycle time."""
+    pytest.importorskip("abb_robot_client._egm_protobuf.egm_pb2")
+    from joulepath.egm import EmulatorConfig, ServeConfig, StreamSettings, run_emulator, stream_run
+
+    result, _ = solved
+    write_cycle_run(tmp_path, result, pareto=None, write_rapid=False, egm="always")
+    config = ServeConfig(host="127.0.0.1", port=0, timeout_s=3.0, settings=StreamSettings(repeats=2))
+    server = background(lambda listening: stream_run(tmp_path, config, on_listening=listening))
+    address = server.wait_listening()
+    q0 = tuple(np.degrees(result.planned.q[0]))
+    run_emulator(address, EmulatorConfig(q_start_deg=q0, wall_period_s=0.0005))
+    server.join()
+    s = json.loads((tmp_path / "stream.json").read_text())
+    assert s["outcome"] == "done" and s["repetitions_executed"] == 2
+    for rep in s["repetitions"]:
+        assert abs(rep["executed_duration_s"] - result.optimized_cycle_s) <= 0.01
+    assert s["saved_planned_pct"] == pytest.approx(result.saved_pct, abs=1e-6)
+    assert abs(s["saved_executed_pct"] - result.saved_pct) <= 1.0
+
+
+def test_bundled_example_at_its_own_cycle_time(robot):
+    """The bundled example is optimized at its own cycle time, never slower, and saves energy."""
+    spec, _ = read_cycle_program(EXAMPLE, robot)
+    result, opt = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
+    assert result.optimized_cycle_s <= result.default_cycle_s + 1e-9
+    assert result.saved_pct > 0.0
+    assert opt.within  # its MoveJ transfers blended into MoveL approaches are units
