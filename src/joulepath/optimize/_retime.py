@@ -224,7 +224,7 @@ def _check_limits_arg(name: str, value: FloatArray | None, n: int, *, required: 
 
 # --------------------------------------------------------------------------- the sin² start
 def _peak_speed(at: Callable[..., Any]) -> FloatArray:
-    _, q1, _ = at(np.linspace(0.0, 1.0, 65))
+    _, q1, _ = at(np.linspace(0.0, 1.0, 33))  # as the controller (sim._timing.fastest_profile)
     out: FloatArray = np.abs(np.asarray(q1, dtype=float)).max(axis=0)
     return out
 
