@@ -261,3 +261,11 @@ def test_shortest_on_path_without_toppra_names_the_extra(irb120, lines, limits, 
     monkeypatch.setitem(sys.modules, "toppra", None)
     with pytest.raises(ImportError, match=r"joulepath\[motion\]"):
         shortest_on_path(irb120, lines["fast"].path, acceleration_limit=limits[0])
+
+
+def test_retime_on_path_free_end_keeps_the_path_and_its_start_at_rest(irb120, lines, limits):
+    line = lines["fast"]
+    r = retime_on_path(irb120, line.path, 0.8, acceleration_limit=limits[0], end_at_rest=False)
+    assert r.s[-1] == pytest.approx(1.0, abs=1e-12)
+    np.testing.assert_allclose(r.fine.qd[0], 0.0, atol=1e-9)
+    assert r.energy_J <= r.start_energy_J

@@ -448,6 +448,15 @@ def _search(
     shift = np.zeros(n + 1)
     shift[n] = 1.0
     scale = max(problem.energy(x0)[0], 1e-6)
+    last: dict[bytes, tuple[FloatArray, FloatArray]] = {}  # SLSQP asks for g and its Jacobian apart
+
+    def limits_at(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        key = np.asarray(x, dtype=float).tobytes()
+        if key not in last:
+            last.clear()
+            last[key] = problem.constraints(x)
+        return last[key]
+
     result = minimize(
         lambda x: tuple(v / scale for v in problem.energy(x)),
         x0,
@@ -456,11 +465,7 @@ def _search(
         bounds=[(0.0, 1.0)] * n,
         constraints=[
             {"type": "ineq", "fun": lambda x: order @ x + shift, "jac": lambda x: order},
-            {
-                "type": "ineq",
-                "fun": lambda x: problem.constraints(x)[0],
-                "jac": lambda x: problem.constraints(x)[1],
-            },  # noqa: E501
+            {"type": "ineq", "fun": lambda x: limits_at(x)[0], "jac": lambda x: limits_at(x)[1]},
         ],
         options={"maxiter": MAX_ITERATIONS, "ftol": 1e-9},
     )
@@ -544,6 +549,18 @@ def retime_on_path(
     ------
     InvalidInput
         A duration that is not positive, limits of the wrong shape, a path that does not move.
+
+    Examples
+    --------
+    >>> import joulepath
+    >>> from joulepath.sim import acceleration_limit
+    >>> robot = joulepath.load_robot("irb120")
+    >>> dq = np.array([0.6, -0.4, 0.5, 0.0, 0.3, 0.0])
+    >>> def line(s):  # a joint-space line from the home pose
+    ...     return robot.home + s[:, None] * dq, np.tile(dq, (s.size, 1)), np.zeros((s.size, 6))
+    >>> r = retime_on_path(robot, line, 1.0, acceleration_limit=acceleration_limit(robot, 0.25))
+    >>> r.feasible, r.energy_J <= r.start_energy_J, float(r.s[-1])
+    (True, True, 1.0)
     """
     if not (np.isfinite(duration) and duration > 0):
         raise InvalidInput(f"duration must be a positive number of seconds, got {duration}")
