@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import sys
 from dataclasses import dataclass
 
@@ -23,7 +24,9 @@ from joulepath.optimize._verify import energy_on_samples
 from joulepath.sim import ControllerConfig, SpeedData, Step, acceleration_limit, jerk_limit
 from joulepath.sim._timing import PlannedMove, SegmentPath, fastest_profile, segment_path, standalone
 
-pytest.importorskip("toppra")
+needs_toppra = pytest.mark.skipif(
+    importlib.util.find_spec("toppra") is None, reason="toppra (the motion extra) is not installed"
+)
 
 TOOL = np.eye(4)
 TOOL[:3, 3] = (0.0, 0.0, 0.1)  # a 100 mm tool along the flange's z
@@ -155,6 +158,7 @@ def test_retime_on_path_respects_the_tcp_speed(irb120, lines, limits):
     np.testing.assert_allclose(jac_speed[1:-1], 0.5 * (chord[1:] + chord[:-1]), atol=2e-3)
 
 
+@needs_toppra
 def test_shortest_on_path_is_at_most_the_controllers_and_reachable(irb120, lines, limits):
     for line in lines.values():
         controller, _ = _controller(line, None, 0.0)
@@ -166,6 +170,7 @@ def test_shortest_on_path_is_at_most_the_controllers_and_reachable(irb120, lines
         assert r.feasible, r.limit_excess
 
 
+@needs_toppra
 def test_shortest_on_path_accepts_a_plain_callable(irb120, lines, limits):
     line = lines["fast"]
     a = shortest_on_path(irb120, line.path, acceleration_limit=limits[0])
@@ -173,6 +178,7 @@ def test_shortest_on_path_accepts_a_plain_callable(irb120, lines, limits):
     assert a == b
 
 
+@needs_toppra
 def test_retime_on_path_energy_does_not_grow_with_duration(irb120, lines, limits):
     line = lines["fast"]
     kwargs = dict(acceleration_limit=limits[0], tcp_speed_limit=line.v_tcp, tcp=TOOL)
@@ -191,6 +197,7 @@ def test_retime_on_path_is_deterministic_and_takes_a_callable(irb120, lines, lim
     np.testing.assert_array_equal(a.fine.q, b.fine.q)
 
 
+@needs_toppra
 def test_shortest_on_path_with_a_jerk_limit_is_feasible_and_tight(irb120, lines, limits):
     line = lines["slow"]
     kwargs = dict(acceleration_limit=limits[0], jerk_limit=limits[1], tcp_speed_limit=line.v_tcp, tcp=TOOL)
