@@ -13,7 +13,7 @@ $(BIN)/python:
 
 $(STAMP): $(BIN)/python pyproject.toml constraints.txt
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -c constraints.txt -e ".[ml,synth,dask,reference,robots,abb,test]"
+	$(BIN)/python -m pip install -q -c constraints.txt -e ".[ml,synth,dask,reference,robots,abb,motion,test]"
 	touch $(STAMP)
 
 demo: $(STAMP)

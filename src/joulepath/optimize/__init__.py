@@ -23,6 +23,13 @@ from joulepath.optimize._problem import (
     physics_energy,
     register_fitness,
 )
+from joulepath.optimize._retime import (
+    Retimed,
+    controller_profile,
+    retime_on_path,
+    shortest_on_path,
+    tcp_velocity,
+)
 from joulepath.optimize._run import (
     FOLLOW,
     MAX_DURATION,
@@ -71,6 +78,7 @@ __all__ = [
     "PARAMETRIZATIONS",
     "PENALTY",
     "RUN_FILES",
+    "Retimed",
     "SearchOutcome",
     "SplineProblem",
     "TrajectoryProblem",
@@ -79,6 +87,7 @@ __all__ = [
     "bench_optimizers",
     "check_default_feasible",
     "check_limits",
+    "controller_profile",
     "default_configuration",
     "fitness_kind",
     "jerk_limit",
@@ -93,8 +102,11 @@ __all__ = [
     "rapid_execution",
     "register_fitness",
     "resolve_algorithm",
+    "retime_on_path",
     "shortest_feasible_duration",
+    "shortest_on_path",
     "summarize_bench",
+    "tcp_velocity",
     "thesis_configurations",
     "verify_move",
     "write_run",

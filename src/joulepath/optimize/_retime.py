@@ -1,0 +1,722 @@
+"""Energy-optimal re-timing of a move along its fixed joint path (a ``MoveL`` keeps its line).
+
+A move's geometry is a joint path ``q(s)``, ``s`` in [0, 1] (for a ``MoveL``: the TCP on
+the straight line, the orientation by slerp; :class:`joulepath.sim.SegmentPath`). Only
+its timing ``s(t)`` is chosen here; the speeddata's TCP speed is a bound, not a target.
+
+Formulation (:func:`retime_on_path`)
+------------------------------------
+``s(t)`` is a clamped quintic B-spline on ``[0, T]`` (``N_COEFFICIENTS`` free control
+points, uniform knots). Rest to rest fixes the first and last three control points
+(0 and 1), so ``s``, ``ds/dt`` and ``d²s/dt²`` are 0 / 1, 0, 0 at the ends; the free
+ones are kept non-decreasing (linear constraints), which makes ``s`` monotone. The
+duration is exact by construction. Quintic: the joint jerk is continuous, so a jerk
+limit can be kept on the 2.5 ms grid. Chain rule: ``qd = q'(s) ṡ``,
+``qdd = q''(s) ṡ² + q'(s) s̈``.
+
+The path dynamics are tabulated once along ``s`` (``TABLE_POINTS`` points): with
+``q(s)`` fixed, the rigid-body torque is ``tau = m(s) s̈ + c(s) ṡ² + g(s)`` (``m = M q'``,
+``c = M q'' + C(q, q') q'``, ``g`` the gravity), plus friction of ``q'(s) ṡ``. The energy
+``Σ |tau · qd| dt`` on the 2.5 ms grid (a smoothed absolute value) and the limits
+(joint speed, acceleration, jerk as the grid's own difference of accelerations, TCP
+speed) are then cheap functions of ``(s, ṡ, s̈)`` at the grid points, which are linear
+in the control points; their gradients are analytic. SciPy's SLSQP minimizes. The
+start is the controller's own jerk-limited sin² profile (:mod:`joulepath.sim._profile`)
+stretched to ``T``, fitted by the spline.
+
+Whatever the search returns is measured anew: the joints from ``path.at(s)``, the
+energy with :func:`joulepath.optimize._verify.energy_on_samples` on the fine grid and
+the limits with :func:`check_limits` (and the TCP speed from the Jacobian). The result is
+the better of the optimized timing and the sin² start (a feasible one before an
+infeasible one), so it is never worse than the controller's profile at that duration.
+
+Why this and not a convex ``b = ṡ²`` formulation over ``s``: the energy with |·| and
+friction is not convex anyway, and piecewise-linear ``b(s)`` has a piecewise-constant
+``s̈``, whose jumps break any jerk limit on the fine grid; the smooth spline keeps it.
+
+The time-optimal bound (:func:`shortest_on_path`) is TOPP-RA (``toppra``, the
+``motion`` extra), with joint speed and acceleration constraints and the TCP speed as
+a bound on ``ṡ``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+from scipy.interpolate import BSpline, CubicSpline
+from scipy.optimize import minimize
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import NOMINAL_FRICTION, Friction, Robot, friction_derivative
+from joulepath.errors import InvalidInput
+from joulepath.optimize._verify import check_limits, energy_on_samples
+from joulepath.sim._profile import Profile, evaluate_profile, plan_profile
+from joulepath.trajectory import Trajectory
+
+FINE_DT = 0.0025
+"""s, the longest step of the grid on which energy and limits are computed (the cycle's)."""
+SAMPLE_DT = 0.025
+"""s, the longest step of :attr:`Retimed.samples` (the logs' 40 Hz)."""
+N_COEFFICIENTS = 12
+"""Free control points of the timing spline ``s(t)``."""
+DEGREE = 5
+"""Degree of the timing spline (quintic: continuous jerk)."""
+TABLE_POINTS = 513
+"""Points along ``s`` at which the path and its dynamics are tabulated for the search."""
+TOPPRA_GRIDPOINTS = 401
+"""Grid points along ``s`` of the TOPP-RA problem."""
+MAX_ITERATIONS = 200
+"""SLSQP iterations at most."""
+MAX_STRETCHES = 8
+"""With a jerk limit, :func:`shortest_on_path` stretches the sin² duration by 25 % this often at most."""
+_EPS_POWER = 1e-3  # W: smoothing of |P| in the search's objective only
+_MARGIN = 1e-3  # the search keeps its limits this fraction below the checked ones
+_TCP_TOLERANCE = 1e-7  # relative excess of the TCP speed that still counts as held
+
+
+class JointPath(Protocol):
+    """A joint path ``q(s)``, ``s`` in [0, 1]: ``at(s)`` (n,) -> ``q, dq/ds, d²q/ds²`` (n, joints)."""
+
+    def at(self, s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]: ...
+
+
+PathLike = JointPath | Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]
+
+
+@dataclass(frozen=True, slots=True)
+class Retimed:
+    """A move re-timed along its path.
+
+    Attributes
+    ----------
+    duration : float
+        s, exactly the one asked for.
+    energy_J : float
+        ``Σ |tau · qd| dt`` on :attr:`fine` (J).
+    fine : Trajectory
+        The motion on a grid of at most 2.5 ms, its last sample at the end.
+    samples : Trajectory
+        The same motion on a grid of at most 25 ms.
+    s : ndarray of shape (n_fine,)
+        The path parameter at the times of :attr:`fine`.
+    feasible : bool
+        Every limit holds on :attr:`fine`.
+    limit_excess : tuple of str
+        The worst excess of each violated kind of limit, in words (empty when feasible).
+    optimized : bool
+        Whether the optimized timing was kept (False: the sin² start was better).
+    start_energy_J : float
+        The energy of the start, the controller's sin² profile stretched to ``duration``.
+    """
+
+    duration: float
+    energy_J: float
+    fine: Trajectory
+    samples: Trajectory
+    s: FloatArray
+    feasible: bool
+    limit_excess: tuple[str, ...]
+    optimized: bool
+    start_energy_J: float
+
+
+# --------------------------------------------------------------------------- path helpers
+def _path_function(path: PathLike) -> Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]:
+    at = getattr(path, "at", None)
+    if callable(at):
+        return at  # type: ignore[no-any-return]
+    if callable(path):
+        return path
+    raise InvalidInput(
+        f"path must have .at(s) -> (q, dq/ds, d²q/ds²) (like joulepath.sim SegmentPath) or be such a "
+        f"callable, got {type(path).__name__}"
+    )
+
+
+def _tcp_offset(tcp: FloatArray | None) -> FloatArray:
+    if tcp is None:
+        return np.zeros(3)
+    t = np.asarray(tcp, dtype=float)
+    if t.shape != (4, 4):
+        raise InvalidInput(f"tcp must be a 4x4 flange-to-TCP transform, got shape {t.shape}")
+    return t[:3, 3].copy()
+
+
+def tcp_velocity(robot: Robot, q: FloatArray, qd: FloatArray, tcp: FloatArray | None = None) -> FloatArray:
+    """The TCP's linear velocity (m/s) in the base frame, (n_steps, n) -> (n_steps, 3).
+
+    ``v = J_v qd + w x (R r)``: the geometric Jacobian at tool0 and the TCP offset ``r``.
+    """
+    offset = _tcp_offset(tcp)
+    jac = robot.jacobian(q)
+    v = np.einsum("kij,kj->ki", jac[:, :3], qd)
+    w = np.einsum("kij,kj->ki", jac[:, 3:], qd)
+    r = np.einsum("kij,j->ki", robot.fk(q).rotation, offset)
+    out: FloatArray = v + np.cross(w, r)
+    return out
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Table:
+    """The path and its dynamics along ``s``, as one spline of columns (see the module docstring)."""
+
+    spline: CubicSpline  # columns: q' | q'' | m | c | g | |dp/ds|
+    n: int
+
+    def eval(self, s: FloatArray) -> tuple[FloatArray, FloatArray]:
+        return self.spline(s), self.spline(s, 1)
+
+
+def _table(robot: Robot, at: Callable[..., Any], tcp: FloatArray | None) -> _Table:
+    s = np.linspace(0.0, 1.0, TABLE_POINTS)
+    q, q1, q2 = (np.asarray(a, dtype=float) for a in at(s))
+    n = q.shape[1]
+    zero = np.zeros_like(q)
+    g = robot.inverse_dynamics(q, zero, zero)
+    m = robot.inverse_dynamics(q, zero, q1) - g
+    c = robot.inverse_dynamics(q, q1, q2) - g
+    p1 = np.linalg.norm(tcp_velocity(robot, q, q1, tcp), axis=1)
+    cols = np.concatenate([q1, q2, m, c, g, p1[:, None]], axis=1)
+    return _Table(CubicSpline(s, cols, axis=0), n)
+
+
+Law = Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]
+"""A timing: times (n,) -> ``s, ṡ, s̈`` (n,)."""
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Limits:
+    """What a timing is measured against (validated at the public edge)."""
+
+    friction: Friction | None
+    amax: FloatArray
+    jmax: FloatArray | None
+    tcp_speed: float | None
+    tcp: FloatArray | None
+
+
+def _motion(
+    at: Callable[..., Any], s: FloatArray, sd: FloatArray, sdd: FloatArray, t: FloatArray
+) -> Trajectory:
+    q, q1, q2 = (np.asarray(a, dtype=float) for a in at(s))
+    return Trajectory(t=t, q=q, qd=q1 * sd[:, None], qdd=q2 * (sd * sd)[:, None] + q1 * sdd[:, None])
+
+
+def _grid(duration: float, dt: float) -> FloatArray:
+    return np.linspace(0.0, duration, max(2, int(np.ceil(duration / dt - 1e-9)) + 1))
+
+
+def _check_limits_arg(name: str, value: FloatArray | None, n: int, *, required: bool) -> FloatArray | None:
+    if value is None:
+        if required:
+            raise InvalidInput(f"{name} is required (rad/s², one per joint)")
+        return None
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (n,) or np.any(~(arr > 0)):
+        raise InvalidInput(
+            f"{name} must be {n} positive values (one per joint), got {np.array2string(arr, precision=3)}"
+        )
+    return arr
+
+
+# --------------------------------------------------------------------------- the sin² start
+def _peak_speed(at: Callable[..., Any]) -> FloatArray:
+    _, q1, _ = at(np.linspace(0.0, 1.0, 33))  # as the controller (sim._timing.fastest_profile)
+    out: FloatArray = np.abs(np.asarray(q1, dtype=float)).max(axis=0)
+    return out
+
+
+def controller_profile(
+    robot: Robot,
+    path: PathLike,
+    *,
+    acceleration_limit: FloatArray,
+    jerk_limit: FloatArray | None = None,
+    tcp_speed_limit: float | None = None,
+    tcp: FloatArray | None = None,
+) -> Profile:
+    """The controller's fastest sin² profile of ``s`` on this path (as :func:`joulepath.sim` plans a move).
+
+    The speed bound is the joints' speed limits over the largest ``|dq/ds|`` and the TCP
+    speed limit over the path's TCP length; acceleration and jerk bounds likewise.
+    """
+    at = _path_function(path)
+    peak = _peak_speed(at)
+    vmax = np.asarray(robot.velocity_limit, dtype=float)
+    moving = peak > 1e-9
+    if not moving.any():
+        raise InvalidInput("the path does not move (dq/ds is 0 everywhere); nothing to time")
+    bounds = [float(np.min(vmax[moving] / peak[moving]))]
+    if tcp_speed_limit is not None:
+        s = np.linspace(0.0, 1.0, 129)
+        q, q1, _ = at(s)
+        speed = np.linalg.norm(tcp_velocity(robot, np.asarray(q), np.asarray(q1), tcp), axis=1)
+        length = float(np.trapezoid(speed, s))
+        if length > 1e-9:
+            bounds.append(tcp_speed_limit / length)
+    amax = np.asarray(acceleration_limit, dtype=float)
+    jmax = np.full(peak.shape, np.inf) if jerk_limit is None else np.asarray(jerk_limit, dtype=float)
+    return plan_profile(
+        min(bounds), float(np.min(amax[moving] / peak[moving])), float(np.min(jmax[moving] / peak[moving]))
+    )
+
+
+def _stretched(profile: Profile, duration: float) -> Profile:
+    k = duration / profile.duration
+    return Profile(ta=profile.ta * k, tc=profile.tc * k, v=profile.v / k)
+
+
+# --------------------------------------------------------------------------- the timing spline
+@dataclass(frozen=True, slots=True, eq=False)
+class _Timing:
+    """``s(t) = B(t) c``: the basis (and its derivatives) on a grid, and the fixed control points."""
+
+    knots: FloatArray
+    n_ctrl: int
+    fixed_lo: int  # control points 0..fixed_lo-1 are 0
+    fixed_hi: int  # the last fixed_hi are 1
+
+    @property
+    def n_free(self) -> int:
+        return self.n_ctrl - self.fixed_lo - self.fixed_hi
+
+    def control(self, x: FloatArray) -> FloatArray:
+        return np.concatenate([np.zeros(self.fixed_lo), x, np.ones(self.fixed_hi)])
+
+    def basis(self, t: FloatArray, nu: int) -> FloatArray:
+        out: FloatArray = BSpline(self.knots, np.eye(self.n_ctrl), DEGREE)(t, nu)
+        return out
+
+    def evaluate(self, x: FloatArray, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        spl = BSpline(self.knots, self.control(x), DEGREE)
+        return spl(t), spl(t, 1), spl(t, 2)
+
+
+def _timing(duration: float, start_at_rest: bool, end_at_rest: bool) -> _Timing:
+    n_ctrl = N_COEFFICIENTS + (3 if start_at_rest else 1) + (3 if end_at_rest else 1)
+    n_inner = n_ctrl - DEGREE - 1
+    inner = np.linspace(0.0, duration, n_inner + 2)[1:-1]
+    knots = np.concatenate([np.zeros(DEGREE + 1), inner, np.full(DEGREE + 1, duration)])
+    return _Timing(knots, n_ctrl, 3 if start_at_rest else 1, 3 if end_at_rest else 1)
+
+
+def _fit_start(timing: _Timing, t: FloatArray, s: FloatArray) -> FloatArray:
+    """Least-squares control points of a given ``s(t)``, made non-decreasing within [0, 1]."""
+    basis = timing.basis(t, 0)
+    free = basis[:, timing.fixed_lo : timing.n_ctrl - timing.fixed_hi]
+    rhs = s - basis[:, timing.n_ctrl - timing.fixed_hi :].sum(axis=1)
+    x, *_ = np.linalg.lstsq(free, rhs, rcond=None)
+    out: FloatArray = np.clip(np.maximum.accumulate(x), 0.0, 1.0)
+    return out
+
+
+# --------------------------------------------------------------------------- the search's functions
+@dataclass(frozen=True, slots=True, eq=False)
+class _Search:
+    """Energy and limits as functions of the free control points, with their gradients."""
+
+    table: _Table
+    friction: Friction | None
+    dt: float
+    b0: FloatArray  # basis and its derivatives at the grid, free columns only (n_t, n_free)
+    b1: FloatArray
+    b2: FloatArray
+    off0: FloatArray  # the fixed control points' contribution (n_t,)
+    off1: FloatArray
+    off2: FloatArray
+    vmax: FloatArray
+    amax: FloatArray
+    jmax: FloatArray | None
+    tcp_speed: float | None
+
+    def state(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        return self.b0 @ x + self.off0, self.b1 @ x + self.off1, self.b2 @ x + self.off2
+
+    def _parts(self, x: FloatArray) -> dict[str, FloatArray]:
+        s, sd, sdd = self.state(x)
+        val, der = self.table.eval(np.clip(s, 0.0, 1.0))
+        n = self.table.n
+        cut = [val[:, k * n : (k + 1) * n] for k in range(5)]
+        dcut = [der[:, k * n : (k + 1) * n] for k in range(5)]
+        return {
+            "s": s, "sd": sd, "sdd": sdd,
+            "q1": cut[0], "q2": cut[1], "m": cut[2], "c": cut[3], "g": cut[4], "p1": val[:, 5 * n],
+            "dq1": dcut[0], "dq2": dcut[1], "dm": dcut[2], "dc": dcut[3], "dg": dcut[4], "dp1": der[:, 5 * n],
+        }  # fmt: skip
+
+    def _chain(self, ds: FloatArray, dsd: FloatArray, dsdd: FloatArray) -> FloatArray:
+        """Jacobian (rows, n_free) of per-point quantities from their partials (n_t, k) in s, ṡ, s̈."""
+        out: FloatArray = (
+            np.einsum("tk,tf->tkf", ds, self.b0)
+            + np.einsum("tk,tf->tkf", dsd, self.b1)
+            + np.einsum("tk,tf->tkf", dsdd, self.b2)
+        )
+        return out
+
+    def energy(self, x: FloatArray) -> tuple[float, FloatArray]:
+        p = self._parts(x)
+        sd, sdd = p["sd"][:, None], p["sdd"][:, None]
+        qd = p["q1"] * sd
+        tau = p["m"] * sdd + p["c"] * sd * sd + p["g"]
+        fd = np.zeros_like(qd)
+        if self.friction is not None:
+            tau = tau + self.friction.torque(qd)
+            fd = friction_derivative(self.friction, qd)
+        power = tau * qd
+        smooth = np.sqrt(power * power + _EPS_POWER**2)
+        w = power / smooth
+        dqd_ds = p["dq1"] * sd
+        dtau_ds = p["dm"] * sdd + p["dc"] * sd * sd + p["dg"] + fd * dqd_ds
+        dtau_dsd = 2.0 * p["c"] * sd + fd * p["q1"]
+        dp_ds = dtau_ds * qd + tau * dqd_ds
+        dp_dsd = dtau_dsd * qd + tau * p["q1"]
+        dp_dsdd = p["m"] * qd
+        e_s = (w * dp_ds).sum(axis=1)
+        e_sd = (w * dp_dsd).sum(axis=1)
+        e_sdd = (w * dp_dsdd).sum(axis=1)
+        grad = self.dt * (e_s @ self.b0 + e_sd @ self.b1 + e_sdd @ self.b2)
+        return float(self.dt * (smooth - _EPS_POWER).sum()), grad
+
+    def constraints(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """``g(x) >= 0`` (relative margins to each limit) and its Jacobian."""
+        p = self._parts(x)
+        sd, sdd = p["sd"][:, None], p["sdd"][:, None]
+        lim = 1.0 - _MARGIN
+        rows: list[FloatArray] = []
+        jacs: list[FloatArray] = []
+        # joint speed: |q'| ṡ <= vmax (ṡ >= 0 by the monotone control points)
+        a1 = np.abs(p["q1"]) / self.vmax
+        rows.append(lim - a1 * sd)
+        jacs.append(-self._chain(np.sign(p["q1"]) * p["dq1"] / self.vmax * sd, a1, np.zeros_like(a1)))
+        # acceleration: qdd = q'' ṡ² + q' s̈, both signs
+        qdd = p["q2"] * sd * sd + p["q1"] * sdd
+        d_s = p["dq2"] * sd * sd + p["dq1"] * sdd
+        d_sd = 2.0 * p["q2"] * sd
+        d_sdd = p["q1"]
+        ja = self._chain(d_s / self.amax, d_sd / self.amax, d_sdd / self.amax)
+        rows += [lim - qdd / self.amax, lim + qdd / self.amax]
+        jacs += [-ja, ja]
+        if self.jmax is not None:  # the grid's own jerk: consecutive accelerations' difference / dt
+            jerk = np.diff(qdd, axis=0) / self.dt / self.jmax
+            jj = np.diff(self._chain(d_s, d_sd, d_sdd), axis=0) / self.dt / self.jmax[None, :, None]
+            rows += [lim - jerk, lim + jerk]
+            jacs += [-jj, jj]
+        if self.tcp_speed is not None:
+            v = p["p1"][:, None] / self.tcp_speed
+            rows.append(lim - v * sd)
+            jacs.append(-self._chain(p["dp1"][:, None] / self.tcp_speed * sd, v, np.zeros_like(v)))
+        g = np.concatenate([r.ravel() for r in rows])
+        jac = np.concatenate([j.reshape(-1, j.shape[-1]) for j in jacs])
+        return g, jac
+
+
+def _search(
+    robot: Robot,
+    at: Callable[..., Any],
+    timing: _Timing,
+    t: FloatArray,
+    x0: FloatArray,
+    limits: _Limits,
+) -> FloatArray:
+    table = _table(robot, at, limits.tcp)
+    lo, hi = timing.fixed_lo, timing.n_ctrl - timing.fixed_hi
+    bases = [timing.basis(t, nu) for nu in range(3)]
+    problem = _Search(
+        table=table,
+        friction=limits.friction,
+        dt=float(t[1] - t[0]),
+        b0=bases[0][:, lo:hi],
+        b1=bases[1][:, lo:hi],
+        b2=bases[2][:, lo:hi],
+        off0=bases[0][:, hi:].sum(axis=1),
+        off1=bases[1][:, hi:].sum(axis=1),
+        off2=bases[2][:, hi:].sum(axis=1),
+        vmax=np.asarray(robot.velocity_limit, dtype=float),
+        amax=limits.amax,
+        jmax=limits.jmax,
+        tcp_speed=limits.tcp_speed,
+    )
+    n = x0.size
+    order = np.zeros((n + 1, n))  # x_0 >= 0, x_{i+1} - x_i >= 0, 1 - x_{n-1} >= 0
+    order[0, 0] = 1.0
+    order[np.arange(1, n), np.arange(1, n)] = 1.0
+    order[np.arange(1, n), np.arange(0, n - 1)] = -1.0
+    order[n, n - 1] = -1.0
+    shift = np.zeros(n + 1)
+    shift[n] = 1.0
+    scale = max(problem.energy(x0)[0], 1e-6)
+    last: dict[bytes, tuple[FloatArray, FloatArray]] = {}  # SLSQP asks for g and its Jacobian apart
+
+    def limits_at(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        key = np.asarray(x, dtype=float).tobytes()
+        if key not in last:
+            last.clear()
+            last[key] = problem.constraints(x)
+        return last[key]
+
+    result = minimize(
+        lambda x: tuple(v / scale for v in problem.energy(x)),
+        x0,
+        jac=True,
+        method="SLSQP",
+        bounds=[(0.0, 1.0)] * n,
+        constraints=[
+            {"type": "ineq", "fun": lambda x: order @ x + shift, "jac": lambda x: order},
+            {"type": "ineq", "fun": lambda x: limits_at(x)[0], "jac": lambda x: limits_at(x)[1]},
+        ],
+        options={"maxiter": MAX_ITERATIONS, "ftol": 1e-9},
+    )
+    out: FloatArray = np.clip(np.asarray(result.x, dtype=float), 0.0, 1.0)
+    return np.maximum.accumulate(out)
+
+
+# --------------------------------------------------------------------------- verification
+def _measure(
+    robot: Robot,
+    at: Callable[..., Any],
+    law: Law,
+    duration: float,
+    limits: _Limits,
+) -> tuple[float, Trajectory, FloatArray, tuple[str, ...]]:
+    """Energy, fine motion, ``s`` and the limits' excesses (in words) of a timing."""
+    t = _grid(duration, FINE_DT)
+    s, sd, sdd = law(t)
+    fine = _motion(at, np.clip(s, 0.0, 1.0), sd, sdd, t)
+    energy = energy_on_samples(robot, fine, friction=limits.friction)
+    report = check_limits(
+        robot, fine, friction=limits.friction, acceleration_limit=limits.amax, jerk_limit=limits.jmax
+    )
+    tcp_speed_limit, tcp = limits.tcp_speed, limits.tcp
+    excess = [w.describe() for w in report.worst]
+    if np.any(np.diff(s) < -1e-12):
+        excess.append(f"the path parameter goes back by {float(-np.diff(s).min()):.2e}")
+    if tcp_speed_limit is not None:
+        speed = np.linalg.norm(tcp_velocity(robot, fine.q, fine.qd, tcp), axis=1)
+        k = int(np.argmax(speed))
+        if speed[k] > tcp_speed_limit * (1.0 + _TCP_TOLERANCE):
+            excess.append(
+                f"TCP speed {1000 * speed[k]:.1f} mm/s at t = {t[k]:.3f} s against its limit "
+                f"{1000 * tcp_speed_limit:.1f} mm/s ({100 * (speed[k] / tcp_speed_limit - 1):.1f} % over)"
+            )
+    return energy, fine, s, tuple(excess)
+
+
+def retime_on_path(
+    robot: Robot,
+    path: PathLike,
+    duration: float,
+    *,
+    acceleration_limit: FloatArray,
+    jerk_limit: FloatArray | None = None,
+    tcp_speed_limit: float | None = None,
+    tcp: FloatArray | None = None,
+    friction: Friction | None = NOMINAL_FRICTION,
+    start_at_rest: bool = True,
+    end_at_rest: bool = True,
+) -> Retimed:
+    """The least-energy timing ``s(t)`` of a fixed joint path in exactly ``duration`` s.
+
+    Parameters
+    ----------
+    robot : Robot
+    path : object with ``at(s)``, or a callable ``s -> (q, dq/ds, d²q/ds²)``
+        ``s`` of shape (n,) in [0, 1] to arrays of shape (n, n_joints), e.g.
+        :class:`joulepath.sim.SegmentPath` (a ``MoveL``'s straight line).
+    duration : float
+        s, positive.
+    acceleration_limit : ndarray of shape (n_joints,)
+        rad/s² (:func:`joulepath.sim.acceleration_limit`).
+    jerk_limit : ndarray of shape (n_joints,), optional
+        rad/s³, checked as the fine grid's difference of accelerations.
+    tcp_speed_limit : float, optional
+        m/s, the move's speeddata ``v_tcp`` (a bound, not a target).
+    tcp : ndarray of shape (4, 4), optional
+        Flange-to-TCP transform (m) for the TCP speed; tool0 if None.
+    friction : Friction or None
+        Added to the rigid-body torque in the energy (default: the nominal friction).
+    start_at_rest, end_at_rest : bool
+        Zero ``ṡ`` and ``s̈`` at that end (else both are free there).
+
+    Returns
+    -------
+    Retimed
+        ``feasible`` only after the limits were checked on the fine grid.
+
+    Raises
+    ------
+    InvalidInput
+        A duration that is not positive, limits of the wrong shape, a path that does not move.
+
+    Examples
+    --------
+    >>> import joulepath
+    >>> from joulepath.sim import acceleration_limit
+    >>> robot = joulepath.load_robot("irb120")
+    >>> dq = np.array([0.6, -0.4, 0.5, 0.0, 0.3, 0.0])
+    >>> def line(s):  # a joint-space line from the home pose
+    ...     return robot.home + s[:, None] * dq, np.tile(dq, (s.size, 1)), np.zeros((s.size, 6))
+    >>> r = retime_on_path(robot, line, 1.0, acceleration_limit=acceleration_limit(robot, 0.25))
+    >>> r.feasible, r.energy_J <= r.start_energy_J, float(r.s[-1])
+    (True, True, 1.0)
+    """
+    if not (np.isfinite(duration) and duration > 0):
+        raise InvalidInput(f"duration must be a positive number of seconds, got {duration}")
+    if tcp_speed_limit is not None and not tcp_speed_limit > 0:
+        raise InvalidInput(f"tcp_speed_limit must be positive (m/s), got {tcp_speed_limit}")
+    at = _path_function(path)
+    n = robot.n_joints
+    amax = _check_limits_arg("acceleration_limit", acceleration_limit, n, required=True)
+    assert amax is not None
+    jmax = _check_limits_arg("jerk_limit", jerk_limit, n, required=False)
+    fastest = controller_profile(
+        robot, path, acceleration_limit=amax, jerk_limit=jmax, tcp_speed_limit=tcp_speed_limit, tcp=tcp
+    )
+    start = _stretched(fastest, duration)
+    limits = _Limits(friction, amax, jmax, tcp_speed_limit, tcp)
+    timing = _timing(duration, start_at_rest, end_at_rest)
+    t = _grid(duration, FINE_DT)
+    x = _search(robot, at, timing, t, _fit_start(timing, t, evaluate_profile(start, t)[0]), limits)
+
+    def controller(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        return evaluate_profile(start, tt)
+
+    def optimized(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        return timing.evaluate(x, tt)
+
+    e0, fine0, s0, excess0 = _measure(robot, at, controller, duration, limits)
+    e1, fine1, s1, excess1 = _measure(robot, at, optimized, duration, limits)
+    take_new = (not excess1, -e1) > (not excess0, -e0)
+    law = optimized if take_new else controller
+    energy, fine, s, excess = (e1, fine1, s1, excess1) if take_new else (e0, fine0, s0, excess0)
+    ts = _grid(duration, SAMPLE_DT)
+    ss, sds, sdds = law(ts)
+    samples = _motion(at, np.clip(ss, 0.0, 1.0), sds, sdds, ts)
+    return Retimed(
+        duration=float(duration),
+        energy_J=energy,
+        fine=fine,
+        samples=samples,
+        s=s,
+        feasible=not excess,
+        limit_excess=excess,
+        optimized=take_new,
+        start_energy_J=e0,
+    )
+
+
+# --------------------------------------------------------------------------- time-optimal bound
+def _toppra() -> Any:
+    try:
+        import toppra
+    except ImportError as err:
+        raise ImportError(
+            "shortest_on_path needs toppra (TOPP-RA); install joulepath's 'motion' extra: "
+            "pip install 'joulepath[motion]'"
+        ) from err
+    return toppra
+
+
+def shortest_on_path(
+    robot: Robot,
+    path: PathLike,
+    *,
+    acceleration_limit: FloatArray,
+    jerk_limit: FloatArray | None = None,
+    tcp_speed_limit: float | None = None,
+    tcp: FloatArray | None = None,
+) -> float:
+    """The time-optimal duration (s) of a rest-to-rest motion along the path (TOPP-RA).
+
+    Joint speed and acceleration limits and the TCP speed limit (m/s, a bound on ``ṡ``
+    from ``|dp/ds|``) on ``TOPPRA_GRIDPOINTS`` points along ``s``. TOPP-RA's problem is of
+    second order: with a ``jerk_limit`` the returned value is the shortest duration at
+    which :func:`retime_on_path` is feasible, searched upwards from TOPP-RA's bound
+    (bisection to 0.5 %, up to the controller's sin² duration).
+
+    Raises
+    ------
+    ImportError
+        toppra is missing (the ``motion`` extra).
+    InvalidInput
+        Limits of the wrong shape; a path TOPP-RA cannot parametrize.
+    """
+    toppra = _toppra()
+    from toppra.constraint.linear_constraint import LinearConstraint
+
+    at = _path_function(path)
+    n = robot.n_joints
+    amax = _check_limits_arg("acceleration_limit", acceleration_limit, n, required=True)
+    jmax = _check_limits_arg("jerk_limit", jerk_limit, n, required=False)
+    vmax = np.asarray(robot.velocity_limit, dtype=float)
+
+    geometric: Any = toppra.interpolator.AbstractGeometricPath
+    linear: Any = LinearConstraint
+
+    class _Path(geometric):  # type: ignore[misc]
+        def __call__(self, ss: Any, order: int = 0) -> FloatArray:
+            arr = np.atleast_1d(np.asarray(ss, dtype=float))
+            out: FloatArray = np.asarray(at(arr)[order], dtype=float)
+            return out if np.ndim(ss) else out[0]
+
+        @property
+        def dof(self) -> int:
+            return n
+
+        @property
+        def path_interval(self) -> FloatArray:
+            return np.array([0.0, 1.0])
+
+    class _TcpSpeed(linear):  # type: ignore[misc]
+        """``|dp/ds| ṡ <= v``: a bound on ``x = ṡ²``."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.dof = n
+
+        def compute_constraint_params(self, geom: Any, gridpoints: FloatArray, *args: Any, **kw: Any) -> Any:
+            q, q1 = geom(gridpoints, 0), geom(gridpoints, 1)
+            speed = np.linalg.norm(tcp_velocity(robot, q, q1, tcp), axis=1)
+            upper = np.where(speed > 1e-12, (tcp_speed_limit / np.maximum(speed, 1e-12)) ** 2, 1e12)
+            xbound = np.stack([np.zeros_like(upper), upper], axis=1)
+            return None, None, None, None, None, None, xbound
+
+    constraints = [
+        toppra.constraint.JointVelocityConstraint(vmax),
+        toppra.constraint.JointAccelerationConstraint(
+            amax, discretization_scheme=toppra.constraint.DiscretizationType.Interpolation
+        ),
+    ]
+    if tcp_speed_limit is not None:
+        constraints.append(_TcpSpeed())
+    grid = np.linspace(0.0, 1.0, TOPPRA_GRIDPOINTS)
+    algo = toppra.algorithm.TOPPRA(constraints, _Path(), gridpoints=grid, solver_wrapper="seidel")
+    _, sd, _ = algo.compute_parameterization(0.0, 0.0)
+    if sd is None or np.any(~np.isfinite(sd)):
+        raise InvalidInput("TOPP-RA found no parametrization of this path within the limits")
+    sd = np.asarray(sd, dtype=float)
+    bound = float(np.sum(2.0 * np.diff(grid) / (sd[1:] + sd[:-1])))
+    if jmax is None:
+        return bound
+    kwargs: dict[str, Any] = {
+        "acceleration_limit": amax, "jerk_limit": jmax, "tcp_speed_limit": tcp_speed_limit, "tcp": tcp
+    }  # fmt: skip
+    hi = controller_profile(robot, path, **kwargs).duration
+    if retime_on_path(robot, path, bound, **kwargs).feasible:
+        return bound
+    lo = bound
+    for _ in range(MAX_STRETCHES):
+        if retime_on_path(robot, path, hi, **kwargs).feasible:
+            break
+        lo, hi = hi, hi * 1.25
+    else:
+        raise InvalidInput(
+            f"no feasible timing of this path up to {hi:.3f} s within the jerk limit; check the path "
+            "against the joint ranges and limits"
+        )
+    while hi - lo > 0.005 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if retime_on_path(robot, path, mid, **kwargs).feasible else (mid, hi)
+    return hi
