@@ -46,6 +46,7 @@ from joulepath.optimize import (
     jerk_limit,
 )
 from joulepath.optimize._gradient import SplineProblem, optimize_spline, solve_move
+from joulepath.optimize._retime import retime_on_path, shortest_on_path
 from joulepath.optimize._verify import shortest_feasible_duration, tcp_deviation_mm
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._resolve import CycleSpec, Step
@@ -92,6 +93,8 @@ class CycleSettings:
     reduced to half of either move's TCP length), False: exactly. ``max_time_s``: a
     bound on the wall time; when it is reached no further move is solved and the best
     verified allocation of what was solved is returned (taught motion elsewhere).
+    ``retime_linear``: a ``MoveL`` that runs from rest to rest on its own is re-timed along
+    its line (:func:`joulepath.optimize.retime_on_path`; its speeddata's TCP speed a bound).
     """
 
     cycle_time: float | None = None
@@ -105,6 +108,7 @@ class CycleSettings:
     warm_start: bool = False
     fly_by: bool = True
     zones: bool = True
+    retime_linear: bool = True
     max_time_s: float | None = None
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
@@ -345,6 +349,7 @@ class CycleOptimizer:
         self.span: dict[int, float] = {}
         self.segment_of: dict[int, Segment] = {}  # by unit: the window of the default cycle it replaces
         self.within: set[int] = set()  # units inside a segment with MoveL: fixed duration, taught ends
+        self.linear: set[int] = set()  # MoveL units: re-timed along their line (retime_on_path)
         for seg in self.segments:
             for members, window, inner in self._units_of(seg):
                 self.chains[members[0]] = members
@@ -370,6 +375,10 @@ class CycleOptimizer:
             if i in self.within:  # its ends are the taught motion's: its duration stays
                 self.leg_lo[i] = ()
                 self.t_lo[i] = self.span[i]
+                continue
+            if i in self.linear:
+                self.leg_lo[i] = ()
+                self.t_lo[i] = self._linear_shortest(self.by_index[i])
                 continue
             single: list[float] = []
             for j in members:
@@ -408,6 +417,9 @@ class CycleOptimizer:
             if len(moving) > 1 and not self.settings.fly_by:
                 return []
             return [(tuple(moving), seg, False)]
+        if len(moving) == 1 and self._can_retime(by[moving[0]]):  # a MoveL from rest to rest
+            self.linear.add(moving[0])
+            return [(tuple(moving), seg, False)]
         if not self.settings.fly_by:
             return []
         out: list[tuple[tuple[int, ...], Segment, bool]] = []
@@ -427,10 +439,36 @@ class CycleOptimizer:
             del k
         return out
 
+    def _can_retime(self, m: PlannedMove) -> bool:
+        return (
+            m.step.linear
+            and not m.step.repeated
+            and self.settings.retime_linear
+            and self.default_clearance.get(m.index, np.inf) >= 0.0
+        )
+
     def _can_optimize(self, m: PlannedMove) -> bool:
         return (
             not m.step.linear and not m.step.repeated and self.default_clearance.get(m.index, np.inf) >= 0.0
         )
+
+    def _linear_shortest(self, m: PlannedMove) -> float:
+        """A MoveL's shortest duration along its line within the limits and its speeddata (TOPP-RA,
+        whole 25 ms samples); its taught duration when toppra (extra ``motion``) is not installed."""
+        robot = self._robot(m)
+        assert m.step.speed is not None
+        try:
+            t = shortest_on_path(
+                robot,
+                m.path,
+                acceleration_limit=self._amax_array(robot),
+                jerk_limit=self._jmax(robot),
+                tcp_speed_limit=m.step.speed.v_tcp / 1000.0,
+                tcp=m.step.tcp,
+            )
+        except ImportError:
+            return self.span[m.index]
+        return float(np.ceil(t / STEP - 1e-9) * STEP)
 
     def waits_kept(self, use_waits: bool) -> float:
         """s of waits the cycle keeps: all, or (``use_waits``) all but the idle ones."""
@@ -630,6 +668,10 @@ class CycleOptimizer:
     def _amax(self, robot: Robot) -> FloatArray | None:
         return acceleration_limit(robot, self.settings.accel_time)
 
+    def _amax_array(self, robot: Robot) -> FloatArray:
+        a = self._amax(robot)
+        return np.full(robot.n_joints, np.inf) if a is None else a
+
     def _jmax(self, robot: Robot) -> FloatArray | None:
         return jerk_limit(robot, self.settings.accel_time, self.settings.jerk_time)
 
@@ -702,6 +744,8 @@ class CycleOptimizer:
         amax = self._amax(robot)
         seq = np.random.SeedSequence([self.settings.seed, m.index, units])
         rng = np.random.default_rng(seq)
+        if m.index in self.linear:
+            return self._retime_once(m, T)
         inner = m.index in self.within
         base = self.base(m.index) if inner else None
         q0 = m.path.q0 if base is None else base.q[0]
@@ -748,6 +792,34 @@ class CycleOptimizer:
             tcp_deviation_mm(robot, samples, taught),
             None if self.settings.cell is None else self._clearance_mm(m, fine.q),
             corridor,
+        )
+
+    def _retime_once(self, m: PlannedMove, T: float) -> Solved:
+        """A MoveL re-timed along its line at ``T`` (its speeddata's TCP speed a bound), verified."""
+        robot = self._robot(m)
+        assert m.step.speed is not None
+        r = retime_on_path(
+            robot,
+            m.path,
+            T,
+            acceleration_limit=self._amax_array(robot),
+            jerk_limit=self._jmax(robot),
+            tcp_speed_limit=m.step.speed.v_tcp / 1000.0,
+            tcp=m.step.tcp,
+        )
+        self.n_solves += 1
+        e, e_lab = _energy(robot, self.plant(robot), r.fine)
+        return Solved(
+            T,
+            e,
+            e_lab,
+            r.feasible,
+            r.limit_excess,
+            r.samples,
+            r.fine,
+            0.0,
+            None if self.settings.cell is None else self._clearance_mm(m, r.fine.q),
+            None,
         )
 
     # ------------------------------------------------------------ default
@@ -1130,8 +1202,10 @@ def optimize_cycle(
         waits_J=final.energy_J if settings.use_waits else None,
     )
     result = _assemble(opt, final, table, breakdown, target=target, shortest=shortest, t_start=t_start)
-    inner = [i for i, e in final.choice.items() if i in opt.within and not e.taught]
-    if inner:  # what RAPID via points follow: the units inside MoveL segments as taught
+    inner = [i for i, e in final.choice.items() if (i in opt.within or i in opt.linear) and not e.taught]
+    if inner and len(inner) < sum(
+        1 for e in final.choice.values() if not e.taught
+    ):  # what RAPID follows: the units inside MoveL segments as taught
         simple = opt.evaluate(
             {i: (opt.taught(i) if i in inner else e) for i, e in final.choice.items()},
             final.cycle_time_s - opt.fixed_time - sum(e.duration for e in final.choice.values()),
@@ -1184,7 +1258,9 @@ def _assemble(
         for j in members:
             zones = any(opt.zone_mm(k) > 0 for k in members[:-1])
             notes[j] = (
-                "reshaped and re-timed"
+                "MoveL re-timed along its line (its speeddata's TCP speed a bound)"
+                if j in opt.linear
+                else "reshaped and re-timed"
                 if len(members) == 1
                 else "reshaped and re-timed in one fly-by chain with lines "
                 + ", ".join(str(opt.by_index[k].step.line) for k in members)
