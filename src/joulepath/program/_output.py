@@ -220,7 +220,8 @@ def _unfaithful_reason(check: dict[str, Any]) -> str:
         why.append(f"takes {cyc:.3f} s per cycle, longer than the taught {target:.3f} s")
     if e > e0 * (1.0 - tol["saved_at_least_pct"] / 100.0):
         why.append(
-            f"spends {e:.2f} J against the taught {e0:.2f} J (at least {tol['saved_at_least_pct']:g} % less asked)"
+            f"spends {e:.2f} J against the taught {e0:.2f} J "
+            f"(at least {tol['saved_at_least_pct']:g} % less asked)"
         )
     if dev > tol["path_mm"]:
         why.append(f"leaves the planned TCP path by {dev:.1f} mm (at most {tol['path_mm']:g} mm)")
