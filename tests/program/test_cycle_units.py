@@ -222,3 +222,36 @@ def test_bundled_example_at_its_own_cycle_time(robot):
     assert result.optimized_cycle_s <= result.default_cycle_s + 1e-9
     assert result.saved_pct > 0.0
     assert opt.within  # its MoveJ transfers blended into MoveL approaches are units
+
+
+LINES = """MODULE Lin
+    CONST robtarget pA := [[400, -150, 250], [0, 0, 1, 0], [-1, 0, -1, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pB := [[400, 150, 250], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    PROC main()
+        MoveJ pA, v1000, fine, tool0;
+        MoveL pB, v1000, fine, tool0;
+        WaitTime 0.5;
+        MoveL pA, v1000, fine, tool0;
+    ENDPROC
+ENDMODULE
+"""
+
+
+def test_moveL_from_rest_to_rest_is_re_timed_on_its_line(robot):
+    """A MoveL between stops is re-timed along its straight line: the TCP stays on the line, the
+    speeddata's TCP speed holds, the cycle is no longer and the energy no higher than taught."""
+    pytest.importorskip("toppra")
+    spec = resolve_module(parse_module(LINES, path="lin.mod"), robot)
+    result, opt = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
+    assert opt.linear and set(opt.linear) <= set(result.paths)
+    assert result.optimized_cycle_s <= result.default_cycle_s + 1e-9
+    assert result.optimized_energy_J < result.default_energy_J
+    for i in opt.linear:
+        step, s = spec.steps[i], result.paths[i]
+        p, _ = _tcp(robot, s.fine.q, step.tcp)
+        a, b = p[0], p[-1]
+        u = (b - a) / np.linalg.norm(b - a)
+        off = (p - a) - np.outer((p - a) @ u, u)
+        assert 1000 * np.linalg.norm(off, axis=1).max() <= 0.1
+        v = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(s.fine.t)
+        assert v.max() <= step.speed.v_tcp / 1000 * 1.01
