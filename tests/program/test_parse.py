@@ -126,7 +126,7 @@ CORPUS = [
     ("unknown speeddata", _prog("MoveAbsJ jA, v123, fine, tool0;"), 5),
     ("move inside IF", _prog("IF nParts > 3 THEN", "    MoveJ pA, v100, fine, tool0;", "ENDIF"), 6),
     ("other work object", _prog("MoveJ pA, v100, fine, tool0 \\WObj:=wobjTable;"), 5),
-    ("WaitTime InPos", _prog("MoveJ pA, v100, fine, tool0;", "WaitTime \\InPos, 0.5;"), 6),
+    ("WaitTime InPos without a time", _prog("MoveJ pA, v100, fine, tool0;", "WaitTime \\InPos;"), 6),
     (
         "declared twice",
         HEAD
@@ -135,7 +135,7 @@ CORPUS = [
         + TAIL,
         4,
     ),
-    ("robtarget without value", _prog("MoveJ pA, v100, fine, tool0;", decl="    VAR robtarget pNone;\n"), 4),
+    ("robtarget without value", _prog("MoveJ pNone, v100, fine, tool0;", decl="    VAR robtarget pNone;\n"), 4),
     (
         "recursion",
         HEAD

@@ -55,7 +55,54 @@ class ToolData:
     cog_mm: tuple[float, float, float]
 
 
-Value = JointTarget | RobTarget | SpeedData | ZoneData | ToolData | float
+@dataclass(frozen=True, slots=True)
+class WObjData:
+    """``wobjdata``: a work object; only fixed ones (robhold FALSE, ufprog TRUE, ufmec "") are modelled.
+
+    ``uframe`` and ``oframe`` are (position mm, quaternion w-first); a target given in
+    the work object is at ``uframe * oframe * target`` in the base frame.
+    """
+
+    robhold: bool
+    ufprog: bool
+    ufmec: str
+    uframe: tuple[tuple[float, float, float], tuple[float, float, float, float]]
+    oframe: tuple[tuple[float, float, float], tuple[float, float, float, float]]
+
+    @property
+    def moving(self) -> bool:
+        """Held by the robot or moved by a mechanical unit: not a fixed frame."""
+        return self.robhold or not self.ufprog or bool(self.ufmec.strip())
+
+
+@dataclass(frozen=True, slots=True)
+class Offset:
+    """One ``Offs`` or ``RelTool`` applied to a robtarget.
+
+    ``Offs(p, dx, dy, dz)``: ``p`` displaced by (dx, dy, dz) mm in the frame the target is
+    given in (the work object), same orientation. ``RelTool(p, dx, dy, dz \\Rx \\Ry \\Rz)``:
+    displaced in the tool frame of ``p``, then turned about the tool's x, the new y and
+    the new z axis by ``rotation_deg``.
+    """
+
+    kind: str
+    displacement_mm: tuple[float, float, float]
+    rotation_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True, slots=True)
+class TargetRef:
+    """A target as a move (or a robtarget declaration) computes it: a declared target and offsets.
+
+    ``name`` is a declared ``robtarget`` / ``jointtarget`` (or an array element ``NAME{k}``);
+    ``offsets`` are applied in order (the innermost ``Offs`` / ``RelTool`` first).
+    """
+
+    name: str
+    offsets: tuple[Offset, ...] = ()
+
+
+Value = JointTarget | RobTarget | SpeedData | ZoneData | ToolData | WObjData | TargetRef | float
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,24 +136,34 @@ class Move:
     zone: str
     z_tcp: float | None  # \Z
     tool: str
+    wobj: str | None = None  # \WObj (None: wobj0, the base frame)
+    target_ref: TargetRef | None = None  # Offs / RelTool or a procedure's argument; None: ``target``
 
 
 @dataclass(frozen=True, slots=True)
 class WaitTime:
-    """``WaitTime seconds;``."""
+    """``WaitTime [\\InPos,] seconds;``; ``idle``: marked ``! joulepath: idle`` (time to spend on moves)."""
 
     line: int
     end_line: int
     seconds: float
+    inpos: bool = False
+    idle: bool = False
 
 
 @dataclass(frozen=True, slots=True)
 class Call:
-    """A call of a procedure of the module without arguments (``Name;``)."""
+    """A call of a procedure of the module (``Name;`` or ``Name arg1, arg2;``).
+
+    A procedure with parameters is read at each of its calls with the arguments bound:
+    ``body`` holds its statements for this call (None: read once, ``Procedure.body``).
+    """
 
     line: int
     end_line: int
     name: str
+    args: tuple[str, ...] = ()
+    body: tuple[Statement, ...] | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,17 +201,36 @@ class ForLoop:
     runs: tuple[tuple[Statement, ...], ...]
 
 
-Statement = Move | WaitTime | Call | Verbatim | WhileTrue | ForLoop
+@dataclass(frozen=True, slots=True)
+class Branch:
+    """``IF`` / ``TEST`` with moves inside whose condition is known when the module is read.
+
+    ``body`` is the branch the cycle runs; ``note`` says which and why, e.g.
+    ``"line 12: IF bDoubleGrip (FALSE) -> ELSE branch"``.
+    """
+
+    line: int
+    end_line: int
+    note: str
+    body: tuple[Statement, ...]
+
+
+Statement = Move | WaitTime | Call | Verbatim | WhileTrue | ForLoop | Branch
 
 
 @dataclass(frozen=True, slots=True)
 class Procedure:
-    """``PROC name() ... ENDPROC`` (no parameters)."""
+    """``PROC name(params) ... ENDPROC``; ``params``: (type, name) pairs.
+
+    A procedure with parameters is read at each call (:class:`Call` ``body``); its own
+    ``body`` is then empty.
+    """
 
     line: int
     end_line: int
     name: str
     body: tuple[Statement, ...]
+    params: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True, slots=True)

@@ -37,26 +37,30 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from joulepath.program._model import (
+    Branch,
     Call,
     Declaration,
     ForLoop,
     JointTarget,
     Module,
     Move,
+    Offset,
     Procedure,
     RapidError,
     RobTarget,
     Statement,
+    TargetRef,
     ToolData,
     Value,
     Verbatim,
     WaitTime,
     WhileTrue,
+    WObjData,
     ZoneData,
 )
 from joulepath.sim._steps import SpeedData
 
-READ_TYPES = ("jointtarget", "robtarget", "speeddata", "zonedata", "tooldata", "num")
+READ_TYPES = ("jointtarget", "robtarget", "speeddata", "zonedata", "tooldata", "wobjdata", "num")
 MOVES = ("MoveAbsJ", "MoveJ", "MoveL")
 OTHER_MOTION = re.compile(
     r"^(Move\w*|Search[LCJ]\w*|Trigg[LCJ]\w*|Cap[LC]\w*|Arc\w*|Spot\w*|StartMove\w*|StopMove\w*|"
@@ -75,6 +79,17 @@ MOTION_SETTINGS = (
     "GripLoad",
     "MotionSup",
     "SoftAct",
+    "PDispOn",
+    "PDispSet",
+    "EOffsOn",
+    "EOffsSet",
+    "PathResol",
+    "TuneServo",
+    "SpeedRefresh",
+    "SpeedLimAxis",
+    "SpeedLimCheckPoint",
+    "CorrCon",
+    "SyncMoveOn",
 )
 MAX_RUNS = 10_000
 """Most runs of one FOR loop with moves inside that are unrolled."""
@@ -87,17 +102,22 @@ BLOCK_CLOSE = {"IF": "ENDIF", "FOR": "ENDFOR", "WHILE": "ENDWHILE", "TEST": "END
 _IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 
-# predefined data (RobotWare): speeddata v5..v7000, zonedata fine, z0..z200, tool0
+# predefined data (RobotWare): speeddata v5..v7000 and vmax, zonedata fine, z0..z200, tool0, wobj0
 PREDEFINED_SPEEDS = {
     f"v{v}": SpeedData(float(v), 500.0, 5000.0, 1000.0)
     for v in (5, 10, 20, 30, 40, 50, 60, 80, 100, 150, 200, 300, 400, 500, 600, 800, 1000)
     + (1500, 2000, 2500, 3000, 4000, 5000, 6000, 7000)
-}
+} | {"vmax": SpeedData(5000.0, 500.0, 5000.0, 1000.0)}
+"""``vmax``: 5000 mm/s TCP as declared in RobotWare's base module (the manual names the robot's
+``MaxRobSpeed`` for its TCP speed; the joint speed limits bound the motion either way)."""
 PREDEFINED_ZONES = {"fine": ZoneData(True, 0.0)} | {
     f"z{z}": ZoneData(False, float(z) if z else 0.3)
     for z in (0, 1, 5, 10, 15, 20, 30, 40, 50, 60, 80, 100, 150, 200)
 }
 TOOL0 = ToolData(True, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), 0.0, (0.0, 0.0, 0.0))
+WOBJ0 = WObjData(
+    False, True, "", ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)), ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -252,6 +272,20 @@ def _aggregate(path: str, line: int, text: str) -> object:
                     pos += 1
                     return items
                 raise fail("',' or ']' expected")
+        if text[pos] == '"':  # a string (wobjdata ufmec); "" inside is one quote
+            end = pos + 1
+            chars: list[str] = []
+            while end < len(text):
+                if text[end] == '"':
+                    if text[end + 1 : end + 2] == '"':
+                        chars.append('"')
+                        end += 2
+                        continue
+                    pos = end + 1
+                    return "".join(chars)
+                chars.append(text[end])
+                end += 1
+            raise fail("a string is not closed")
         m = _NUMBER.match(text, pos)
         if m:
             pos = m.end()
@@ -327,6 +361,8 @@ def _value_of(path: str, line: int, type_: str, agg: object, text: str) -> Value
         if rest[0] < 0:
             raise RapidError(f"{path}:{line}: zonedata pzone_tcp must be ≥ 0, got {rest[0]:g}")
         return ZoneData(bool(agg[0]), rest[0])
+    if type_ == "wobjdata":
+        return _wobjdata(path, line, agg)
     # tooldata
     if (
         len(agg) != 3
@@ -360,13 +396,40 @@ def _value_of(path: str, line: int, type_: str, agg: object, text: str) -> Value
     )
 
 
+def _wobjdata(path: str, line: int, agg: list[object]) -> WObjData:
+    shape = "wobjdata needs [robhold, ufprog, ufmec, [[x,y,z],[q1..q4]], [[x,y,z],[q1..q4]]]"
+    if (
+        len(agg) != 5
+        or not isinstance(agg[0], bool)
+        or not isinstance(agg[1], bool)
+        or not isinstance(agg[2], str)
+    ):
+        raise RapidError(f"{path}:{line}: {shape}")
+    frames = []
+    for item, what in ((agg[3], "uframe"), (agg[4], "oframe")):
+        if not isinstance(item, list) or len(item) != 2:
+            raise RapidError(f"{path}:{line}: {shape} ({what} is not [[x,y,z],[q1..q4]])")
+        pos = _nums(path, line, item[0], 3, f"{what}.trans")
+        rot = _nums(path, line, item[1], 4, f"{what}.rot")
+        norm = sum(v * v for v in rot) ** 0.5
+        if abs(norm - 1.0) > 1e-3:
+            raise RapidError(f"{path}:{line}: the {what} quaternion has norm {norm:.5f}, not 1; normalize it")
+        frames.append(((pos[0], pos[1], pos[2]), (rot[0], rot[1], rot[2], rot[3])))
+    return WObjData(agg[0], agg[1], agg[2], frames[0], frames[1])
+
+
 _DECL = re.compile(
     r"^(?:(?:LOCAL|TASK)\s+)?(CONST|PERS|VAR)\s+([A-Za-z]\w*)\s+([A-Za-z]\w*)\s*(\{[^}]*\})?\s*(?::=\s*(.*))?;$",
     re.IGNORECASE | re.DOTALL,
 )
 
 
-def _declaration(path: str, unit: Unit) -> Declaration | None:
+def _declaration(path: str, unit: Unit, names: Names) -> Declaration | None:
+    """A declaration of a type joulepath reads; None: another type, or a value read where it is used.
+
+    A ``robtarget`` may be computed from another one (``:= Offs(pB, 0, 0, 50)``). A target
+    without a value is refused where a move goes to it (``names.novalue``).
+    """
     m = _DECL.match(unit.text)
     if not m:
         raise RapidError(f"{path}:{unit.line}: cannot read the declaration {unit.text[:60]!r}")
@@ -377,14 +440,23 @@ def _declaration(path: str, unit: Unit) -> Declaration | None:
     if dims:
         return _array_declaration(path, unit, storage, type_l, name, dims, value)
     if value is None:
-        if type_l == "num":
-            return None
-        raise RapidError(f"{path}:{unit.line}: {type_l} {name} has no value; give it one with := [...]")
+        if type_l != "num":
+            names.novalue[name.lower()] = unit.line
+        return None
+    if type_l == "robtarget" and _CALL.match(value.strip()):
+        ref = _target_ref(path, unit.line, value.strip(), names, f"the value of {name}")
+        return Declaration(unit.line, unit.end_line, storage.upper(), type_l, name, ref)
     try:
         parsed = _value(path, unit.line, type_l, value)
     except RapidError:
-        if type_l == "num":  # an expression: kept verbatim, refused only where a move needs it
-            return None
+        if type_l == "num":  # an expression: its value where the module's constants give it
+            try:
+                number = _evaluate(path, unit.line, value, names, f"the value of {name}")
+            except RapidError:
+                return None  # kept verbatim, refused only where a move needs it
+            if isinstance(number, bool):
+                return None
+            return Declaration(unit.line, unit.end_line, storage.upper(), type_l, name, number)
         raise
     return Declaration(unit.line, unit.end_line, storage.upper(), type_l, name, parsed)
 
@@ -473,41 +545,72 @@ def _split_args(path: str, line: int, text: str) -> list[str]:
 
 
 _SWITCH = re.compile(r"\\\s*([A-Za-z]\w*)\s*(?::=\s*([^\\]+?))?\s*(?=\\|$)")
+SWITCH_NAMES = {s.lower(): s for s in ("V", "T", "Z", "WObj", "NoEOffs", "InPos", "Rx", "Ry", "Rz")}
+"""Optional arguments joulepath reads, by their lower-case name (RAPID names ignore case)."""
+
+
+def _top_level_backslash(text: str) -> int:
+    depth = 0
+    for k, ch in enumerate(text):
+        if ch in "[(":
+            depth += 1
+        elif ch in "])":
+            depth -= 1
+        elif ch == "\\" and depth == 0:
+            return k
+    return -1
 
 
 def _argument(path: str, line: int, text: str) -> tuple[str, dict[str, str | None]]:
-    """``primary \\Sw:=value \\Flag`` -> (primary, {switch: value or None})."""
-    head, _, rest = text.partition("\\")
-    primary = head.strip()
+    """``primary \\Sw:=value \\Flag`` -> (primary, {switch: value or None}); switch names canonical."""
+    cut = _top_level_backslash(text)
+    primary = (text if cut < 0 else text[:cut]).strip()
     switches: dict[str, str | None] = {}
-    if rest:
-        tail = "\\" + rest
+    if cut >= 0:
+        tail = text[cut:]
         pos = 0
         for m in _SWITCH.finditer(tail):
             if m.start() != pos:
                 raise RapidError(f"{path}:{line}: cannot read the argument {text!r}")
-            switches[m.group(1)] = m.group(2).strip() if m.group(2) else None
+            name = SWITCH_NAMES.get(m.group(1).lower(), m.group(1))
+            switches[name] = m.group(2).strip() if m.group(2) else None
             pos = m.end()
         if pos != len(tail):
             raise RapidError(f"{path}:{line}: cannot read the argument {text!r}")
     return primary, switches
 
 
+Binding = float | bool | str | TargetRef
+"""A procedure argument as the callee sees it: a number, a truth value, a declared name, a target."""
+
+
 @dataclass
 class Names:
-    """What a number or an index may name while a routine is read.
+    """What a name may stand for while a routine is read.
 
-    ``nums``: the module's ``CONST num`` (lower-case names); ``arrays``: its arrays
-    as (storage, type, elements); ``loop``: the variables of the FOR loops being
-    unrolled around the statement, bound to their value in this run.
+    ``nums`` / ``bools``: the module's ``CONST`` and ``PERS`` num and bool values that no
+    statement assigns (lower-case names; a ``PERS`` reads as declared); ``arrays``: its
+    arrays as (storage, type, elements); ``loop``: the variables of the FOR loops being
+    unrolled around the statement, bound to their value in this run; ``params``: the
+    arguments of the procedure call being read; ``assigned``: names some statement of the
+    module assigns (line, text); ``novalue``: targets declared without a value (line).
     """
 
     nums: dict[str, float] = field(default_factory=dict)
     arrays: dict[str, tuple[str, str, tuple[Value, ...]]] = field(default_factory=dict)
     loop: dict[str, int] = field(default_factory=dict)
+    bools: dict[str, bool] = field(default_factory=dict)
+    params: dict[str, Binding] = field(default_factory=dict)
+    assigned: dict[str, tuple[int, str]] = field(default_factory=dict)
+    novalue: dict[str, int] = field(default_factory=dict)
+
+    def called(self, params: dict[str, Binding]) -> Names:
+        """The names a called procedure sees: the module's, its arguments, no loop variables."""
+        return Names(dict(self.nums), self.arrays, {}, dict(self.bools), params, self.assigned, self.novalue)
 
 
 _ELEMENT = re.compile(r"^([A-Za-z]\w*)\s*\{\s*(.*?)\s*\}$", re.DOTALL)
+_CALL = re.compile(r"^([A-Za-z]\w*)\s*\((.*)\)$", re.DOTALL)
 
 
 def _index(path: str, line: int, text: str, names: Names) -> int:
@@ -520,6 +623,8 @@ def _index(path: str, line: int, text: str, names: Names) -> int:
         value = float(text)
     elif _IDENT.match(text) and text.lower() in names.loop:
         value = float(names.loop[text.lower()])
+    elif _IDENT.match(text) and isinstance(names.params.get(text.lower()), float):
+        value = float(names.params[text.lower()])  # type: ignore[arg-type]
     elif _IDENT.match(text) and text.lower() in names.nums:
         value = names.nums[text.lower()]
     if value is None:
@@ -556,6 +661,9 @@ def _number(path: str, line: int, text: str, names: Names, what: str) -> float:
         return float(text)
     if _IDENT.match(text) and text.lower() in names.loop:
         return float(names.loop[text.lower()])
+    bound = names.params.get(text.lower())
+    if _IDENT.match(text) and isinstance(bound, float):
+        return bound
     if _IDENT.match(text) and text.lower() in names.nums:
         return names.nums[text.lower()]
     at = _array_element(path, line, text, names)
@@ -566,17 +674,281 @@ def _number(path: str, line: int, text: str, names: Names, what: str) -> float:
             assert isinstance(value, float)
             return value
     raise RapidError(
-        f"{path}:{line}: {what} must be a number, a num constant of the module or an element of a "
+        f"{path}:{line}: {what} must be a number, a CONST or PERS num of the module or an element of a "
         f"CONST num array, got {text!r}"
     )
 
 
-def _move(path: str, unit: Unit, names: Names) -> Move:
-    instr = unit.head
-    body = unit.text[len(instr) :].rstrip(";").strip()
+# ---------------------------------------------------------------- expressions
+_TOKEN = re.compile(
+    r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(?P<name>[A-Za-z]\w*(?:\s*\{[^}]*\})?)"
+    r"|(?P<op><>|<=|>=|[-+*/()=<>]))"
+)
+
+
+def _evaluate(
+    path: str, line: int, text: str, names: Names, what: str, seen: dict[str, str] | None = None
+) -> float | bool:
+    """A num or bool expression of numbers, constants, loop variables and arguments.
+
+    ``+ - * / DIV MOD``, comparisons ``= <> < > <= >=``, ``AND OR XOR NOT``, brackets.
+    ``seen`` collects the names read and their values (for notes). Anything else
+    (functions, VAR data, data some statement assigns) is refused with the reason.
+    """
+    tokens: list[tuple[str, str]] = []
+    pos = 0
+    body = text.strip()
+    while pos < len(body):
+        m = _TOKEN.match(body, pos)
+        if m is None or m.end() == pos:
+            raise RapidError(
+                f"{path}:{line}: cannot read {what} {text.strip()!r} at {body[pos : pos + 10]!r}"
+            )
+        pos = m.end()
+        kind = m.lastgroup or ""
+        tokens.append((kind, m.group(kind)))
+    k = 0
+
+    def fail(msg: str) -> RapidError:
+        return RapidError(f"{path}:{line}: {what} {text.strip()!r}: {msg}")
+
+    def peek() -> str:
+        return tokens[k][1].upper() if k < len(tokens) else ""
+
+    def take() -> tuple[str, str]:
+        nonlocal k
+        if k >= len(tokens):
+            raise fail("it ends too early")
+        k += 1
+        return tokens[k - 1]
+
+    def num(v: float | bool) -> float:
+        if isinstance(v, bool):
+            raise fail("a truth value where a number is needed")
+        return v
+
+    def name_value(word: str) -> float | bool:
+        low = word.lower()
+        if "{" in word:
+            return _number(path, line, word, names, what)
+        if low in ("true", "false"):
+            return low == "true"
+        if low in names.loop:
+            return float(names.loop[low])
+        if low in names.params:
+            bound = names.params[low]
+            if isinstance(bound, float | bool):
+                return bound
+            raise fail(f"{word} is a {type(bound).__name__} argument, not a num or bool")
+        if low in names.nums:
+            return names.nums[low]
+        if low in names.bools:
+            return names.bools[low]
+        if low in names.assigned:
+            at, stmt = names.assigned[low]
+            raise fail(
+                f"{word} is assigned at line {at} ({stmt[:40]!r}), so its value is known only while the "
+                "program runs; use a CONST or PERS value no statement changes"
+            )
+        raise fail(
+            f"{word} is not a CONST or PERS num or bool of the module (a VAR, a function or unknown); "
+            "declare it CONST"
+        )
+
+    def primary() -> float | bool:
+        kind, tok = take()
+        if kind == "num":
+            return float(tok)
+        if kind == "name":
+            if tok.upper() == "NOT":
+                v = primary()
+                if not isinstance(v, bool):
+                    raise fail("NOT needs a truth value")
+                return not v
+            if peek() == "(":
+                raise fail(f"the function {tok} is evaluated only while the program runs")
+            value = name_value(tok)
+            if seen is not None and tok.lower() not in ("true", "false"):
+                seen[tok] = _show(value)
+            return value
+        if tok == "(":
+            v = disjunction()
+            if take()[1] != ")":
+                raise fail("')' expected")
+            return v
+        if tok in "+-":
+            v = num(primary())
+            return v if tok == "+" else -v
+        raise fail(f"unexpected {tok!r}")
+
+    def product() -> float | bool:
+        v = primary()
+        while peek() in ("*", "/", "DIV", "MOD"):
+            op = take()[1].upper()
+            r = num(primary())
+            a = num(v)
+            if op != "*" and r == 0:
+                raise fail("division by zero")
+            v = (
+                a * r
+                if op == "*"
+                else a / r
+                if op == "/"
+                else float(int(a) // int(r))
+                if op == "DIV"
+                else a % r
+            )
+        return v
+
+    def total() -> float | bool:
+        v = product()
+        while peek() in ("+", "-"):
+            op = take()[1]
+            r = num(product())
+            v = num(v) + r if op == "+" else num(v) - r
+        return v
+
+    def comparison() -> float | bool:
+        v = total()
+        if peek() in ("=", "<>", "<", ">", "<=", ">="):
+            op = take()[1]
+            r = total()
+            if op in ("=", "<>"):
+                if isinstance(v, bool) != isinstance(r, bool):
+                    raise fail("compares a number with a truth value")
+                same = v == r if isinstance(v, bool) else abs(float(v) - float(r)) <= 1e-9
+                return same if op == "=" else not same
+            a, b = num(v), num(r)
+            return {"<": a < b, ">": a > b, "<=": a <= b, ">=": a >= b}[op]
+        return v
+
+    def conjunction() -> float | bool:
+        v = comparison()
+        while peek() == "AND":
+            take()
+            r = comparison()
+            if not isinstance(v, bool) or not isinstance(r, bool):
+                raise fail("AND needs truth values")
+            v = v and r
+        return v
+
+    def disjunction() -> float | bool:
+        v = conjunction()
+        while peek() in ("OR", "XOR"):
+            op = take()[1].upper()
+            r = conjunction()
+            if not isinstance(v, bool) or not isinstance(r, bool):
+                raise fail(f"{op} needs truth values")
+            v = (v or r) if op == "OR" else (v != r)
+        return v
+
+    if not tokens:
+        raise fail("it is empty")
+    out = disjunction()
+    if k != len(tokens):
+        raise fail(f"unexpected {tokens[k][1]!r}")
+    return out
+
+
+def _show(value: float | bool) -> str:
+    return ("TRUE" if value else "FALSE") if isinstance(value, bool) else f"{value:g}"
+
+
+# ---------------------------------------------------------------- targets
+COMPUTED_AT_RUN_TIME = ("CRobT", "CJointT", "CalcRobT", "CalcJointT", "CTool", "CWObj", "MirPos")
+
+
+def _target_ref(path: str, line: int, text: str, names: Names, what: str) -> TargetRef:
+    """A target: a declared name, an array element, an argument, ``Offs(...)`` or ``RelTool(...)``."""
+    text = text.strip()
+    m = _CALL.match(text)
+    if m is None:
+        at = _array_element(path, line, text, names)
+        if at is not None:
+            return TargetRef(f"{at[0]}{{{at[1]}}}")
+        if not _IDENT.match(text):
+            raise RapidError(
+                f"{path}:{line}: {what} must be a declared target, Offs(...) or RelTool(...), got "
+                f"{text[:40]!r}; declare it (CONST robtarget ... := [...]) and use its name"
+            )
+        low = text.lower()
+        if low in names.params:
+            bound = names.params[low]
+            if not isinstance(bound, TargetRef):
+                raise RapidError(f"{path}:{line}: {what}: the argument {text} is not a target")
+            return bound
+        if low in names.assigned:
+            at_line, stmt = names.assigned[low]
+            raise RapidError(
+                f"{path}:{line}: {what} {text} is assigned at line {at_line} ({stmt[:40]!r}): a target "
+                "computed while the program runs is not modelled; move to a declared CONST robtarget"
+            )
+        if low in names.novalue:
+            raise RapidError(
+                f"{path}:{names.novalue[low]}: {text} is declared without a value, and line {line} moves "
+                "to it; give it one with := [...]"
+            )
+        return TargetRef(text)
+    func, inner = m.group(1), m.group(2)
+    kind = next((k for k in ("Offs", "RelTool") if k.lower() == func.lower()), None)
+    if kind is None:
+        run_time = func.lower() in [f.lower() for f in COMPUTED_AT_RUN_TIME]
+        how = "while the program runs" if run_time else "by a function joulepath does not read"
+        raise RapidError(
+            f"{path}:{line}: {what} {func}(...) is computed {how}; not modelled; move to a declared "
+            "robtarget (Offs and RelTool are read)"
+        )
+    args = _split_args(path, line, inner)
+    if len(args) != 4:
+        raise RapidError(f"{path}:{line}: {kind} needs 4 arguments (target, dx, dy, dz), got {len(args)}")
+    last, switches = _argument(path, line, args[3])
+    if switches and kind == "Offs":
+        raise RapidError(f"{path}:{line}: Offs takes no optional arguments; use RelTool for \\Rx, \\Ry, \\Rz")
+    rotation = [0.0, 0.0, 0.0]
+    for sw, value in switches.items():
+        if sw not in ("Rx", "Ry", "Rz") or value is None:
+            raise RapidError(f"{path}:{line}: RelTool \\{sw} is not read; use \\Rx:=, \\Ry:=, \\Rz:= (deg)")
+        rotation["xyz".index(sw[1])] = _real(path, line, value, names, f"RelTool \\{sw}")
+    base = _target_ref(path, line, args[0], names, f"the target of {kind}")
+    d = tuple(
+        _real(path, line, t, names, f"{kind}'s {axis}")
+        for t, axis in zip((*args[1:3], last), "xyz", strict=True)
+    )
+    offset = Offset(kind, (d[0], d[1], d[2]), (rotation[0], rotation[1], rotation[2]))
+    return TargetRef(base.name, (*base.offsets, offset))
+
+
+def _real(path: str, line: int, text: str, names: Names, what: str) -> float:
+    value = _evaluate(path, line, text, names, what)
+    if isinstance(value, bool):
+        raise RapidError(f"{path}:{line}: {what} {text.strip()!r} is a truth value; give a number")
+    return value
+
+
+def _target_text(ref: TargetRef, written: str) -> str:
+    """What a move's ``target`` says: the declared name, or the expression as written."""
+    return ref.name if not ref.offsets else re.sub(r"\s+", " ", written.strip())
+
+
+def _name_argument(path: str, line: int, text: str, names: Names, what: str) -> str:
+    """A speed, zone, tool or work object: a declared name (an argument stands for its value's name)."""
+    low = text.lower()
+    if _IDENT.match(text) and low in names.params:
+        bound = names.params[low]
+        if not isinstance(bound, str):
+            raise RapidError(f"{path}:{line}: the {what} argument {text} is not a {what} name")
+        return bound
+    return text
+
+
+def _move(path: str, unit: Unit, names: Names, instr: str) -> Move:
+    body = unit.text[len(unit.head) :].rstrip(";").strip()
     if body.startswith("\\"):
         sw = body[1:].split()[0].split(",")[0]
-        raise RapidError(f"{path}:{unit.line}: {instr} \\{sw} is not supported; remove the \\{sw} argument")
+        what = " (concurrent execution)" if sw.lower() == "conc" else ""
+        raise RapidError(
+            f"{path}:{unit.line}: {instr} \\{sw}{what} is not modelled; remove the \\{sw} argument"
+        )
     args = _split_args(path, unit.line, body)
     if len(args) != 4:
         raise RapidError(
@@ -584,6 +956,7 @@ def _move(path: str, unit: Unit, names: Names) -> Move:
         )
     allowed = ({"NoEOffs"} if instr == "MoveAbsJ" else set(), {"V", "T"}, {"Z"}, {"WObj"})
     parsed = []
+    ref: TargetRef | None = None
     for text, ok, what in zip(args, allowed, ("target", "speed", "zone", "tool"), strict=True):
         primary, switches = _argument(path, unit.line, text)
         for sw in switches:
@@ -591,6 +964,11 @@ def _move(path: str, unit: Unit, names: Names) -> Move:
                 raise RapidError(
                     f"{path}:{unit.line}: {instr} argument \\{sw} (on the {what}) is not supported; remove it"
                 )
+        if what == "target":
+            ref = _target_ref(path, unit.line, primary, names, f"the target of {instr}")
+            primary = _target_text(ref, primary)
+            parsed.append((primary, switches))
+            continue
         at = _array_element(path, unit.line, primary, names) if what != "tool" else None
         if at is not None:
             primary = f"{at[0]}{{{at[1]}}}"  # the element this run of the loops names
@@ -599,13 +977,18 @@ def _move(path: str, unit: Unit, names: Names) -> Move:
                 f"{path}:{unit.line}: the {what} of {instr} must be a name declared in the module, got "
                 f"{primary!r}; declare it (CONST ... := ...) and use its name"
             )
+        else:
+            primary = _name_argument(path, unit.line, primary, names, what)
         parsed.append((primary, switches))
     (target, _), (speed, sp), (zone, zs), (tool, ts) = parsed
-    wobj = ts.get("WObj")
-    if "WObj" in ts and (wobj is None or wobj.strip().lower() != "wobj0"):
-        raise RapidError(
-            f"{path}:{unit.line}: work object {wobj!r} is not supported; only wobj0 (the base frame)"
-        )
+    wobj: str | None = None
+    if "WObj" in ts:
+        written = ts["WObj"]
+        if written is None or not _IDENT.match(written):
+            raise RapidError(f"{path}:{unit.line}: \\WObj needs a work object name (\\WObj:=wobj1)")
+        wobj = _name_argument(path, unit.line, written, names, "work object")
+        if wobj.lower() == "wobj0":
+            wobj = None
     for key, sws in (("V", sp), ("T", sp), ("Z", zs)):
         if key in sws and sws[key] is None:
             raise RapidError(f"{path}:{unit.line}: \\{key} needs a value (\\{key}:=...)")
@@ -620,19 +1003,67 @@ def _move(path: str, unit: Unit, names: Names) -> Move:
         raise RapidError(f"{path}:{unit.line}: \\V:={v:g} mm/s must be positive")
     if z is not None and z < 0:
         raise RapidError(f"{path}:{unit.line}: \\Z:={z:g} mm must be ≥ 0")
-    return Move(unit.line, unit.end_line, instr, target, speed, v, t, zone, z, tool)
+    target_ref = ref if ref is not None and ref.offsets else None
+    return Move(unit.line, unit.end_line, instr, target, speed, v, t, zone, z, tool, wobj, target_ref)
 
 
-def _wait(path: str, unit: Unit, names: Names) -> WaitTime:
-    body = unit.text.split(None, 1)[1].rstrip(";").strip() if len(unit.text.split()) > 1 else ""
+_IDLE_MARK = re.compile(r"^\s*!\s*joulepath\s*:\s*idle\b", re.IGNORECASE)
+_IDLE_AFTER = re.compile(r";\s*!\s*joulepath\s*:\s*idle\b", re.IGNORECASE)
+
+
+def _is_idle(source: tuple[str, ...], unit: Unit) -> bool:
+    """``! joulepath: idle`` after the statement's ``;`` or alone on the line directly above it."""
+    last = source[unit.end_line - 1] if unit.end_line <= len(source) else ""
+    above = source[unit.line - 2] if unit.line >= 2 else ""
+    return bool(_IDLE_AFTER.search(last) or _IDLE_MARK.match(above))
+
+
+def _wait(path: str, unit: Unit, names: Names, source: tuple[str, ...]) -> WaitTime:
+    body = unit.text[len(unit.head) :].rstrip(";").strip()
+    inpos = False
     if body.startswith("\\"):
-        raise RapidError(f"{path}:{unit.line}: WaitTime {body.split()[0]} is not supported; remove it")
+        first, _, rest = body.partition(",")
+        if first[1:].strip().lower() != "inpos":
+            raise RapidError(
+                f"{path}:{unit.line}: WaitTime {first.strip()} is not read; remove it (\\InPos is read)"
+            )
+        inpos, body = True, rest.strip()
     if not body:
         raise RapidError(f"{path}:{unit.line}: WaitTime needs a time in s")
-    seconds = _number(path, unit.line, body, names, "the WaitTime")
+    seconds = _real(path, unit.line, body, names, "the WaitTime")
     if not 0 <= seconds <= 3600:
         raise RapidError(f"{path}:{unit.line}: WaitTime {seconds:g} s must be within [0, 3600] s")
-    return WaitTime(unit.line, unit.end_line, seconds)
+    return WaitTime(unit.line, unit.end_line, seconds, inpos, _is_idle(source, unit))
+
+
+# ---------------------------------------------------------------- routines
+MOTION_FIXES = {
+    "PDispOn": "it displaces every following target (program displacement); remove it and PDispOff, or "
+    "write the displaced targets (Offs)",
+    "PDispSet": "it displaces every following target (program displacement); remove it and PDispOff, or "
+    "write the displaced targets (Offs)",
+    "EOffsOn": "it offsets the external axes; remove it and EOffsOff",
+    "EOffsSet": "it offsets the external axes; remove it and EOffsOff",
+    "VelSet": "it scales the programmed speeds; remove it and write the speeds in the moves",
+    "AccSet": "it lowers the acceleration; remove it to optimize",
+}
+_PROC_LINE = re.compile(r"(?:LOCAL\s+)?PROC\s+([A-Za-z]\w*)\s*\(\s*(.*?)\s*\)", re.IGNORECASE | re.DOTALL)
+_PARAM = re.compile(r"^(?:(VAR|PERS|INOUT)\s+)?([A-Za-z]\w*)\s+([A-Za-z]\w*)$", re.IGNORECASE)
+ARGUMENT_TYPES = ("num", "bool", "robtarget", "jointtarget", "speeddata", "zonedata", "tooldata", "wobjdata")
+"""Parameter types whose arguments are substituted; others (string, signals, ...) are passed as written."""
+MAX_EXPANDED = 200_000
+"""Most statements the calls of procedures with parameters may read in all."""
+WRITES_FIRST_ARGUMENT = ("Incr", "Decr", "Add", "Clear", "TPReadNum", "TPReadFK", "TPReadDnum", "GetDataVal")
+"""Instructions that change the data named by their first argument."""
+_ASSIGN = re.compile(r"^([A-Za-z]\w*)\s*(?:\{[^}]*\})?\s*(?:\.\s*\w+\s*)*:=", re.DOTALL)
+
+
+@dataclass
+class _Routine:
+    unit: Unit
+    start: int  # index of the PROC unit in the reader's units
+    end: int  # index of its ENDPROC
+    params: tuple[tuple[str, str], ...]
 
 
 @dataclass
@@ -641,8 +1072,12 @@ class _Reader:
     units: list[Unit]
     procs: set[str]
     names: Names
+    source: tuple[str, ...] = ()
+    routines: dict[str, _Routine] = field(default_factory=dict)
     pos: int = 0
     unrolled: int = 0
+    expanded: int = 0
+    stack: tuple[str, ...] = ()
 
     def peek(self) -> Unit | None:
         return self.units[self.pos] if self.pos < len(self.units) else None
@@ -655,52 +1090,85 @@ class _Reader:
     def fail(self, line: int, msg: str) -> RapidError:
         return RapidError(f"{self.path}:{line}: {msg}")
 
+    def is_motion(self, u: Unit) -> bool:
+        head = u.head
+        return bool(head.lower() in _MOVES_LOWER or OTHER_MOTION.match(head) or head.lower() in self.procs)
+
     def block(self, close: str, opener: Unit, *, inside: str) -> tuple[list[Statement], Unit]:
         body: list[Statement] = []
         while True:
             u = self.peek()
             if u is None:
                 raise self.fail(opener.line, f"{inside} is not closed; add {close}")
-            if u.head.upper() == close:
+            up = u.head.upper()
+            if up == close:
                 return body, self.take()
-            if u.head.upper() in ("ENDPROC", "ENDMODULE", "ENDFUNC", "ENDTRAP") and close != u.head.upper():
+            if close == "ENDPROC" and up in ("ERROR", "UNDO", "BACKWARD"):
+                # the routine's handler: kept verbatim in the source, never part of the cycle
+                while (v := self.peek()) is not None and v.head.upper() != "ENDPROC":
+                    self.take()
+                continue
+            if up in ("ENDPROC", "ENDMODULE", "ENDFUNC", "ENDTRAP") and close != up:
                 raise self.fail(
                     u.line, f"{u.head} before {close} (opened at line {opener.line}); add {close}"
                 )
+            if up in ("CONST", "PERS", "VAR") and inside.startswith("PROC"):
+                self.take()
+                self.local_declaration(u)
+                continue
             body.append(self.statement(inside))
 
-    def skip_block(self, opener: Unit, close: str, *, refuse_motion: bool = True) -> Unit:
-        """A conditional block kept verbatim; a move inside it is refused."""
+    def local_declaration(self, u: Unit) -> None:
+        """Data declared in a routine: a ``CONST num`` joins the names; the rest is not read."""
+        m = _DECL.match(u.text)
+        if m is None:
+            raise self.fail(u.line, f"cannot read the declaration {u.text[:60]!r}")
+        storage, type_, name, dims, value = m.groups()
+        if storage.upper() == "CONST" and type_.lower() == "num" and not dims and value is not None:
+            self.names.nums[name.lower()] = _real(
+                self.path, u.line, value, self.names, f"the value of {name}"
+            )
+
+    def find_end(self, opener: Unit, close: str) -> int:
+        """Index of the unit that closes the block just opened (nested blocks skipped)."""
         depth = 1
-        while True:
-            u = self.peek()
-            if u is None:
-                raise self.fail(opener.line, f"{opener.head.upper()} is not closed; add {close}")
-            self.take()
-            head = u.head
-            up = head.upper()
-            if up in BLOCK_CLOSE and u.text.rstrip().upper().endswith(("THEN", "DO")) or up == "TEST":
+        for k in range(self.pos, len(self.units)):
+            u = self.units[k]
+            up = u.head.upper()
+            if _opens_nested(u):
                 depth += 1
             elif up in BLOCK_CLOSE.values():
                 depth -= 1
                 if depth == 0:
-                    return u
+                    if up != close:
+                        raise self.fail(
+                            u.line,
+                            f"{u.head} closes {opener.head.upper()} (line {opener.line}); write {close}",
+                        )
+                    return k
             elif up in ("ENDPROC", "ENDMODULE"):
-                raise self.fail(u.line, f"{head} before {close} (opened at line {opener.line}); add {close}")
-            elif refuse_motion and (head in MOVES or OTHER_MOTION.match(head) or head.lower() in self.procs):
+                break
+        raise self.fail(opener.line, f"{opener.head.upper()} is not closed; add {close}")
+
+    def skip_block(self, opener: Unit, close: str, *, refuse_motion: bool = True) -> Unit:
+        """A block kept verbatim; a move inside it is refused."""
+        end = self.find_end(opener, close)
+        for u in self.units[self.pos : end]:
+            if refuse_motion and self.is_motion(u):
                 raise self.fail(
                     u.line,
-                    f"{head} inside {opener.head.upper()} (line {opener.line}): moves or calls under a "
+                    f"{u.head} inside {opener.head.upper()} (line {opener.line}): moves or calls under a "
                     "condition or a WHILE loop are not supported; take them out of the block",
                 )
+        self.pos = end + 1
+        return self.units[end]
 
     def has_motion(self) -> bool:
         """Whether the block just opened holds a move or a call; reads nothing."""
         depth = 1
         for u in self.units[self.pos :]:
-            head = u.head
-            up = head.upper()
-            if up in BLOCK_CLOSE and u.text.rstrip().upper().endswith(("THEN", "DO")) or up == "TEST":
+            up = u.head.upper()
+            if _opens_nested(u):
                 depth += 1
             elif up in BLOCK_CLOSE.values():
                 depth -= 1
@@ -708,7 +1176,7 @@ class _Reader:
                     return False
             elif up in ("ENDPROC", "ENDMODULE"):
                 return False  # the unclosed block is refused by whoever reads it
-            elif head in MOVES or OTHER_MOTION.match(head) or head.lower() in self.procs:
+            elif self.is_motion(u):
                 return True
             elif up == "IF" and any(
                 OTHER_MOTION.match(w) or w.lower() in self.procs for w in re.findall(r"[A-Za-z]\w*", u.text)
@@ -765,6 +1233,165 @@ class _Reader:
             end = self.skip_block(u, "ENDFOR", refuse_motion=False)
         return ForLoop(u.line, end.end_line, var, values, tuple(runs))
 
+    def branches(self, opener: Unit, close: str, heads: tuple[str, ...]) -> list[tuple[Unit, int, int]]:
+        """The parts of an IF / TEST just opened: (its first unit, first body index, end index)."""
+        end = self.find_end(opener, close)
+        parts: list[tuple[Unit, int, int]] = []
+        start, first, depth = opener, self.pos, 0
+        for k in range(self.pos, end):
+            u = self.units[k]
+            up = u.head.upper()
+            if depth == 0 and up in heads:
+                parts.append((start, first, k))
+                start, first = u, k + 1
+            if _opens_nested(u):
+                depth += 1
+            elif up in BLOCK_CLOSE.values():
+                depth -= 1
+        parts.append((start, first, end))
+        return parts
+
+    def choose(self, u: Unit) -> Branch:
+        """An IF / TEST with moves inside: the branch its constant condition picks is read, the others not."""
+        up = u.head.upper()
+        close = BLOCK_CLOSE[up]
+        motion = next((v for v in self.units[self.pos : self.find_end(u, close)] if self.is_motion(v)), u)
+
+        def evaluate(text: str) -> tuple[float | bool, dict[str, str]]:
+            seen: dict[str, str] = {}
+            try:
+                return _evaluate(self.path, u.line, text, self.names, "the condition", seen), seen
+            except RapidError as err:
+                reason = str(err).split(": ", 2)[-1]
+                raise self.fail(
+                    motion.line,
+                    f"{motion.head} inside {up} (line {u.line}): {reason}; moves under a condition known "
+                    "only while the program runs are not modelled (or take them out of the block)",
+                ) from None
+
+        def shown(text: str, value: float | bool, seen: dict[str, str]) -> str:
+            text = text.strip()
+            if _IDENT.match(text) or not seen:
+                return f"{text} ({_show(value)})"
+            return f"{text} ({', '.join(f'{k} = {v}' for k, v in seen.items())}: {_show(value)})"
+
+        chosen: tuple[Unit, int, int] | None = None
+        said: list[str] = []
+        if up == "IF":
+            parts = self.branches(u, close, ("ELSEIF", "ELSE"))
+            for part, first, last in parts:
+                kind = part.head.upper()
+                if kind == "ELSE":
+                    chosen = (part, first, last)
+                    break
+                cond = re.sub(r"^\s*(?:ELSE)?IF\s+|\s+THEN\s*$", "", part.text, flags=re.IGNORECASE)
+                value, seen = evaluate(cond)
+                if not isinstance(value, bool):
+                    raise self.fail(
+                        part.line, f"the condition {cond.strip()!r} is a number; write a comparison"
+                    )
+                said.append(f"{kind} {shown(cond, value, seen)}")
+                if value:
+                    chosen = (part, first, last)
+                    break
+        else:
+            parts = self.branches(u, close, ("CASE", "DEFAULT"))
+            subject = u.text.strip()[4:].strip()
+            value, seen = evaluate(subject)
+            said.append(f"TEST {shown(subject, value, seen)}")
+            for part, first, last in parts[1:]:
+                if part.head.upper() == "DEFAULT":
+                    chosen = (part, first, last)
+                    break
+                labels = part.text.strip()[4:].rstrip(":").strip()
+                cases = [evaluate(c)[0] for c in _split_args(self.path, part.line, labels)]
+                if any(
+                    type(c) is type(value)
+                    and (c == value if isinstance(c, bool) else abs(float(c) - float(value)) <= 1e-9)
+                    for c in cases
+                ):
+                    chosen = (part, first, last)
+                    break
+        end = self.units[parts[-1][2]]
+        body: list[Statement] = []
+        if chosen is None:
+            where = "no branch (nothing runs)"
+        else:
+            part, first, last = chosen
+            head = part.head.upper()
+            where = "THEN branch" if head == "IF" else f"{head} branch"
+            if head != "IF" and (head != "ELSE" or up == "TEST"):
+                where += f" (line {part.line})"
+            self.pos = first
+            while self.pos < last:
+                body.append(self.statement(f"{up} (line {u.line})"))
+        self.pos = parts[-1][2] + 1
+        note = f"line {u.line}: {', '.join(said)} -> {where}"
+        return Branch(u.line, end.end_line, note, tuple(body))
+
+    def call(self, u: Unit, head: str) -> Call:
+        """A call: without arguments as it is; with arguments, the procedure read with them bound."""
+        rest = u.text[len(head) :].rstrip(";").strip()
+        routine = self.routines[head.lower()]
+        name = routine.unit.head
+        if not rest and not routine.params:
+            return Call(u.line, u.end_line, head)
+        if rest.startswith("\\") or "\\" in rest and _top_level_backslash(rest) >= 0:
+            raise self.fail(
+                u.line,
+                f"call of {head} with optional arguments (\\...) is not supported; "
+                "pass every argument by position",
+            )
+        args = _split_args(self.path, u.line, rest) if rest else []
+        if len(args) != len(routine.params):
+            raise self.fail(
+                u.line,
+                f"{head} takes {len(routine.params)} argument(s) (line {routine.unit.line}), got {len(args)}",
+            )
+        if head.lower() in self.stack:
+            raise self.fail(u.line, f"{head} calls itself (through {' -> '.join(self.stack)}); not supported")
+        bound: dict[str, Binding] = {}
+        for (type_, pname), text in zip(routine.params, args, strict=True):
+            what = f"argument {pname} of {head}"
+            if type_ in ("num", "bool"):
+                value = _evaluate(self.path, u.line, text, self.names, f"the {what}")
+                if isinstance(value, bool) != (type_ == "bool"):
+                    raise self.fail(u.line, f"the {what} must be a {type_}, got {text!r}")
+                bound[pname.lower()] = value
+            elif type_ in ("robtarget", "jointtarget"):
+                bound[pname.lower()] = _target_ref(self.path, u.line, text, self.names, f"the {what}")
+            elif type_ in ARGUMENT_TYPES:
+                at = _array_element(self.path, u.line, text, self.names)
+                if at is not None:
+                    bound[pname.lower()] = f"{at[0]}{{{at[1]}}}"
+                elif not _IDENT.match(text):
+                    raise self.fail(u.line, f"the {what} must be a declared {type_} name, got {text[:40]!r}")
+                else:
+                    bound[pname.lower()] = _name_argument(self.path, u.line, text, self.names, type_)
+        size = routine.end - routine.start
+        self.expanded += size
+        if self.expanded > MAX_EXPANDED:
+            raise self.fail(
+                u.line,
+                f"the calls of procedures with parameters read more than {MAX_EXPANDED} "
+                "statements; call them fewer times",
+            )
+        sub = _Reader(
+            self.path,
+            self.units,
+            self.procs,
+            self.names.called(bound),
+            self.source,
+            self.routines,
+            routine.start + 1,
+            self.unrolled,
+            self.expanded,
+            (*self.stack, head.lower()),
+        )
+        body, _ = sub.block("ENDPROC", routine.unit, inside=f"PROC {name}")
+        self.unrolled, self.expanded = sub.unrolled, sub.expanded
+        return Call(u.line, u.end_line, head, tuple(args), tuple(body))
+
     def statement(self, inside: str) -> Statement:
         u = self.take()
         head = u.head
@@ -776,132 +1403,244 @@ class _Reader:
                 raise self.fail(u.line, "WHILE TRUE is read as the cycle only directly in PROC main")
             body, end = self.block("ENDWHILE", u, inside="WHILE TRUE")
             return WhileTrue(u.line, end.end_line, tuple(body))
+        if up in ("IF", "TEST") and (u.text.rstrip().upper().endswith("THEN") or up == "TEST"):
+            if self.has_motion():
+                return self.choose(u)
+            end = self.skip_block(u, BLOCK_CLOSE[up])
+            return Verbatim(u.line, end.end_line, up)
         if up in BLOCK_CLOSE and (u.text.rstrip().upper().endswith(("THEN", "DO")) or up == "TEST"):
             end = self.skip_block(u, BLOCK_CLOSE[up])
             return Verbatim(u.line, end.end_line, up)
         if up == "IF":  # compact IF: IF condition instruction;
             words = set(re.findall(r"[A-Za-z]\w*", u.text))
             if any(OTHER_MOTION.match(w) or w.lower() in self.procs for w in words):
-                raise self.fail(u.line, "a move or call under IF is not supported; take it out of the IF")
+                raise self.fail(
+                    u.line, "a move or call in a compact IF is not supported; write IF ... THEN ... ENDIF"
+                )
             return Verbatim(u.line, u.end_line, "IF")
+        if up in ("ERROR", "UNDO", "BACKWARD"):
+            raise self.fail(u.line, f"{head} handler inside {inside}; it goes at the end of the routine")
         if up in ("ELSE", "ELSEIF", "CASE", "DEFAULT", "ENDIF", "ENDFOR", "ENDWHILE", "ENDTEST"):
             raise self.fail(u.line, f"{head} without its opening block")
         if up in ("MODULE", "PROC", "FUNC", "TRAP") or up in ("CONST", "PERS", "VAR"):
             raise self.fail(u.line, f"{head} inside {inside}; close {inside} first")
         if not u.text.endswith(";"):
             raise self.fail(u.line, f"cannot read {u.text[:50]!r}; an instruction ends with ';'")
-        if head in MOVES:
-            return _move(self.path, u, self.names)
-        for m in MOVES:
-            if head.lower() == m.lower():
-                raise self.fail(u.line, f"{head}: write {m} (RAPID names are read as written here)")
+        if head.lower() in _MOVES_LOWER:
+            return _move(self.path, u, self.names, _MOVES_LOWER[head.lower()])
         if OTHER_MOTION.match(head):
             raise self.fail(
                 u.line, f"{head} is not supported (joulepath reads MoveAbsJ, MoveJ and MoveL); replace it"
             )
         if head.lower() == "waittime":
-            return _wait(self.path, u, self.names)
+            return _wait(self.path, u, self.names, self.source)
         for s in MOTION_SETTINGS:
             if head.lower() == s.lower():
                 if s in ("ConfJ", "ConfL") and re.search(r"\\\s*On\b", u.text, re.IGNORECASE):
                     return Verbatim(u.line, u.end_line, s)
-                raise self.fail(
-                    u.line, f"{s} changes how the robot moves and is not modelled; remove it to optimize"
-                )
+                fix = MOTION_FIXES.get(s, "remove it to optimize")
+                raise self.fail(u.line, f"{s} changes how the robot moves and is not modelled; {fix}")
         if head.lower() in self.procs:
-            if u.text.rstrip(";").strip().lower() != head.lower():
-                raise self.fail(u.line, f"call of {head} with arguments is not supported; call it without")
-            return Call(u.line, u.end_line, head)
+            return self.call(u, head)
         if not _IDENT.match(head):
             raise self.fail(u.line, f"cannot read {u.text[:50]!r}")
         return Verbatim(u.line, u.end_line, head)
+
+
+_MOVES_LOWER = {m.lower(): m for m in MOVES}
+
+
+def _opens_nested(u: Unit) -> bool:
+    up = u.head.upper()
+    return (up in BLOCK_CLOSE and u.text.rstrip().upper().endswith(("THEN", "DO"))) or up == "TEST"
+
+
+def _blank_header(path: str, text: str) -> str:
+    """A saved module's ``%%% VERSION:1 LANGUAGE:ENGLISH %%%`` header as blank lines (numbers kept)."""
+    lines = text.split("\n")
+    first = next((k for k, t in enumerate(lines) if t.strip()), None)
+    if first is None or lines[first].strip() != "%%%":
+        return text
+    close = next((k for k in range(first + 1, len(lines)) if lines[k].strip() == "%%%"), None)
+    if close is None:
+        raise RapidError(f"{path}:{first + 1}: the %%% header is not closed; add a line %%% after it")
+    return "\n".join([""] * (close + 1) + lines[close + 1 :])
+
+
+def _assignments(units: list[Unit]) -> dict[str, tuple[int, str]]:
+    """Names some statement assigns (``x := ...``, ``Incr x``, ``TPReadNum x, ...``): their first line."""
+    out: dict[str, tuple[int, str]] = {}
+    writers = {w.lower() for w in WRITES_FIRST_ARGUMENT}
+    for u in units:
+        if u.head.upper() in ("CONST", "PERS", "VAR", "PROC", "FUNC", "TRAP", "MODULE"):
+            continue
+        m = _ASSIGN.match(u.text)
+        if m:
+            out.setdefault(m.group(1).lower(), (u.line, u.text))
+        elif u.head.lower() in writers:
+            rest = u.text[len(u.head) :].strip()
+            w = re.match(r"([A-Za-z]\w*)", rest)
+            if w:
+                out.setdefault(w.group(1).lower(), (u.line, u.text))
+    return out
+
+
+def _routines(path: str, units: list[Unit]) -> tuple[list[tuple[Unit, int, int]], list[Unit]]:
+    """Module level: its routines (opener, index, index of the closing unit) and declarations."""
+    routines: list[tuple[Unit, int, int]] = []
+    decls: list[Unit] = []
+    i = 0
+    while i < len(units):
+        u = units[i]
+        head = u.head.upper()
+        if head in ("CONST", "PERS", "VAR"):
+            decls.append(u)
+            i += 1
+            continue
+        if head not in ("PROC", "FUNC", "TRAP"):
+            raise RapidError(
+                f"{path}:{u.line}: {u.text[:40]!r} at module level; only declarations and routines go there"
+            )
+        close = "END" + head
+        j = i + 1
+        while j < len(units) and units[j].head.upper() != close:
+            v = units[j]
+            if v.head.upper() in ("PROC", "FUNC", "TRAP", "ENDPROC", "ENDFUNC", "ENDTRAP"):
+                raise RapidError(
+                    f"{path}:{v.line}: {v.head} inside {head} (line {u.line}); add {close} before it"
+                )
+            j += 1
+        if j == len(units):
+            raise RapidError(f"{path}:{u.line}: {head} is not closed; add {close}")
+        routines.append((u, i, j))
+        i = j + 1
+    return routines, decls
+
+
+def _params(path: str, u: Unit, text: str) -> tuple[tuple[str, str], ...]:
+    if not text:
+        return ()
+    out = []
+    for item in re.split(r"\s*[,|]\s*", text):
+        m = _PARAM.match(item.strip())
+        if m is None:
+            raise RapidError(
+                f"{path}:{u.line}: cannot read the parameter {item.strip()!r}; write 'type name' (optional "
+                "\\parameters and arrays are not supported)"
+            )
+        out.append((m.group(2).lower(), m.group(3)))
+    return tuple(out)
 
 
 def parse_module(text: str, *, path: str = "<program>") -> Module:
     """Read a RAPID module (the subset above); ``RapidError`` naming the line otherwise."""
     if "\x00" in text:
         raise RapidError(f"{path}:1: the file holds NUL bytes; it is not a RAPID text file")
-    units = split_units(path, text)
+    units = split_units(path, _blank_header(path, text))
     if not units:
         raise RapidError(f"{path}:1: the file is empty; a RAPID module starts with MODULE name")
     first = units[0]
     m = re.fullmatch(r"MODULE\s+([A-Za-z]\w*)\s*(\([^)]*\))?", first.text, re.IGNORECASE)
     if first.head.upper() != "MODULE" or not m:
         raise RapidError(f"{path}:{first.line}: expected 'MODULE name', got {first.text[:40]!r}")
-    if units[-1].head.upper() != "ENDMODULE":
+    if len(units) < 2 or units[-1].head.upper() != "ENDMODULE":
         raise RapidError(f"{path}:{units[-1].end_line}: the module does not end with ENDMODULE; add it")
-    for u in units[1:-1]:
+    inner = units[1:-1]
+    for u in inner:
         if u.head.upper() in ("MODULE", "ENDMODULE"):
             raise RapidError(f"{path}:{u.line}: {u.head} inside the module; one module per file")
-    procs = set()
-    for u in units:
-        pm = re.fullmatch(r"(?:LOCAL\s+)?PROC\s+([A-Za-z]\w*)\s*\(\s*(.*?)\s*\)", u.text, re.IGNORECASE)
-        if u.head.upper() == "PROC":
-            if not pm:
-                raise RapidError(f"{path}:{u.line}: expected 'PROC name()', got {u.text[:40]!r}")
-            if pm.group(1).lower() in procs:
-                raise RapidError(f"{path}:{u.line}: PROC {pm.group(1)} is defined twice; rename one")
-            procs.add(pm.group(1).lower())
-    decls: list[Declaration] = []
-    names: dict[str, int] = {}
-    scope = Names()
+    found, decl_units = _routines(path, inner)
+    routines: dict[str, _Routine] = {}
+    for u, start, end in found:
+        if u.head.upper() != "PROC":
+            continue
+        pm = _PROC_LINE.fullmatch(u.text)
+        if not pm:
+            raise RapidError(f"{path}:{u.line}: expected 'PROC name()', got {u.text[:40]!r}")
+        if pm.group(1).lower() in routines:
+            raise RapidError(f"{path}:{u.line}: PROC {pm.group(1)} is defined twice; rename one")
+        routines[pm.group(1).lower()] = _Routine(u, start, end, _params(path, u, pm.group(2)))
+    scope = Names(assigned=_assignments(inner))
+    source = tuple(text.splitlines())
+    decls = _declarations(path, decl_units, scope)
     procedures: list[Procedure] = []
-    reader = _Reader(path, units[1:-1], procs, scope)
-    while (cur := reader.peek()) is not None:
-        u = cur
-        head = u.head.upper()
-        if head in ("CONST", "PERS", "VAR"):
-            reader.take()
-            d = _declaration(path, u)
-            dm = _DECL.match(u.text)
-            name = dm.group(3).lower() if dm else ""
-            if name in names:
-                raise RapidError(f"{path}:{u.line}: {name} is declared twice (first at line {names[name]})")
-            names[name] = u.line
-            if d is not None:
-                decls.append(d)
-                if d.type == "num" and isinstance(d.value, float) and d.storage == "CONST":
-                    scope.nums[d.name.lower()] = d.value
-                if isinstance(d.value, tuple):
-                    scope.arrays[d.name.lower()] = (d.storage, d.type, d.value)
-        elif head == "PROC":
-            reader.take()
-            pm = re.fullmatch(r"(?:LOCAL\s+)?PROC\s+([A-Za-z]\w*)\s*\(\s*(.*?)\s*\)", u.text, re.IGNORECASE)
-            assert pm is not None
-            if pm.group(2):
-                raise RapidError(f"{path}:{u.line}: PROC {pm.group(1)} has parameters; not supported")
-            body, end = reader.block("ENDPROC", u, inside=f"PROC {pm.group(1)}")
-            procedures.append(Procedure(u.line, end.end_line, pm.group(1), tuple(body)))
-        elif head in ("FUNC", "TRAP"):
-            reader.take()
-            close = "END" + head
-            while (v := reader.peek()) is not None and v.head.upper() != close:
-                if v.head.upper() in ("PROC", "FUNC", "TRAP", "ENDPROC"):
-                    raise RapidError(f"{path}:{v.line}: {v.head} inside {head} (line {u.line}); add {close}")
-                reader.take()
-            if v is None:
-                raise RapidError(f"{path}:{u.line}: {head} is not closed; add {close}")
-            reader.take()
-        else:
-            raise RapidError(
-                f"{path}:{u.line}: {u.text[:40]!r} at module level; only declarations and routines go there"
-            )
+    reader = _Reader(path, inner, set(routines), scope, source, routines)
+    for key, routine in routines.items():
+        u = routine.unit
+        name = _PROC_LINE.fullmatch(u.text).group(1)  # type: ignore[union-attr]
+        if routine.params:  # read at each call, with its arguments bound
+            procedures.append(Procedure(u.line, inner[routine.end].end_line, name, (), routine.params))
+            continue
+        reader.names = scope.called({})
+        reader.pos = routine.start + 1
+        reader.stack = (key,)
+        body, end = reader.block("ENDPROC", u, inside=f"PROC {name}")
+        procedures.append(Procedure(u.line, end.end_line, name, tuple(body)))
     module = Module(m.group(1), tuple(decls), tuple(procedures), tuple(text.splitlines()), path)
-    if module.procedure("main") is None:
+    main = module.procedure("main")
+    if main is None:
         raise RapidError(f"{path}:{first.line}: the module has no PROC main(); the cycle is read from main")
+    if main.params:
+        raise RapidError(f"{path}:{main.line}: PROC main has parameters; the cycle starts at main()")
     _check_calls(module)
     return module
 
 
+def _declarations(path: str, units: list[Unit], scope: Names) -> list[Declaration]:
+    """The module's data: nums and bools first (targets may use them), then the rest in order."""
+    seen: dict[str, int] = {}
+    for u in units:
+        dm = _DECL.match(u.text)
+        name = dm.group(3).lower() if dm else ""
+        if name in seen:
+            raise RapidError(f"{path}:{u.line}: {name} is declared twice (first at line {seen[name]})")
+        seen[name] = u.line
+    by_line: dict[int, Declaration] = {}
+    for numeric in (True, False):
+        for u in units:
+            dm = _DECL.match(u.text)
+            type_ = dm.group(2).lower() if dm else ""
+            if (type_ in ("num", "bool")) != numeric:
+                continue
+            if type_ == "bool":
+                _bool_declaration(path, u, dm, scope)
+                continue
+            d = _declaration(path, u, scope)
+            if d is None:
+                continue
+            by_line[u.line] = d
+            constant = d.storage in ("CONST", "PERS") and d.name.lower() not in scope.assigned
+            if d.type == "num" and isinstance(d.value, float) and constant:
+                scope.nums[d.name.lower()] = d.value
+            if isinstance(d.value, tuple):
+                scope.arrays[d.name.lower()] = (d.storage, d.type, d.value)
+    return [by_line[k] for k in sorted(by_line)]
+
+
+def _bool_declaration(path: str, u: Unit, dm: re.Match[str] | None, scope: Names) -> None:
+    assert dm is not None
+    storage, _, name, dims, value = dm.groups()
+    if dims or value is None or storage.upper() == "VAR" or name.lower() in scope.assigned:
+        return
+    try:
+        v = _evaluate(path, u.line, value, scope, f"the value of {name}")
+    except RapidError:
+        return
+    if isinstance(v, bool):
+        scope.bools[name.lower()] = v
+
+
 def _statements(body: tuple[Statement, ...]) -> Iterator[Statement]:
-    """Every statement of a body, those inside WHILE TRUE and every run of a FOR loop included."""
+    """Every statement of a body: inside WHILE TRUE, every run of a FOR loop, chosen branches, calls read."""
     for s in body:
         yield s
-        if isinstance(s, WhileTrue):
+        if isinstance(s, WhileTrue | Branch):
             yield from _statements(s.body)
         elif isinstance(s, ForLoop):
             for run in s.runs:
                 yield from _statements(run)
+        elif isinstance(s, Call) and s.body is not None:
+            yield from _statements(s.body)
 
 
 def _check_calls(module: Module) -> None:
@@ -911,22 +1650,26 @@ def _check_calls(module: Module) -> None:
     loops = [s for s in main.body if isinstance(s, WhileTrue)]
     if len(loops) > 1:
         raise module.error(loops[1].line, "a second WHILE TRUE in main; the cycle is one loop")
+    done: set[str] = set()
 
-    def visit(proc: Procedure, stack: tuple[str, ...]) -> None:
+    def visit(body: tuple[Statement, ...], stack: tuple[str, ...]) -> None:
         calls: dict[str, Call] = {}  # each callee once (a FOR loop repeats its calls)
-        for s in _statements(proc.body):
-            if isinstance(s, Call):
+        for s in _statements(body):
+            if isinstance(s, Call) and s.body is None:
                 calls.setdefault(s.name.lower(), s)
         for s in calls.values():
             if s.name.lower() in stack:
                 raise module.error(
                     s.line, f"{s.name} calls itself (through {' -> '.join(stack)}); not supported"
                 )
+            if s.name.lower() in done:
+                continue
             callee = module.procedure(s.name)
             assert callee is not None
-            visit(callee, (*stack, callee.name.lower()))
+            visit(callee.body, (*stack, callee.name.lower()))
+            done.add(s.name.lower())
 
-    visit(main, ("main",))
+    visit(main.body, ("main",))
 
 
 def read_module(path: str | Path) -> Module:

@@ -13,7 +13,8 @@ are taken into account (targets are TCP poses, the load is carried in the dynami
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass
+from collections.abc import Collection
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,7 @@ from joulepath.errors import InvalidInput
 from joulepath.kinematics import quaternion_to_rotation
 from joulepath.kinematics._ik import check_layout, confdata, solve_ik
 from joulepath.program._model import (
+    Branch,
     Call,
     ForLoop,
     JointTarget,
@@ -32,19 +34,25 @@ from joulepath.program._model import (
     RapidError,
     RobTarget,
     Statement,
+    TargetRef,
     ToolData,
     Verbatim,
     WaitTime,
     WhileTrue,
+    WObjData,
     ZoneData,
 )
-from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES, TOOL0, read_module
+from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES, TOOL0, WOBJ0, read_module
 from joulepath.sim._steps import SpeedData, Step
 
 
 @dataclass(frozen=True, slots=True, eq=False)
 class CycleSpec:
-    """The cycle: its steps, where it starts (rad), and where it came from."""
+    """The cycle: its steps, where it starts (rad), and where it came from.
+
+    ``choices``: for each IF / TEST with moves inside, which branch the cycle runs and
+    why (e.g. ``"line 12: IF bDoubleGrip (FALSE) -> ELSE branch"``), in program order.
+    """
 
     steps: tuple[Step, ...]
     start: FloatArray
@@ -52,6 +60,7 @@ class CycleSpec:
     module: Module | None
     fixed_lines: tuple[int, ...]
     robot: Robot
+    choices: tuple[str, ...] = field(default=())
 
 
 def tool_transform(tool: ToolData) -> FloatArray:
@@ -78,7 +87,11 @@ def _size(module: Module, body: tuple[Statement, ...], memo: dict[str, int]) -> 
     """How many statements :func:`_flatten` gives, without building them (each procedure counted once)."""
     n = 0
     for s in body:
-        if isinstance(s, Call):
+        if isinstance(s, Call) and s.body is not None:
+            n += _size(module, s.body, memo)
+        elif isinstance(s, Branch):
+            n += _size(module, s.body, memo)
+        elif isinstance(s, Call):
             key = s.name.lower()
             if key not in memo:
                 proc = module.procedure(s.name)
@@ -96,18 +109,26 @@ def _size(module: Module, body: tuple[Statement, ...], memo: dict[str, int]) -> 
     return n
 
 
-def _flatten(module: Module, body: tuple[Statement, ...]) -> list[Statement]:
+def _flatten(module: Module, body: tuple[Statement, ...], notes: list[str]) -> list[Statement]:
+    """The statements the cycle runs, in order; ``notes`` gets the branch choices made on the way."""
     out: list[Statement] = []
     for s in body:
         if isinstance(s, Call):
+            if s.body is not None:  # read with its arguments bound
+                out.extend(_flatten(module, s.body, notes))
+                continue
             proc = module.procedure(s.name)
             assert proc is not None
-            out.extend(_flatten(module, proc.body))
+            out.extend(_flatten(module, proc.body, notes))
         elif isinstance(s, WhileTrue):
-            out.extend(_flatten(module, s.body))
+            out.extend(_flatten(module, s.body, notes))
+        elif isinstance(s, Branch):
+            if s.note not in notes:
+                notes.append(s.note)
+            out.extend(_flatten(module, s.body, notes))
         elif isinstance(s, ForLoop):  # unrolled: every run in order
             for run in s.runs:
-                out.extend(_flatten(module, run))
+                out.extend(_flatten(module, run, notes))
         else:
             out.append(s)
     return out
@@ -132,6 +153,8 @@ def _lookup(module: Module, name: str, type_: str, line: int) -> object:
             return PREDEFINED_ZONES[name.lower()]
         if type_ == "tooldata" and name.lower() == "tool0":
             return TOOL0
+        if type_ == "wobjdata" and name.lower() == "wobj0":
+            return WOBJ0
         if type_ in ("robtarget", "jointtarget"):
             raise module.error(line, f"unknown target {name!r}: declare it (CONST {type_} {name} := [...])")
         raise module.error(line, f"unknown {type_} {name!r}: declare it or use a predefined one")
@@ -140,8 +163,13 @@ def _lookup(module: Module, name: str, type_: str, line: int) -> object:
     return d.value
 
 
-def resolve_module(module: Module, robot: Robot) -> CycleSpec:
-    """The cycle of a parsed module on ``robot``; ``RapidError`` naming the line otherwise."""
+def resolve_module(module: Module, robot: Robot, *, idle_waits: Collection[int] = ()) -> CycleSpec:
+    """The cycle of a parsed module on ``robot``; ``RapidError`` naming the line otherwise.
+
+    A ``WaitTime`` is idle time (``Step.idle``: an optimizer may spend it on the moves)
+    when it is marked ``! joulepath: idle`` or its line is in ``idle_waits``; every run
+    of it is (a procedure called twice, a FOR loop).
+    """
     main = module.procedure("main")
     assert main is not None
     loop = next((s for s in main.body if isinstance(s, WhileTrue)), None)
@@ -153,7 +181,16 @@ def resolve_module(module: Module, robot: Robot) -> CycleSpec:
             f"main runs more than {MAX_STEPS} statements once its calls and FOR loops are unrolled; "
             "run fewer repetitions",
         )
-    flat = _flatten(module, body)
+    notes: list[str] = []
+    flat = _flatten(module, body, notes)
+    wait_lines = {s.line for s in flat if isinstance(s, WaitTime)}
+    for line in sorted(set(idle_waits)):
+        if line not in wait_lines:
+            raise module.error(
+                line,
+                f"idle_waits names line {line}, which is not a WaitTime the cycle runs; name the line of "
+                "a WaitTime (or mark it '! joulepath: idle')",
+            )
     lo, hi = robot.joint_ranges()
     counts: dict[int, int] = {}
     for s in flat:
@@ -163,7 +200,9 @@ def resolve_module(module: Module, robot: Robot) -> CycleSpec:
     fixed: list[int] = []
     for s in flat:
         if isinstance(s, WaitTime):
-            steps.append(Step("wait", s.line, f"WaitTime {s.seconds:g}", s, seconds=s.seconds))
+            idle = s.idle or s.line in idle_waits
+            label = ("WaitTime \\InPos, " if s.inpos else "WaitTime ") + f"{s.seconds:g}"
+            steps.append(Step("wait", s.line, label, s, seconds=s.seconds, idle=idle))
         elif isinstance(s, Verbatim):
             steps.append(Step("fixed", s.line, s.text, s))
             fixed.append(s.line)
@@ -176,7 +215,7 @@ def resolve_module(module: Module, robot: Robot) -> CycleSpec:
             loop.line if loop is not None else main.line, f"{where} holds no move; nothing to optimize"
         )
     assert moves[-1].q is not None
-    return CycleSpec(tuple(steps), moves[-1].q.copy(), module.path, module, tuple(fixed), robot)
+    return CycleSpec(tuple(steps), moves[-1].q.copy(), module.path, module, tuple(fixed), robot, tuple(notes))
 
 
 def _move_step(
@@ -206,6 +245,12 @@ def _move_step(
             else robot
         )
     if s.instruction == "MoveAbsJ":
+        if s.target_ref is not None:
+            raise module.error(
+                s.line,
+                f"MoveAbsJ {s.target}: Offs and RelTool compute robtargets; "
+                "MoveAbsJ goes to a jointtarget, so use MoveJ",
+            )
         jt = _lookup(module, s.target, "jointtarget", s.line)
         assert isinstance(jt, JointTarget)
         q = np.radians(np.asarray(jt.joints_deg[: robot.n_joints], dtype=float))
@@ -218,9 +263,10 @@ def _move_step(
                 f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg",
             )
     else:
-        rt = _lookup(module, s.target, "robtarget", s.line)
-        assert isinstance(rt, RobTarget)
-        q = robtarget_joints(module, robot, rt, tcp, s)
+        rt, pose = target_in_object(module, s.target_ref or TargetRef(s.target), s.line, ())
+        if s.wobj is not None:
+            pose = wobj_transform(module, s.wobj, s.line) @ pose
+        q = robtarget_joints(module, robot, rt, tcp, s, pose=pose)
     return Step(
         "move",
         s.line,
@@ -237,22 +283,98 @@ def _move_step(
     )
 
 
-def robtarget_joints(module: Module, robot: Robot, rt: RobTarget, tcp: FloatArray, s: Move) -> FloatArray:
-    """Joint values of a robtarget with its confdata; ``RapidError`` if unreachable or no solution fits."""
+def _frame(position_mm: tuple[float, ...], quaternion: tuple[float, ...]) -> FloatArray:
+    out = np.eye(4)
+    out[:3, :3] = quaternion_to_rotation(np.asarray(quaternion, dtype=float))
+    out[:3, 3] = np.asarray(position_mm, dtype=float) / 1000.0
+    return out
+
+
+def _rotation(axis: int, deg: float) -> FloatArray:
+    c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    out = np.eye(4)
+    out[i, i], out[i, j], out[j, i], out[j, j] = c, -s, s, c
+    return out
+
+
+def target_in_object(
+    module: Module, ref: TargetRef, line: int, seen: tuple[str, ...]
+) -> tuple[RobTarget, FloatArray]:
+    """A robtarget (its confdata) and its TCP pose in its work object (m), ``Offs`` / ``RelTool`` applied.
+
+    ``Offs`` adds its displacement in the work object's frame; ``RelTool`` moves in the
+    tool frame of the target and turns about its x, the new y and the new z axis.
+    """
+    if ref.name.lower() in seen:
+        raise module.error(line, f"the robtarget {ref.name} is computed from itself ({' -> '.join(seen)})")
+    d = module.declaration(ref.name.partition("{")[0])
+    if d is not None and isinstance(d.value, TargetRef) and "{" not in ref.name:
+        rt, pose = target_in_object(module, d.value, d.line, (*seen, ref.name.lower()))
+    else:
+        value = _lookup(module, ref.name, "robtarget", line)
+        assert isinstance(value, RobTarget)
+        rt, pose = value, target_pose(value)
+    for off in ref.offsets:
+        shift = np.asarray(off.displacement_mm, dtype=float) / 1000.0
+        if off.kind == "Offs":
+            pose = pose.copy()
+            pose[:3, 3] += shift
+        else:
+            step = np.eye(4)
+            step[:3, 3] = shift
+            pose = pose @ step @ _rotation(0, off.rotation_deg[0]) @ _rotation(1, off.rotation_deg[1])
+            pose = pose @ _rotation(2, off.rotation_deg[2])
+    return rt, pose
+
+
+def wobj_transform(module: Module, name: str, line: int) -> FloatArray:
+    """Base to object frame (``uframe * oframe``, m) of a fixed work object; moving ones are refused."""
+    wobj = _lookup(module, name, "wobjdata", line)
+    assert isinstance(wobj, WObjData)
+    if wobj.moving:
+        why = (
+            "robhold TRUE" if wobj.robhold else "ufprog FALSE" if not wobj.ufprog else f"ufmec {wobj.ufmec!r}"
+        )
+        raise module.error(
+            line,
+            f"work object {name} moves ({why}): coordinated or robot-held work objects are not modelled; "
+            'use a fixed wobjdata (robhold FALSE, ufprog TRUE, ufmec "")',
+        )
+    return _frame(*wobj.uframe) @ _frame(*wobj.oframe)
+
+
+def robtarget_joints(
+    module: Module,
+    robot: Robot,
+    rt: RobTarget,
+    tcp: FloatArray,
+    s: Move,
+    *,
+    pose: FloatArray | None = None,
+) -> FloatArray:
+    """Joint values of a robtarget with its confdata; ``RapidError`` if unreachable or no solution fits.
+
+    ``pose``: the TCP pose in the base frame (m) when it is not the robtarget's own
+    (a work object, ``Offs`` / ``RelTool``).
+    """
     try:
         check_layout(robot.chain)
     except InvalidInput as err:
         raise module.error(s.line, str(err)) from err
     lo, hi = robot.joint_ranges()
-    flange = target_pose(rt) @ np.linalg.inv(tcp)
+    if pose is None:
+        pose = target_pose(rt)
+    flange = pose @ np.linalg.inv(tcp)
     q = solve_ik(robot.chain, flange, rt.conf, lower=lo, upper=hi)
     if q is not None:
         return q
     anyq = solve_ik(robot.chain, flange, None, lower=lo, upper=hi, near=np.zeros(robot.n_joints))
+    where = [round(float(v), 3) for v in pose[:3, 3] * 1000.0]
     if anyq is None:
         raise module.error(
             s.line,
-            f"{s.target} at {list(rt.position_mm)} mm is out of the robot's reach with this orientation "
+            f"{s.target} at {where} mm is out of the robot's reach with this orientation "
             "and tool (no joint solution within the ranges); move the target",
         )
     from joulepath.kinematics._ik import ik_branches
@@ -360,8 +482,26 @@ def _joints(value: object, n: int, where: str) -> FloatArray:
 __all__ = ["CycleSpec", "RapidError", "Step", "read_cycle_toml", "resolve_module"]
 
 
-def read_cycle_program(path: str | Path, robot: Robot) -> tuple[CycleSpec, bool]:
-    """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID module."""
+def read_cycle_program(
+    path: str | Path, robot: Robot, *, idle_waits: Collection[int] = ()
+) -> tuple[CycleSpec, bool]:
+    """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID module.
+
+    ``idle_waits``: lines of ``WaitTime`` instructions that are idle time (see
+    :func:`resolve_module`); for a ``.toml`` file, numbers of ``wait_s`` steps.
+    """
     p = Path(path)
     rapid = p.suffix.lower() != ".toml"
-    return (resolve_module(read_module(p), robot) if rapid else read_cycle_toml(p, robot)), rapid
+    if rapid:
+        return resolve_module(read_module(p), robot, idle_waits=idle_waits), True
+    spec = read_cycle_toml(p, robot)
+    if not idle_waits:
+        return spec, False
+    steps = list(spec.steps)
+    for k in sorted(set(idle_waits)):
+        if not 1 <= k <= len(steps) or steps[k - 1].kind != "wait":
+            raise InvalidInput(
+                f"{p}: idle_waits names step {k}, which is not a wait_s step; name a wait step"
+            )
+        steps[k - 1] = replace(steps[k - 1], idle=True)
+    return replace(spec, steps=tuple(steps)), False

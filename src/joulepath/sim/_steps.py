@@ -31,7 +31,7 @@ class Step:
     For a move: the joint target (rad), whether the TCP moves on a straight line
     (``MoveL``), the speed, ``\\T`` (s), the zone radius (mm; None: a stop point), the
     tool (TCP in m as a 4x4 flange-to-TCP transform) and the robot carrying its load.
-    ``idle``: a wait the user declared idle time, which an optimizer may spend on the moves.
+    ``idle``: a wait the user declared idle time that an optimizer may spend on the moves.
     """
 
     kind: str
