@@ -70,7 +70,7 @@ ALLOWED = {
         "sim",
         "energy",
     },
-    "program": {"kinematics", "dynamics", "trajectory", "optimize", "sim", "energy"},
+    "program": {"kinematics", "dynamics", "trajectory", "optimize", "sim", "energy", "export"},
     "measure": {"data", "energy"},  # a log and a run folder's files in, measure.json out
     "energy": set(),
     "units": set(),

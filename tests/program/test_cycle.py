@@ -188,19 +188,24 @@ def test_cli_writes_a_program_that_reads_back(tmp_path, robot):
     prog = tmp_path / "small.mod"
     prog.write_text(SMALL.replace("MoveAbsJ jB, v800", "MoveAbsJ jB, v300"))
     out = tmp_path / "run"
-    args = ["--use-waits", "--knot-spacing", "0.1", "--table-points", "2", "--pareto", "--points", "3"]
-    rc = main(["cycle", str(prog), "--out", str(tmp_path / "strict"), *args])
+    args = ["--use-waits", "--idle-wait", "11", "--knot-spacing", "0.1", "--table-points", "2"]
+    args += ["--pareto", "--points", "3"]
+    rc = main(["cycle", str(prog), "--out", str(tmp_path / "strict"), "--export", "rapid", *args])
     strict = json.loads((tmp_path / "strict" / "cycle.json").read_text())
     if strict["written_program_matches_plan"]:
         assert rc == 0 and (tmp_path / "strict" / "optimized.mod").is_file()
     else:  # not written unless asked: the reason, with the emulated numbers, in cycle.json
         assert rc == 1 and not (tmp_path / "strict" / "optimized.mod").exists()
-        assert "do not reproduce the plan" in strict["rapid_refused"] and strict["rapid"] is None
+        assert "do not keep the plan" in strict["rapid_refused"] and strict["rapid"] is None
+        assert not (tmp_path / "strict" / "egm.mod").exists()
+    # the default (--export auto): RAPID where the emulation runs it, else the EGM module
+    assert main(["cycle", str(prog), "--out", str(tmp_path / "auto"), *args]) == 0
+    assert (tmp_path / "auto" / "optimized.mod").is_file() != (tmp_path / "auto" / "egm.mod").is_file()
     assert main(["cycle", str(prog), "--out", str(out), *args, "--write-anyway"]) == 0
     data = json.loads((out / "cycle.json").read_text())
     assert data["saved_pct"] == pytest.approx(strict["saved_pct"])  # same plan either way
     assert data["limits_ok"] and data["optimized_cycle_s"] <= data["target_cycle_s"] + 1e-9
-    assert data["waits"] == [{"line": 11, "default_s": 0.2, "optimized_s": 0.0}]
+    assert data["waits"] == [{"line": 11, "default_s": 0.2, "optimized_s": 0.0}]  # the idle wait
     assert data["kept_verbatim_lines"] == [14]
     assert (out / "pareto.csv").read_text().count("\n") == 3 + 2
     written = read_module(out / "optimized.mod")
@@ -210,13 +215,30 @@ def test_cli_writes_a_program_that_reads_back(tmp_path, robot):
     # the targets the original program stops at are reached by the optimized program too
     ends = {tuple(np.round(s.q, 6)) for s in moves}
     for s in original:
-        assert tuple(np.round(s.q, 6)) in ends
+        if s.zone_mm is None:
+            assert tuple(np.round(s.q, 6)) in ends
     # every written joint target within its range
     lo, hi = robot.joint_ranges()
     assert all(np.all(s.q >= lo - 1e-9) and np.all(s.q <= hi + 1e-9) for s in moves)
     # untouched statements are unchanged
     assert "MoveL pDown, v200, fine, tool0;" in (out / "optimized.mod").read_text()
     assert "SetDO doGrip, 1;" in (out / "optimized.mod").read_text()
+    # a wait not declared idle keeps its length
+    assert main(
+        [
+            "cycle",
+            str(prog),
+            "--out",
+            str(tmp_path / "w"),
+            "--use-waits",
+            "--knot-spacing",
+            "0.1",
+            "--table-points",
+            "2",
+        ]
+    ) in (0, 1)
+    kept = json.loads((tmp_path / "w" / "cycle.json").read_text())
+    assert kept["waits"] == [{"line": 11, "default_s": 0.2, "optimized_s": 0.2}]
 
 
 def test_plain_cycle_file(tmp_path, robot):
