@@ -59,6 +59,7 @@ from joulepath.sim._timing import (
     evaluate_cycle,
     plan_cycle,
 )
+from joulepath.sim._via import RAPID_ACCEL_SHARE
 from joulepath.sim._via import layout as via_layout
 from joulepath.trajectory import SplineBasis, Trajectory
 from joulepath.units import SAMPLE_PERIOD
@@ -95,6 +96,12 @@ class CycleSettings:
     verified allocation of what was solved is returned (taught motion elsewhere).
     ``retime_linear``: a ``MoveL`` that runs from rest to rest on its own is re-timed along
     its line (:func:`joulepath.optimize.retime_on_path`; its speeddata's TCP speed a bound).
+    ``follow``: what the controller follows: ``"samples"`` (a streamed trajectory, EGM) or
+    ``"via-points"`` (RAPID via points: only the units from rest to rest of joint moves, planned
+    within :data:`joulepath.sim._via.RAPID_ACCEL_SHARE` of the acceleration limit, as for a
+    single move's ``path.mod``). ``rapid_plan``: with ``"samples"`` and a RAPID program, also
+    plan for via points (:attr:`CycleResult.rapid_plan`), the module written where the
+    emulation runs the plan itself as the checks ask.
     """
 
     cycle_time: float | None = None
@@ -110,6 +117,8 @@ class CycleSettings:
     zones: bool = True
     retime_linear: bool = True
     max_time_s: float | None = None
+    follow: str = "samples"
+    rapid_plan: bool = True
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     seed: int = 0
@@ -127,6 +136,8 @@ class CycleSettings:
             raise InvalidInput(f"accel_time must be in (0, 10] s, got {self.accel_time}")
         if not 0 <= self.jerk_time <= 10:
             raise InvalidInput(f"jerk_time must be in [0, 10] s (0: no jerk limit), got {self.jerk_time}")
+        if self.follow not in ("samples", "via-points"):
+            raise InvalidInput(f"follow must be samples or via-points, got {self.follow!r}")
         if self.max_time_s is not None and not (np.isfinite(self.max_time_s) and self.max_time_s > 0):
             raise InvalidInput(f"max_time_s must be a positive number of seconds, got {self.max_time_s}")
 
@@ -417,6 +428,8 @@ class CycleOptimizer:
             if len(moving) > 1 and not self.settings.fly_by:
                 return []
             return [(tuple(moving), seg, False)]
+        if self.settings.follow == "via-points":
+            return []  # via points follow only joint moves from rest to rest
         if len(moving) == 1 and self._can_retime(by[moving[0]]):  # a MoveL from rest to rest
             self.linear.add(moving[0])
             return [(tuple(moving), seg, False)]
@@ -666,7 +679,10 @@ class CycleOptimizer:
         return m.step.robot
 
     def _amax(self, robot: Robot) -> FloatArray | None:
-        return acceleration_limit(robot, self.settings.accel_time)
+        a = acceleration_limit(robot, self.settings.accel_time)
+        if a is not None and self.settings.follow == "via-points":
+            a = a * RAPID_ACCEL_SHARE
+        return a
 
     def _amax_array(self, robot: Robot) -> FloatArray:
         a = self._amax(robot)
@@ -1202,20 +1218,19 @@ def optimize_cycle(
         waits_J=final.energy_J if settings.use_waits else None,
     )
     result = _assemble(opt, final, table, breakdown, target=target, shortest=shortest, t_start=t_start)
-    inner = [i for i, e in final.choice.items() if (i in opt.within or i in opt.linear) and not e.taught]
-    if inner and len(inner) < sum(
-        1 for e in final.choice.values() if not e.taught
-    ):  # what RAPID follows: the units inside MoveL segments as taught
-        simple = opt.evaluate(
-            {i: (opt.taught(i) if i in inner else e) for i, e in final.choice.items()},
-            final.cycle_time_s - opt.fixed_time - sum(e.duration for e in final.choice.values()),
+    if settings.rapid_plan and settings.follow == "samples" and spec.module is not None:
+        left = (
+            None
+            if settings.max_time_s is None
+            else max(1.0, settings.max_time_s - (time.perf_counter() - t_start))
         )
-        result = replace(
-            result,
-            rapid_plan=_assemble(
-                opt, simple, table, breakdown, target=target, shortest=shortest, t_start=t_start
-            ),
-        )
+        via = replace(settings, follow="via-points", rapid_plan=False, max_time_s=left)
+        try:
+            rapid, _ = optimize_cycle(spec, via, progress=progress)
+        except LimitViolation:  # no plan for via points at this cycle time: EGM only
+            rapid = None
+        if rapid is not None and rapid.paths:
+            result = replace(result, rapid_plan=rapid)
     return result, opt
 
 

@@ -450,10 +450,11 @@ def write_cycle_run(
     follows = None
     if write_rapid:
         plans = [("the plan", result)]
-        if result.rapid_plan is not None:
+        if result.rapid_plan is not None and result.limits_ok:
             plans.append(
                 (
-                    "the plan with the units inside MoveL segments and the re-timed MoveL as taught",
+                    "the plan for via points (its units from rest to rest of joint moves only, within "
+                    "3/(2π) of the acceleration limit)",
                     result.rapid_plan,
                 )
             )
@@ -485,9 +486,11 @@ def write_cycle_run(
         files["pareto.png"] = pareto_plot(pareto, default, out / "pareto.png")
     data = cycle_json(result, pareto, "optimized.mod" if text is not None else None, refused, check)
     data["rapid_follows"] = follows
+    data["rapid_plan_saved_pct"] = None if result.rapid_plan is None else result.rapid_plan.saved_pct
     data["rapid_follows_note"] = (
         "which plan optimized.mod's via points follow: the plan, or (where the controller emulation does "
-        "not run the units inside MoveL segments as planned) the plan with those units as taught; "
+        "not run it as the checks ask) the plan for via points: only the units from rest to rest of joint "
+        "moves, planned within 3/(2π) of the acceleration limit (rapid_plan_saved_pct: its planned saving); "
         "cycle_path.csv and --export egm always stream the plan"
     )
     files["cycle.json"] = atomic_write_text(
