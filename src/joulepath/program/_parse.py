@@ -1574,8 +1574,8 @@ def parse_module(text: str, *, path: str = "<program>") -> Module:
         reader.names = scope.called({})
         reader.pos = routine.start + 1
         reader.stack = (key,)
-        body, end = reader.block("ENDPROC", u, inside=f"PROC {name}")
-        procedures.append(Procedure(u.line, end.end_line, name, tuple(body)))
+        body, closing = reader.block("ENDPROC", u, inside=f"PROC {name}")
+        procedures.append(Procedure(u.line, closing.end_line, name, tuple(body)))
     module = Module(m.group(1), tuple(decls), tuple(procedures), tuple(text.splitlines()), path)
     main = module.procedure("main")
     if main is None:
