@@ -1,4 +1,4 @@
-"""Valid programs integrators write run through the reader and the controller's plan; mutated ones fail cleanly."""
+"""Valid programs run through the reader and the controller's plan; mutated ones fail in one line."""
 
 from pathlib import Path
 

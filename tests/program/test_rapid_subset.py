@@ -60,7 +60,9 @@ def test_keywords_in_any_case_read_the_same(robot):
 
 
 def test_saved_module_header_keeps_line_numbers(robot):
-    text = "%%%\n  VERSION:1\n  LANGUAGE:ENGLISH\n%%%\n\n" + _module("        MoveJ pA, v1000, fine, tool0;\n")
+    text = "%%%\n  VERSION:1\n  LANGUAGE:ENGLISH\n%%%\n\n" + _module(
+        "        MoveJ pA, v1000, fine, tool0;\n"
+    )
     spec = _spec(text, robot)
     # 5 header lines, MODULE on 6, pA on 7, PROC on 8: the move is on line 9
     assert _moves(spec)[0].line == 9
@@ -131,7 +133,7 @@ def test_fixed_work_object_places_the_target(robot):
 
 @pytest.mark.parametrize(
     ("edit", "needle"),
-    [("[FALSE, TRUE, \"\"", "robhold TRUE"), ("[FALSE, TRUE, \"\"", "ufmec 'STN1'")],
+    [('[FALSE, TRUE, ""', "robhold TRUE"), ('[FALSE, TRUE, ""', "ufmec 'STN1'")],
 )
 def test_moving_work_object_is_refused(robot, edit, needle):
     new = '[TRUE, TRUE, ""' if "robhold" in needle else '[FALSE, TRUE, "STN1"'
@@ -180,7 +182,7 @@ def test_procedure_argument_count_is_checked(robot):
 
 # ---------------------------------------------------------------- 7. IF / TEST on constants
 def test_if_on_a_constant_runs_the_chosen_branch_and_says_so(robot):
-    decl = f"    CONST robtarget pB := Offs(pA, 0, 0, -100);\n    CONST bool bDoubleGrip := FALSE;\n"
+    decl = "    CONST robtarget pB := Offs(pA, 0, 0, -100);\n    CONST bool bDoubleGrip := FALSE;\n"
     body = (
         "        IF bDoubleGrip THEN\n            MoveJ pA, v100, fine, tool0;\n"
         "        ELSE\n            MoveJ pB, v200, fine, tool0;\n        ENDIF\n"
@@ -206,7 +208,8 @@ def test_test_on_a_pers_num_picks_its_case(robot):
 def test_if_on_a_comparison_inside_a_for_loop(robot):
     body = (
         "        FOR i FROM 1 TO 3 DO\n            IF i MOD 2 = 1 THEN\n"
-        "                MoveL Offs(pA, 0, 0, -10 * i), v100, fine, tool0;\n            ENDIF\n        ENDFOR\n"
+        "                MoveL Offs(pA, 0, 0, -10 * i), v100, fine, tool0;\n"
+        "            ENDIF\n        ENDFOR\n"
     )
     spec = _spec(_module(body), robot)
     heights = [round(_tcp(m)[0][2], 6) for m in _moves(spec)]
@@ -236,7 +239,9 @@ def test_if_on_a_run_time_value_is_refused_at_the_move(robot):
     ],
 )
 def test_motion_changes_are_refused_in_one_line(robot, instruction, needle):
-    text = _module(f"        MoveJ pA, v100, fine, tool0;\n        {instruction}\n        MoveL pA, v100, fine, tool0;\n")
+    text = _module(
+        f"        MoveJ pA, v100, fine, tool0;\n        {instruction}\n        MoveL pA, v100, fine, tool0;\n"
+    )
     message = _refused(text, robot)
     assert message.startswith("t.mod:5:") and needle in message, message
 
@@ -254,7 +259,13 @@ def test_non_motion_instructions_stay_verbatim(robot):
         '        TPWrite "done";\n        Reset doGrip;\n        PDispOff;\n'
     )
     spec = _spec(_module(body, "    VAR robtarget pUnused;\n"), robot)
-    assert [s.label for s in spec.steps if s.kind == "fixed"] == ["SetDO", "WaitDI", "TPWrite", "Reset", "PDispOff"]
+    assert [s.label for s in spec.steps if s.kind == "fixed"] == [
+        "SetDO",
+        "WaitDI",
+        "TPWrite",
+        "Reset",
+        "PDispOff",
+    ]
 
 
 # ---------------------------------------------------------------- 9. idle waits
