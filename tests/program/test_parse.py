@@ -135,7 +135,11 @@ CORPUS = [
         + TAIL,
         4,
     ),
-    ("robtarget without value", _prog("MoveJ pNone, v100, fine, tool0;", decl="    VAR robtarget pNone;\n"), 4),
+    (
+        "robtarget without value",
+        _prog("MoveJ pNone, v100, fine, tool0;", decl="    VAR robtarget pNone;\n"),
+        4,
+    ),
     (
         "recursion",
         HEAD

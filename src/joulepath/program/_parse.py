@@ -1,31 +1,35 @@
 """A strict reader of the RAPID subset joulepath optimizes; every error names its line.
 
-Read (and checked): ``MODULE`` / ``ENDMODULE``; ``PROC name()`` / ``ENDPROC``;
-``CONST`` / ``PERS`` / ``VAR`` declarations of ``jointtarget``, ``robtarget``,
-``speeddata``, ``zonedata``, ``tooldata`` and ``num`` (a literal value);
-``MoveAbsJ`` / ``MoveJ`` / ``MoveL`` with ``\\V``, ``\\T``, ``\\Z``, ``\\WObj:=wobj0``
-(and ``\\NoEOffs`` on ``MoveAbsJ``); ``WaitTime``; ``WHILE TRUE DO`` in ``main``;
-calls of the module's procedures without arguments; one-dimensional arrays of
-``jointtarget``, ``robtarget`` and ``num`` (``CONST jointtarget OPT{3} := [...]``), and
-of ``speeddata`` / ``zonedata`` (literal values or predefined names: ``[v100, v7000]``);
-``FOR i FROM a TO b [STEP s] DO`` with moves or calls inside, when its bounds are
-whole numbers or ``CONST num``: the loop is unrolled (its body read once per value
-of ``i``), and ``i`` may index the arrays (``MoveAbsJ OPT{i}, v1000 \\T:=OPT_T{i}, ...``).
-Indices are whole numbers, ``CONST num``, the variables of the FOR loops around or
-elements of ``CONST num`` arrays (``SPEED_ARR{SPEED_IDX{i}}``, as ``JPCollect.mod`` in
-table mode writes).
+Keywords, instructions and names are read in any case (``MoveJ`` / ``movej``), and the
+``%%%`` header of a saved module is skipped (line numbers kept).
+
+Read (and checked): ``MODULE`` / ``ENDMODULE``; ``PROC name(params)`` / ``ENDPROC`` (an
+``ERROR`` / ``UNDO`` / ``BACKWARD`` handler is kept verbatim, never part of the cycle);
+``CONST`` / ``PERS`` / ``VAR`` declarations of ``jointtarget``, ``robtarget`` (a literal or
+``Offs`` / ``RelTool`` of another), ``speeddata``, ``zonedata``, ``tooldata``,
+``wobjdata``, ``num`` and ``bool``; predefined ``v5`` .. ``v7000``, ``vmax``, ``fine``,
+``z0`` .. ``z200``, ``tool0``, ``wobj0``; ``MoveAbsJ`` / ``MoveJ`` / ``MoveL`` with ``\\V``,
+``\\T``, ``\\Z``, ``\\WObj`` (a fixed work object) and ``\\NoEOffs`` on ``MoveAbsJ``, to a
+declared target, an array element, ``Offs(p, dx, dy, dz)`` or ``RelTool(p, dx, dy, dz
+\\Rx \\Ry \\Rz)`` with constant arguments; ``WaitTime [\\InPos,] t`` (``t`` a constant
+expression; ``! joulepath: idle`` marks idle time); ``WHILE TRUE DO`` in ``main``;
+calls of the module's procedures, with arguments (num, bool, targets, speeds, zones,
+tools, work objects) substituted: the callee is read at each call; one-dimensional
+arrays; ``FOR`` loops with constant bounds, unrolled; ``IF`` / ``TEST`` with moves
+inside whose conditions are constant (``CONST`` / ``PERS`` num and bool no statement
+assigns; a ``PERS`` reads as declared): the chosen branch is read and the choice noted.
 
 Kept verbatim, their run time treated as fixed: every other instruction
-(``SetDO``, ``WaitDI``, ``TPWrite`` ...), declarations of other types, ``FUNC`` and
-``TRAP`` routines, and ``IF`` / ``FOR`` / ``TEST`` / other ``WHILE`` blocks without a
-move inside.
+(``SetDO``, ``WaitDI``, ``TPWrite``, ``PDispOff`` ...), declarations of other types,
+``FUNC`` and ``TRAP`` routines, and blocks without a move inside.
 
 Refused (:class:`RapidError`, one line ``file:line: what; how to fix``): syntax
-errors, unknown names, arguments joulepath does not model (``\\Conc``, ``\\ID``,
-``\\Inpos``, a work object other than ``wobj0`` ...), other motion instructions
-(``MoveC``, ``SearchL`` ...), instructions that change how the robot moves
-(``VelSet``, ``AccSet``, ``ConfJ \\Off`` ...), moves inside conditional blocks and
-other ``WHILE`` loops, and FOR loops with moves inside whose bounds are not constants.
+errors, unknown names, arguments joulepath does not model (``\\Conc``, ``\\ID``, ...),
+moving work objects, other motion instructions (``MoveC``, ``SearchL`` ...),
+instructions that change how the robot moves (``PDispOn``, ``PDispSet``, ``EOffsSet``,
+``VelSet``, ``AccSet``, ``ConfJ \\Off`` ...), targets computed while the program runs
+(``CRobT``, a target some statement assigns), moves under conditions known only at run
+time, in other ``WHILE`` loops, and in FOR loops whose bounds are not constants.
 Reading never executes anything.
 """
 
@@ -1574,8 +1578,8 @@ def parse_module(text: str, *, path: str = "<program>") -> Module:
         reader.names = scope.called({})
         reader.pos = routine.start + 1
         reader.stack = (key,)
-        body, end = reader.block("ENDPROC", u, inside=f"PROC {name}")
-        procedures.append(Procedure(u.line, end.end_line, name, tuple(body)))
+        body, closing = reader.block("ENDPROC", u, inside=f"PROC {name}")
+        procedures.append(Procedure(u.line, closing.end_line, name, tuple(body)))
     module = Module(m.group(1), tuple(decls), tuple(procedures), tuple(text.splitlines()), path)
     main = module.procedure("main")
     if main is None:
