@@ -284,7 +284,7 @@ class SplineProblem:
     # ------------------------------------------------------------- constraints
     def _hull(self) -> tuple[FloatArray, FloatArray]:
         """``A x + b ≥ 0``: every control point of q, qd, qdd inside its bounds (holds at every instant);
-        with a given ``base``, q and qd inside their bounds at every point of the fine grid."""
+        with a given ``base``, q and qd inside their bounds at every sample."""
         if self.base is not None:
             return self._grid_hull()
         maps = self.basis.control_maps[:2]
@@ -311,11 +311,13 @@ class SplineProblem:
         rows_a, rows_b, rows_s = [], [], []
         eye = np.eye(self.n)
         span = np.where(np.isfinite(self.hi - self.lo), self.hi - self.lo, 2 * np.pi)
+        # on the samples (the fine grid would hold ten times the rows); the result is verified on the
+        # fine grid all the same (check_limits)
         for M, P, hi, lo, sc in (
-            (self.fine.B, self.default_fine.q, self.hi - RANGE_MARGIN, self.lo + RANGE_MARGIN, span),
+            (self.samples.B, self.default.q, self.hi - RANGE_MARGIN, self.lo + RANGE_MARGIN, span),
             (
-                self.fine.Bd,
-                self.default_fine.qd,
+                self.samples.Bd,
+                self.default.qd,
                 self.vmax * (1 - RATE_MARGIN),
                 -self.vmax * (1 - RATE_MARGIN),
                 self.vmax,

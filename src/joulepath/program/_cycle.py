@@ -161,6 +161,7 @@ class Solved:
     clearance_mm: float | None = None  # smallest distance to the cell's obstacles (None: no cell)
     corridor_used_mm: float | None = None
     taught: bool = False  # the taught motion of the unit, as the controller runs it (not re-solved)
+    passes: tuple[float, ...] | None = None  # s: when it passes the inner targets (None: waypoints())
 
     @property
     def usable(self) -> bool:
@@ -315,6 +316,10 @@ def segments(plan: PlannedCycle) -> list[Segment]:
     return out
 
 
+ON_TAUGHT_KNOTS = 0.1
+"""s between knots, at least, of a shape added to the taught motion: the taught motion runs at the
+joints' speed limits, so nearly every speed row is active, and SLSQP's cost grows with their number."""
+
 TIME_UNIT = FINE_DT
 """s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
 
@@ -455,15 +460,22 @@ class CycleOptimizer:
     def _can_retime(self, m: PlannedMove) -> bool:
         return (
             m.step.linear
-            and not m.step.repeated
+            and self._once_or_streamed(m)
             and self.settings.retime_linear
             and self.default_clearance.get(m.index, np.inf) >= 0.0
         )
 
     def _can_optimize(self, m: PlannedMove) -> bool:
         return (
-            not m.step.linear and not m.step.repeated and self.default_clearance.get(m.index, np.inf) >= 0.0
+            not m.step.linear
+            and self._once_or_streamed(m)
+            and self.default_clearance.get(m.index, np.inf) >= 0.0
         )
+
+    def _once_or_streamed(self, m: PlannedMove) -> bool:
+        """A move that runs once in the cycle, or any move of a plan for a streamed trajectory (each
+        call of a procedure is its own motion there; via points of one statement hold only one)."""
+        return not m.step.repeated or self.settings.follow == "samples"
 
     def _linear_shortest(self, m: PlannedMove) -> float:
         """A MoveL's shortest duration along its line within the limits and its speeddata (TOPP-RA,
@@ -508,11 +520,10 @@ class CycleOptimizer:
             (float(e * STEP), self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
         )
 
-    def _taught_passes(self, i: int) -> tuple[tuple[float, FloatArray], ...]:
-        """Inner targets of a unit inside a MoveL segment, at the times (from the window's start, on
-        the 2.5 ms grid) the taught motion comes closest to each (TCP)."""
-        win = self.segment_of[i]
-        traj = self.base(i)
+    def _taught_passes(self, i: int, traj: Trajectory | None = None) -> tuple[tuple[float, FloatArray], ...]:
+        """Inner targets of a unit at the times (from the window's start, on the 2.5 ms grid of
+        ``traj``, default :meth:`base`) the taught motion comes closest to each (TCP)."""
+        traj = self.base(i) if traj is None else traj
         step = self.by_index[i].step
         assert step.robot is not None and step.tcp is not None
         p, _ = _tcp(step.robot, traj.q, step.tcp)
@@ -523,20 +534,111 @@ class CycleOptimizer:
             q = self.by_index[j].path.q1
             p0, _ = _tcp(step.robot, q[None, :], step.tcp)
             d = np.linalg.norm(p - p0, axis=1)
-            k = lo + int(np.argmin(d[lo : d.size - 2]))
+            k = lo + int(np.argmin(d[lo : max(lo + 1, d.size - 2)]))
             out.append((float(traj.t[k]), q))
             lo = k + 2
-        del win
         return tuple(out)
 
-    def base(self, i: int) -> Trajectory:
-        """The taught motion over unit ``i``'s window, on the optimizer's fine grid (from 0)."""
+    def base(self, i: int, n_steps: int | None = None) -> Trajectory:
+        """The taught motion over unit ``i``'s window (or its first ``n_steps`` 25 ms samples), on
+        the optimizer's fine grid (from 0)."""
         win = self.segment_of[i]
         h = STEP / self.settings.gradient.check_factor
-        n = int(round(win.span / h)) + 1
+        length = win.span if n_steps is None else n_steps * STEP
+        n = int(round(length / h)) + 1
         t = np.linspace(0.0, (n - 1) * h, n)
         tr = evaluate_cycle(self.plan, win.t0 + t)
         return Trajectory(t=t, q=tr.q, qd=tr.qd, qdd=tr.qdd)
+
+    def passes(self, i: int, s: Solved) -> tuple[tuple[float, FloatArray], ...]:
+        """When the entry ``s`` of unit ``i`` passes the unit's inner targets, and the targets."""
+        if s.passes is None:
+            return self.waypoints(i, s.duration)
+        members = self.chains[i]
+        return tuple((t, self.by_index[j].path.q1) for t, j in zip(s.passes, members[:-1], strict=True))
+
+    def solve_on_taught(self, i: int) -> Solved | None:
+        """A unit from rest to rest reshaped from its taught motion at its taught duration: the shape
+        is added to the taught motion over its whole 25 ms samples (the rest of it, less than one
+        sample to the stop, stays taught), through its targets where the taught motion passes them.
+        It starts where the controller's own motion is, within every limit. None: under 0.15 s."""
+        key = (i, -2)
+        if key in self.cache:
+            return self.cache[key]
+        win = self.segment_of[i]
+        n = int(np.floor(win.span / STEP + 1e-9))
+        if n < 6 or i in self.within or i in self.linear or self.settings.follow == "via-points":
+            return None  # (via points: planned within a lower acceleration limit than taught)
+        if self.deadline is not None and time.perf_counter() > self.deadline:
+            self.timed_out = True
+            raise TimeBudgetSpent(f"{self.spec.source}: --max-time reached")
+        m = self.by_index[i]
+        robot = self._robot(m)
+        base = self.base(i, n)
+        way = self._taught_passes(i, base)
+        amax, jmax = self._amax(robot), self._jmax(robot)
+        seq = np.random.SeedSequence([self.settings.seed, m.index, 10_000 + n])
+        corridor = self.settings.corridor_mm
+        g = self.settings.gradient
+        res, problem = solve_move(
+            robot,
+            base.q[0],
+            base.q[-1],
+            n * STEP,
+            friction=NOMINAL_FRICTION,
+            settings=replace(g, knot_spacing=max(g.knot_spacing, ON_TAUGHT_KNOTS), coarse_factor=1),
+            rng=np.random.default_rng(seq),
+            acceleration_limit=amax,
+            max_deviation_m=None if corridor is None else corridor / 1000,
+            waypoints=way,
+            jerk_limit=jmax,
+            waypoint_radius=self.zone_radius(i),
+            base=base,
+        )
+        self.n_solves += 1
+        x = res.coefficients.ravel()
+        window = problem.path(x, fine=True)
+        report = check_limits(
+            robot, window, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=jmax
+        )
+        if win.span - n * STEP > 1e-9:  # the rest of the taught motion, to the stop
+            tail_t = np.append(np.arange(n * STEP + FINE_DT, win.span - 1e-9, FINE_DT), win.span)
+            tail = evaluate_cycle(self.plan, win.t0 + tail_t)
+            fine = Trajectory(
+                t=np.concatenate([window.t, tail_t]),
+                q=np.vstack([window.q, tail.q]),
+                qd=np.vstack([window.qd, tail.qd]),
+                qdd=np.vstack([window.qdd, tail.qdd]),
+            )
+        else:
+            fine = window
+        w = np.append(np.diff(fine.t), 0.0)[:, None]
+        tau = robot.inverse_dynamics(fine.q, fine.qd, fine.qdd, friction=NOMINAL_FRICTION)
+        lab = self.plant(robot).drive_torque(fine.q, fine.qd, fine.qdd)
+        e = float((np.abs(tau * fine.qd) * w).sum())
+        e_lab = float((np.abs(lab * fine.qd) * w).sum())
+        samples = problem.path(x)
+        samples = Trajectory(
+            t=np.append(samples.t, win.span),
+            q=np.vstack([samples.q, fine.q[-1:]]),
+            qd=np.vstack([samples.qd, fine.qd[-1:]]),
+            qdd=np.vstack([samples.qdd, fine.qdd[-1:]]),
+        )
+        out = Solved(
+            win.span,
+            e,
+            e_lab,
+            report.ok and res.feasible,
+            tuple(w_.describe() for w_ in report.worst),
+            samples,
+            fine,
+            tcp_deviation_mm(robot, problem.path(x), problem.path(problem.origin)),
+            None if self.settings.cell is None else self._clearance_mm(m, fine.q),
+            corridor,
+            passes=tuple(t for t, _ in way),
+        )
+        self.cache[key] = out
+        return out
 
     def zone_mm(self, j: int) -> float:
         """The zone (mm) the controller keeps at move ``j``'s target inside a chain: its zone radius,
@@ -582,7 +684,7 @@ class CycleOptimizer:
         step = self.by_index[i].step
         assert step.robot is not None and step.tcp is not None
         worst = 0.0
-        for (t, q), j in zip(self.waypoints(i, s.duration), members[:-1], strict=True):
+        for (t, q), j in zip(self.passes(i, s), members[:-1], strict=True):
             k = int(np.argmin(np.abs(s.fine.t - t)))
             p, _ = _tcp(step.robot, s.fine.q[k][None, :], step.tcp)
             p0, _ = _tcp(step.robot, q[None, :], step.tcp)
@@ -634,7 +736,7 @@ class CycleOptimizer:
         members = self.chains[i]
         if len(members) == 1:
             return {i: s}
-        cuts = [0.0, *(t for t, _ in self.waypoints(i, s.duration)), s.duration]
+        cuts = [0.0, *(t for t, _ in self.passes(i, s)), s.duration]
         robot = self._robot(self.by_index[i])
         plant = self.plant(robot)
         out: dict[int, Solved] = {}
@@ -772,13 +874,16 @@ class CycleOptimizer:
             refine = replace(g, n_starts=1, continuation=g.continuation[-g.refine_stages :])
             res = optimize_spline(problem, refine, rng=rng, initial=start)
         else:
+            g = self.settings.gradient
             res, problem = solve_move(
                 robot,
                 q0,
                 q1,
                 T,
                 friction=NOMINAL_FRICTION,
-                settings=self.settings.gradient,
+                settings=g
+                if base is None
+                else replace(g, knot_spacing=max(g.knot_spacing, ON_TAUGHT_KNOTS), coarse_factor=1),
                 rng=rng,
                 acceleration_limit=amax,
                 max_deviation_m=None if corridor is None else corridor / 1000,
@@ -908,6 +1013,13 @@ class CycleOptimizer:
         shares = np.concatenate([[0.0], np.geomspace(0.06, 1.0, k - 1)])
         floor = {i: min(self.t_lo[i], self.span[i]) for i in self.optimizable}
         out: dict[int, list[Solved]] = {i: [self.taught(i)] for i in self.optimizable}
+        for i in self.optimizable:  # each unit reshaped from its taught motion, at its taught duration
+            try:
+                reshaped = self.solve_on_taught(i)
+            except TimeBudgetSpent:
+                return out
+            if reshaped is not None:
+                out[i].append(reshaped)
         for n_move, i in enumerate(self.optimizable, start=1):
             hi = budget - (sum(floor.values()) - floor[i])
             if hi < self.t_lo[i] - 1e-9:
@@ -1125,7 +1237,7 @@ class CycleOptimizer:
             qs.append(f.q[:k])
             qds.append(f.qd[:k])
             qdds.append(f.qdd[:k])
-            cuts = [0.0, *(t for t, _ in self.waypoints(i, s.duration))]
+            cuts = [0.0, *(t for t, _ in self.passes(i, s))]
             for j, tc in zip(self.chains[i], cuts, strict=True):
                 starts.setdefault(j, off + tc)
             for j in self.segment_of[i].moves:  # moves without motion inside the window

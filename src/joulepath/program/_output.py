@@ -77,6 +77,13 @@ def optimized_module(result: CycleResult, check: dict[str, Any] | None = None) -
             f"the optimized cycle breaks a limit or the cell's margin ({bad or 'clearance'}); "
             "the program is not written"
         )
+    again = sorted({spec.steps[i].line for i in result.paths if spec.steps[i].repeated})
+    if again:
+        raise LimitViolation(
+            f"line(s) {', '.join(map(str, again))}: a move that runs more than once in the cycle "
+            "(a procedure called more than once) is optimized in each call, which one statement's "
+            "via points cannot hold; the program is not written (the streamed cycle, --export egm, runs it)"
+        )
     replace: dict[int, list[str]] = {}
     decls: list[str] = []
     through = {j for chain in result.chains.values() for j in chain[:-1]} | set(result.open_ends)
