@@ -105,7 +105,10 @@ def main() -> None:
         if "optimized.mod" in files:
             written = f"RAPID, emulated {data['executed_saved_pct']:.1f} %"
         else:
-            written = f"EGM, {result.saved_pct:.1f} % (the plan)"
+            via = data["rapid_plan_saved_pct"]
+            written = f"EGM, {result.saved_pct:.1f} % (the plan); via-point plan: " + (
+                "none saves" if via is None else f"{via:.1f} %, refused"
+            )
         opt_pct, share, note = optimum_share(result, opt)
         n_moves = sum(1 for s in spec.steps if s.kind == "move")
         rows.append(

@@ -206,6 +206,8 @@ def cycle(
     console.print(
         f"breakdown: shape {b.by_shape_pct:.1f} %, time allocation {b.by_allocation_pct:.1f} %{waits}"
     )
+    for choice in spec.choices:
+        console.print(f"read: {choice}")
     if result.timed_out:
         console.print("--max-time reached: the best verified result of the moves solved by then")
     if cell_data is not None:

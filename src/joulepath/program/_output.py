@@ -294,6 +294,7 @@ def cycle_json(
         **executed,
         "source": result.spec.source,
         "robot": result.spec.robot.name,
+        "choices": list(result.spec.choices),
         "taught_units": list(result.taught_units),
         "timed_out": result.timed_out,
         "zone_miss_mm": result.zone_miss_mm,
