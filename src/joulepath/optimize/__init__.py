@@ -7,6 +7,7 @@ from joulepath.optimize._bench import (
     summarize_bench,
     thesis_configurations,
 )
+from joulepath.optimize._cycle_reference import CycleLeg, CycleOptimum, cycle_optimum
 from joulepath.optimize._execute import EXECUTION_TOLERANCES, Execution, rapid_execution
 from joulepath.optimize._features import path_features
 from joulepath.optimize._gradient import GradientResult, GradientSettings, SplineProblem, optimize_spline
@@ -59,6 +60,8 @@ __all__ = [
     "ALGORITHMS",
     "AUTO",
     "AlgorithmSpec",
+    "CycleLeg",
+    "CycleOptimum",
     "EXECUTION_TOLERANCES",
     "Execution",
     "FINE_FACTOR",
@@ -88,6 +91,7 @@ __all__ = [
     "check_default_feasible",
     "check_limits",
     "controller_profile",
+    "cycle_optimum",
     "default_configuration",
     "fitness_kind",
     "jerk_limit",
