@@ -45,7 +45,7 @@ Example (``joulepath/experiment/presets/demo.toml``, abridged)::
     cell = ""             # cell file (obstacles) the moves must clear; "" for the TCP corridor
     cycle_time = 0.0      # s; 0: the default program's cycle time
     pareto_points = 0     # ≥ 3: also energy against cycle time
-    fly_by = true         # false: every optimized move rest to rest (no chains through zones)
+    fly_by = true         # false: optimize only moves that run rest to rest on their own
     write_anyway = false  # true: write optimized.mod even if the controller would not run it as planned
 
 Sections left out take their defaults; ``[synth]``, ``[bench]``, ``[identify]`` and ``[cycle]``
@@ -175,9 +175,9 @@ class CycleStage:
     cycle TOML for arms without RAPID) and ``cell`` (a cell TOML; "" keeps the TCP within
     ``corridor_mm`` of the taught path instead, 0: no corridor) are paths relative to the
     experiment file; ``cycle_time`` 0 keeps the default program's; ``use_waits`` spends
-    WaitTime slack on the moves; ``pareto_points`` ≥ 3 also computes energy against cycle time;
-    ``fly_by`` false runs every optimized move rest to rest instead of chaining moves joined
-    by a zone through their targets; ``write_anyway`` writes the RAPID module even when the
+    the waits declared idle (``! joulepath: idle``) on the moves; ``pareto_points`` ≥ 3 also
+    computes energy against cycle time; ``fly_by`` false optimizes only the moves that run from
+    rest to rest on their own (chains through fly-by targets stay as taught); ``write_anyway`` writes the RAPID module even when the
     controller emulation does not run it as planned.
     """
 
