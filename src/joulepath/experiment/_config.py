@@ -177,8 +177,8 @@ class CycleStage:
     experiment file; ``cycle_time`` 0 keeps the default program's; ``use_waits`` spends
     the waits declared idle (``! joulepath: idle``) on the moves; ``pareto_points`` ≥ 3 also
     computes energy against cycle time; ``fly_by`` false optimizes only the moves that run from
-    rest to rest on their own (chains through fly-by targets stay as taught); ``write_anyway`` writes the RAPID module even when the
-    controller emulation does not run it as planned.
+    rest to rest on their own (chains through fly-by targets stay as taught); ``write_anyway``
+    writes the RAPID module even when the controller emulation does not run it as planned.
     """
 
     program: str = ""
