@@ -285,45 +285,21 @@ class SplineProblem:
     def _hull(self) -> tuple[FloatArray, FloatArray]:
         """``A x + b ≥ 0``: every control point of q, qd, qdd inside its bounds (holds at every instant);
         with a given ``base``, q and qd inside their bounds at every sample."""
+        span = np.where(np.isfinite(self.hi - self.lo), self.hi - self.lo, 2 * np.pi)
+        q_bounds = (self.hi - RANGE_MARGIN, self.lo + RANGE_MARGIN, span)
+        v_bounds = (self.vmax * (1 - RATE_MARGIN), -self.vmax * (1 - RATE_MARGIN), self.vmax)
         if self.base is not None:
-            return self._grid_hull()
-        maps = self.basis.control_maps[:2]
-        offsets = self.basis.minimum_jerk_control(self.q_start, self.q_end)[:2]
-        upper = (self.hi - RANGE_MARGIN, self.vmax * (1 - RATE_MARGIN))
-        lower = (self.lo + RANGE_MARGIN, -self.vmax * (1 - RATE_MARGIN))
-        span = np.where(np.isfinite(self.hi - self.lo), self.hi - self.lo, 2 * np.pi)
-        scales = (span, self.vmax)
+            # on the samples (the fine grid would hold ten times the rows); the result is verified
+            # on the fine grid all the same (check_limits)
+            blocks = [(self.samples.B, self.default.q), (self.samples.Bd, self.default.qd)]
+        else:  # control point (r, i) = P[r, i] + Σ_j M[r, j] C[j, i];  x[j * n + i] = C[j, i]
+            maps = self.basis.control_maps[:2]
+            offsets = self.basis.minimum_jerk_control(self.q_start, self.q_end)[:2]
+            blocks = list(zip(maps, offsets, strict=True))
         rows_a, rows_b, rows_s = [], [], []
         eye = np.eye(self.n)
-        for M, P, hi, lo, sc in zip(maps, offsets, upper, lower, scales, strict=True):
-            # control point (r, i) = P[r, i] + Σ_j M[r, j] C[j, i];  x[j * n + i] = C[j, i]
+        for (M, P), (hi, lo, sc) in zip(blocks, (q_bounds, v_bounds), strict=True):
             full = np.kron(M, eye)  # rows r * n + i
-            for sign, bound in ((-1.0, hi), (1.0, lo)):
-                finite = np.isfinite(np.broadcast_to(bound, P.shape)).ravel()
-                b = (sign * (P - bound)).ravel()
-                rows_a.append(sign * full[finite])
-                rows_b.append(b[finite])
-                rows_s.append(np.broadcast_to(sc, P.shape).ravel()[finite])
-        self.hull_scale = np.concatenate(rows_s)
-        return np.concatenate(rows_a), np.concatenate(rows_b)
-
-    def _grid_hull(self) -> tuple[FloatArray, FloatArray]:
-        rows_a, rows_b, rows_s = [], [], []
-        eye = np.eye(self.n)
-        span = np.where(np.isfinite(self.hi - self.lo), self.hi - self.lo, 2 * np.pi)
-        # on the samples (the fine grid would hold ten times the rows); the result is verified on the
-        # fine grid all the same (check_limits)
-        for M, P, hi, lo, sc in (
-            (self.samples.B, self.default.q, self.hi - RANGE_MARGIN, self.lo + RANGE_MARGIN, span),
-            (
-                self.samples.Bd,
-                self.default.qd,
-                self.vmax * (1 - RATE_MARGIN),
-                -self.vmax * (1 - RATE_MARGIN),
-                self.vmax,
-            ),
-        ):
-            full = np.kron(M, eye)
             for sign, bound in ((-1.0, hi), (1.0, lo)):
                 finite = np.isfinite(np.broadcast_to(bound, P.shape)).ravel()
                 b = (sign * (P - bound)).ravel()

@@ -376,15 +376,10 @@ class CycleOptimizer:
         self.optimizable = list(self.chains)  # one unit per window, keyed by its first moving move
         in_units = {j for i in self.chains for j in self.segment_of[i].moves}
         self.kept = [m.index for m in moves if m.index not in in_units]
-        self.dwell = settings.controller.fine_dwell
         self.wait_total = float(sum(s for _, _, s in self.plan.waits))
         self.idle_total = float(sum(s for i, _, s in self.plan.waits if spec.steps[i].idle))
         # everything but the units and the waits: the rest as taught (blended), dwells
         self.fixed_time = self.plan.cycle_time - sum(self.span.values()) - self.wait_total
-        self.kept_time = self.fixed_time - self.dwell * sum(
-            1 for m in moves if m.stops and m.profile.duration
-        )
-        self.n_stops = sum(1 for m in moves if m.stops)
         self.t_lo: dict[int, float] = {}
         self.leg_lo: dict[int, tuple[float, ...]] = {}  # each move's shortest rest-to-rest duration
         for i, members in self.chains.items():
@@ -456,6 +451,12 @@ class CycleOptimizer:
             run = []
             del k
         return out
+
+    def _before_solve(self) -> None:
+        """Raise :class:`TimeBudgetSpent` once ``max_time_s`` is reached (no new solve starts)."""
+        if self.deadline is not None and time.perf_counter() > self.deadline:
+            self.timed_out = True
+            raise TimeBudgetSpent(f"{self.spec.source}: --max-time reached")
 
     def _can_retime(self, m: PlannedMove) -> bool:
         return (
@@ -569,9 +570,7 @@ class CycleOptimizer:
         n = int(np.floor(win.span / STEP + 1e-9))
         if n < 6 or i in self.within or i in self.linear or self.settings.follow == "via-points":
             return None  # (via points: planned within a lower acceleration limit than taught)
-        if self.deadline is not None and time.perf_counter() > self.deadline:
-            self.timed_out = True
-            raise TimeBudgetSpent(f"{self.spec.source}: --max-time reached")
+        self._before_solve()
         m = self.by_index[i]
         robot = self._robot(m)
         base = self.base(i, n)
@@ -805,9 +804,7 @@ class CycleOptimizer:
         key = (i, units)
         if key in self.cache:
             return self.cache[key]
-        if self.deadline is not None and time.perf_counter() > self.deadline:
-            self.timed_out = True
-            raise TimeBudgetSpent(f"{self.spec.source}: --max-time reached")
+        self._before_solve()
         m = self.by_index[i]
         T = units * STEP
         corridors: list[float | None] = [self.settings.corridor_mm]
@@ -957,11 +954,6 @@ class CycleOptimizer:
             e = self.move_energies(self.default_motion())
             self._default_energies = {m.index: (m.profile.duration, *e[m.index]) for m in self.plan.moves}
         return dict(self._default_energies)
-
-    def kept_energies(self) -> dict[int, tuple[float, float]]:
-        """Moves outside the units, run as taught within the default cycle: physics and lab J."""
-        default = self.default_energies()
-        return {i: (default[i][1], default[i][2]) for i in self.kept}
 
     def taught(self, i: int) -> Solved:
         """Unit ``i`` as taught: the default cycle's motion over its window (2.5 ms grid)."""
