@@ -99,6 +99,9 @@ from joulepath.trajectory import (  # noqa: E402
 from joulepath.units import SAMPLE_PERIOD  # noqa: E402
 
 SECTION = "optimizer_peers"
+JERK_PREFIX = "optimizer_peers_jerk"
+"""File prefix of the runs with jerk limits (``--prefix optimizer_peers_jerk``), reported in their own section."""
+JERK_SECTION = "optimizer_peers_jerk"
 TITLE = "## Optimizer: the default against the optimum and its peers (issue 11)"
 FIXED_TASK = (
     np.array([0.3, 0.2, -0.4, 0.5, -0.6, 1.0]),
@@ -586,9 +589,17 @@ class Bench:
 
 
 # ---------------------------------------------------------------------------- report
+def _files(out: Path, prefix: str, suffix: str) -> list[Path]:
+    """The result files of ``prefix``; the jerk-limited runs (prefix ``JERK_PREFIX``) are not the plain one's."""
+    files = sorted(out.glob(f"{prefix}_*{suffix}"))
+    if prefix == "optimizer_peers":
+        files = [f for f in files if not f.name.startswith(JERK_PREFIX + "_")]
+    return files
+
+
 def _read_rows(out: Path, prefix: str = "optimizer_peers") -> list[dict[str, Any]]:
     rows = []
-    for f in sorted(out.glob(f"{prefix}_*.csv")):
+    for f in _files(out, prefix, ".csv"):
         with f.open() as fh:
             for r in csv.DictReader(fh):
                 r["_file"] = f.name
@@ -695,7 +706,7 @@ def _same_energies(timing: list[dict[str, Any]], rows: list[dict[str, Any]]) -> 
 def report(out: Path, unmeasured: str = "") -> str:
     rows = _read_rows(out)
     meta = []
-    for f in sorted(out.glob("optimizer_peers_*.json")):
+    for f in _files(out, "optimizer_peers", ".json"):
         meta.append(json.loads(f.read_text()))
     loads = [r["load1"] for r in rows if np.isfinite(r["load1"])]
     runs: dict[str, list[str]] = {}
@@ -936,6 +947,54 @@ def report(out: Path, unmeasured: str = "") -> str:
     return "\n".join(lines)
 
 
+def report_jerk(out: Path) -> str:
+    """The section of the runs with jerk limits: the default's share of the jerk-limited optimum."""
+    rows = _read_rows(out, JERK_PREFIX)
+    meta = [json.loads(f.read_text()) for f in _files(out, JERK_PREFIX, ".json")]
+    jerk_times = sorted({float(m.get("jerk_time", 0.0)) for m in meta})
+    loads = [r["load1"] for r in rows if np.isfinite(r["load1"])]
+    tasks = _by_task(rows, "nominal")
+    lines = [
+        "## Optimizer: the default against the jerk-limited optimum (benchmarks/optimizer_peers.py, jerk limits on)",
+        "",
+        f"Machine: {machine()}; one BLAS/OpenMP thread per solve; the machine was shared with other work "
+        + (
+            f"(1-minute load average {min(loads):.1f} to {max(loads):.1f}, median {statistics.median(loads):.1f}, "
+            "on 2 logical CPUs), so wall times are longer than on an idle core. "
+            if loads
+            else ". "
+        )
+        + "Code: "
+        + "; ".join(
+            f"commit {m.get('commit', '?')[:10]} (run started {m.get('started', '?')} UTC)" for m in meta
+        )
+        + ".",
+        "",
+        "Every method, the reference included, plans within the acceleration limits v_max / "
+        f"{ACCEL_TIME} s and the jerk limits v_max / {ACCEL_TIME} s / jerk_time (jerk_time "
+        + ", ".join(f"{j:g}" for j in jerk_times)
+        + " s, the default `--jerk-time`); limits and energies on the 10x grid. Share of the optimum = "
+        "(E_default_move - E_method) / (E_default_move - E_optimum), the optimum being the better valid IPOPT "
+        "solve of the jerk-limited reference transcription (from the minimum-jerk move, and from the default's "
+        "path). Same tasks as the section above (seed 11, lab ranges, T in [1, 3] s), the first ones that fit "
+        "the run's time.",
+        "",
+    ]
+    table, n = _method_table(
+        tasks, ("default", "reference-mj", "reference-ours"), ("default",), with_fixed=True
+    )
+    lines += [f"**{n} tasks with jerk limits** (the fixed task of issue 11 included):", "", *table, ""]
+    fx = tasks.get("fixed")
+    if fx and "default" in fx and _optimum(fx):
+        lines.append(
+            f"Fixed task: the default reaches {100 * _share(fx['default'], _optimum(fx)):.1f} % of the jerk-limited "
+            f"optimum's saving ({fx['default']['energy_fine_J']:.3f} J against {_optimum(fx)['energy_fine_J']:.3f} J; "  # type: ignore[index]
+            f"minimum-jerk move {fx['default']['energy_default_fine_J']:.3f} J)."
+        )
+    lines += ["", f"Raw rows: `benchmarks/results/{JERK_PREFIX}_*.csv` ({len(rows)} rows)."]
+    return "\n".join(lines)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -969,6 +1028,11 @@ def main() -> None:
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     if args.report_only:
+        if args.prefix == JERK_PREFIX:
+            text = report_jerk(args.out)
+            write_section(JERK_SECTION, text)
+            print(text)
+            return
         text = report(args.out, args.unmeasured)
         write_section(SECTION, text)
         print(text)
@@ -1037,7 +1101,10 @@ def main() -> None:
     meta.update(finished=time.strftime("%Y-%m-%d %H:%M:%S"), tasks_done=done, load_at_end=os.getloadavg())
     meta_path.write_text(json.dumps(meta, indent=2))
     if not args.no_report:
-        write_section(SECTION, report(args.out))
+        if args.prefix == JERK_PREFIX:
+            write_section(JERK_SECTION, report_jerk(args.out))
+        else:
+            write_section(SECTION, report(args.out))
 
 
 if __name__ == "__main__":
