@@ -74,8 +74,8 @@ def _param_rows(cmd: Any, ctx: Any) -> list[str]:
             names += " / " + ", ".join(f"`{o}`" for o in param.secondary_opts)
         if param.param_type_name == "argument":
             names = f"`{param.name.upper()}`" + ("..." if param.nargs == -1 else "")
-        metavar = spec.rsplit(" ", 1)[-1] if " " in spec else ""
-        kind = f"`{metavar.strip('<>')}`" if metavar.startswith("<") else "flag"
+        metavar = re.search(r"<([^>]*)>", spec)  # "--moves <int range>"; a flag has none
+        kind = f"`{metavar.group(1)}`" if metavar else "flag"
         rows.append(f"| {names} | {kind} | {_text(help_text)} |")
     return rows
 
@@ -162,7 +162,7 @@ def on_files(files: Files, config: MkDocsConfig) -> Files:
 
 
 # ------------------------------------------------------------------ values and fields from the code
-MARKER = re.compile(r"<!-- (value|fields): ([\w.]+) -->")
+MARKER = re.compile(r"<!-- (value|fields|pairs): ([\w.]+) -->")
 SPHINX_ROLE = re.compile(r":(?:func|class|mod|data|attr|meth|exc|obj):(<code>)~?")
 
 
@@ -179,13 +179,17 @@ def _render_marker(match: re.Match[str]) -> str:
     obj = _lookup(dotted)
     if kind == "value":
         return ", ".join(f"`{v}`" for v in obj)
+    if kind == "pairs":
+        rows = [f"| {_text(a)} | {_text(b)} |" for a, b in obj]
+        return "\n".join(["| What | The thesis → here |", "|---|---|", *rows])
     rows = [f"| `{f.name}` | `{f.type}` |" for f in dataclasses.fields(obj)]
     return "\n".join(["| Key | Type |", "|---|---|", *rows])
 
 
 def on_page_markdown(markdown: str, page: Page, **_kwargs: Any) -> str:
-    """Fill ``<!-- value: dotted.NAME -->`` (a tuple of names) and ``<!-- fields: dotted.Class -->``
-    (a dataclass's fields and types) from the code."""
+    """Fill ``<!-- value: dotted.NAME -->`` (a tuple of names), ``<!-- fields: dotted.Class -->``
+    (a dataclass's fields and types) and ``<!-- pairs: dotted.NAME -->`` (a tuple of pairs, as a
+    two-column table) from the code."""
     return MARKER.sub(_render_marker, markdown)
 
 
