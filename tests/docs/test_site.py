@@ -195,3 +195,21 @@ def test_site_page_renders_in_headless_chromium(site, page, tmp_path):
     not_white = np.any(pixels < 0.95, axis=-1).mean()
     colours = np.unique((pixels * 255).astype(np.uint8).reshape(-1, 3), axis=0).shape[0]
     assert 0.03 < not_white < 0.9 and colours > 50, (not_white, colours)
+
+
+def test_api_reference_has_a_page_per_public_module():
+    """Every public module of joulepath (its stages and foundation) has a page in the Python API
+    reference, and the page is in the navigation of mkdocs.yml."""
+    import pkgutil
+
+    import joulepath
+
+    public = sorted(m.name for m in pkgutil.iter_modules(joulepath.__path__) if not m.name.startswith("_"))
+    nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    for name in public:
+        if name == "cli":  # the command line has its own, generated reference
+            continue
+        page = DOCS / "reference" / "api" / f"{name}.md"
+        assert page.is_file(), f"joulepath.{name} has no page in docs/reference/api/"
+        assert f"::: joulepath.{name}" in page.read_text(encoding="utf-8")
+        assert f"reference/api/{name}.md" in nav, f"docs/reference/api/{name}.md is not in mkdocs.yml's nav"
