@@ -163,6 +163,7 @@ def on_files(files: Files, config: MkDocsConfig) -> Files:
 
 # ------------------------------------------------------------------ values and fields from the code
 MARKER = re.compile(r"<!-- (value|fields|pairs): ([\w.]+) -->")
+RST_LITERAL = re.compile(r"::(</p>)")
 SPHINX_ROLE = re.compile(r":(?:func|class|mod|data|attr|meth|exc|obj):(<code>)~?")
 
 
@@ -194,5 +195,6 @@ def on_page_markdown(markdown: str, page: Page, **_kwargs: Any) -> str:
 
 
 def on_page_content(content: str, **_kwargs: Any) -> str:
-    """Drop Sphinx roles (``:func:``, ``:class:`` ...) that numpydoc docstrings carry."""
-    return SPHINX_ROLE.sub(r"\1", content)
+    """Drop what reStructuredText means in numpydoc docstrings and Markdown does not: Sphinx roles
+    (``:func:``, ``:class:`` ...) and the ``::`` that introduces a literal block."""
+    return RST_LITERAL.sub(r":\1", SPHINX_ROLE.sub(r"\1", content))

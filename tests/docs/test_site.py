@@ -213,3 +213,38 @@ def test_api_reference_has_a_page_per_public_module():
         assert page.is_file(), f"joulepath.{name} has no page in docs/reference/api/"
         assert f"::: joulepath.{name}" in page.read_text(encoding="utf-8")
         assert f"reference/api/{name}.md" in nav, f"docs/reference/api/{name}.md is not in mkdocs.yml's nav"
+
+
+def _documented_command_lines() -> list[tuple[str, str]]:
+    """``(page, line)`` of every ``joulepath ...`` line in the bash blocks of docs/ (continued lines joined)."""
+    found = []
+    for page in sorted(DOCS.rglob("*.md")):
+        for block in re.findall(r"```bash\n(.*?)```", page.read_text(encoding="utf-8"), flags=re.S):
+            for line in block.replace("\\\n", " ").splitlines():
+                if line.strip().startswith("joulepath "):
+                    found.append((str(page.relative_to(DOCS)), line.strip()))
+    return found
+
+
+def test_documented_commands_and_options_exist():
+    """Every ``joulepath`` command line in the docs names a real command and only its real options."""
+    import typer.main
+
+    from joulepath.cli._main import app
+
+    group = typer.main.get_command(app)
+    root = group.context_class(group, info_name="joulepath")
+    lines = _documented_command_lines()
+    assert len(lines) > 30
+    for page, line in lines:
+        argv = shlex.split(line.replace("<PC address>", "HOST"), comments=True)[1:]
+        cmd, ctx = group, root
+        while argv and hasattr(cmd, "list_commands") and not argv[0].startswith("-"):
+            name = argv.pop(0)
+            assert name in cmd.list_commands(ctx), f"{page}: no command {name!r} in `{line}`"
+            cmd = cmd.get_command(ctx, name)
+            ctx = cmd.context_class(cmd, info_name=name, parent=ctx)
+        known = {o for p in cmd.params for o in (*p.opts, *p.secondary_opts)} | {"--help", "--debug"}
+        for token in argv:
+            if token.startswith("--"):
+                assert token.split("=")[0] in known, f"{page}: `{line}` has no option {token}"
