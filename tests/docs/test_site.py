@@ -216,7 +216,7 @@ def test_api_reference_has_a_page_per_public_module():
 
 
 def _documented_command_lines() -> list[tuple[str, str]]:
-    """``(page, line)`` of every ``joulepath ...`` line in the bash blocks of docs/ (continued lines joined)."""
+    """``(page, line)`` of every ``joulepath ...`` line in docs/ bash blocks (continued lines joined)."""
     found = []
     for page in sorted(DOCS.rglob("*.md")):
         for block in re.findall(r"```bash\n(.*?)```", page.read_text(encoding="utf-8"), flags=re.S):
