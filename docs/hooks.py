@@ -194,7 +194,29 @@ def on_page_markdown(markdown: str, page: Page, **_kwargs: Any) -> str:
     return MARKER.sub(_render_marker, markdown)
 
 
+RST_TABLE = re.compile(r"<p>(=+(?: +=+)+)\n(.*?)\n\1</p>", flags=re.S)
+
+
+def _rst_table(match: re.Match[str]) -> str:
+    """An RST simple table (rule, header, rule, rows, rule) as an HTML table; columns start where
+    the rule's runs of ``=`` start, the last one takes the rest of the line."""
+    starts = [m.start() for m in re.finditer(r"=+", match.group(1))]
+    lines = match.group(2).split("\n")
+    if len(lines) < 2 or not re.fullmatch(r"=+(?: +=+)+", lines[1]):
+        return match.group(0)
+
+    def cells(line: str, tag: str) -> str:
+        bounds = [*starts[1:], None]
+        row = "".join(f"<{tag}>{line[a:b].strip()}</{tag}>" for a, b in zip(starts, bounds, strict=True))
+        return f"<tr>{row}</tr>"
+
+    body = "".join(cells(line, "td") for line in lines[2:] if line.strip())
+    return f"<table><thead>{cells(lines[0], 'th')}</thead><tbody>{body}</tbody></table>"
+
+
 def on_page_content(content: str, **_kwargs: Any) -> str:
-    """Drop what reStructuredText means in numpydoc docstrings and Markdown does not: Sphinx roles
-    (``:func:``, ``:class:`` ...) and the ``::`` that introduces a literal block."""
+    """Turn what reStructuredText means in numpydoc docstrings, and Markdown does not, into HTML:
+    Sphinx roles (``:func:``, ``:class:`` ...) lose their prefix, the ``::`` that introduces a
+    literal block becomes ``:``, and a simple table becomes a table."""
+    content = RST_TABLE.sub(_rst_table, content)
     return RST_LITERAL.sub(r":\1", SPHINX_ROLE.sub(r"\1", content))
