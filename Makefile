@@ -1,19 +1,20 @@
 # make demo : set up .venv (if missing), install joulepath with its extras, run demo.toml -> runs/demo/report.html
 #             (the folder of `joulepath run demo` too, so either reuses what the other computed)
-# make test : set up .venv (if missing), install joulepath with its extras, run all tests
+# make test : set up .venv (if missing), install joulepath with its extras, build the docs site strictly, run all tests
+# make docs : build the documentation site into build/site (open build/site/index.html)
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test docs bench lint clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 
 $(STAMP): $(BIN)/python pyproject.toml constraints.txt
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -c constraints.txt -e ".[ml,synth,dask,reference,robots,abb,motion,test]"
+	$(BIN)/python -m pip install -q -c constraints.txt -e ".[ml,synth,dask,reference,robots,abb,motion,docs,test]"
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -21,9 +22,14 @@ demo: $(STAMP)
 	@echo "The report: $(CURDIR)/runs/demo/report.html (open it in a browser)"
 
 test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks scripts
+	$(BIN)/ruff check src tests benchmarks scripts docs
 	$(BIN)/mypy src
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir build/site  # no -q: it hides the warnings --strict counts
 	$(BIN)/python -m pytest -q -p no:cacheprovider
+
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir build/site
+	@echo "The site: $(CURDIR)/build/site/index.html"
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/dynamics.py
@@ -36,8 +42,8 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/egm.py
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks scripts
-	$(BIN)/ruff format --check src tests benchmarks scripts
+	$(BIN)/ruff check src tests benchmarks scripts docs
+	$(BIN)/ruff format --check src tests benchmarks scripts docs
 	$(BIN)/mypy src
 
 clean:

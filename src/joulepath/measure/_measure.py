@@ -189,6 +189,11 @@ class MeasureRun:
 def measure_run(log: str | os.PathLike[str], plan: str | os.PathLike[str]) -> MeasureRun:
     """Measure the default and the optimized move in a log of ``path.mod`` against its run folder.
 
+    Each move from rest at START to rest at GOAL is found from the joint positions and
+    speeds; it is told default or optimized by its path (compared with
+    ``default_path.csv`` and ``path.csv``, timing aside), or by the order ``path.mod``
+    runs them (the first half default) when the two paths are too alike to tell.
+
     Parameters
     ----------
     log : path
@@ -197,11 +202,6 @@ def measure_run(log: str | os.PathLike[str], plan: str | os.PathLike[str]) -> Me
     plan : path
         The run folder of ``joulepath optimize`` (``result.json``, ``path.csv``,
         ``default_path.csv``).
-
-    Each move from rest at START to rest at GOAL is found from the joint positions and
-    speeds; it is told default or optimized by its path (compared with
-    ``default_path.csv`` and ``path.csv``, timing aside), or by the order ``path.mod``
-    runs them (the first half default) when the two paths are too alike to tell.
 
     Raises
     ------
