@@ -70,9 +70,9 @@ def plant(tmp_path_factory):
     model.parent.mkdir()
     shutil.copy(preset_path("irb120"), model)
     drives = model.with_name("irb120.drives.toml")
-    drives.write_text(
+    drives.write_text(  # a whole drives file (joulepath.energy's format); evaluate reads torque_constant
         f"torque_constant = {K.tolist()}\nresistance = [1.0, 1.0, 1.0, 1.0, 1.0, 1.0]\n"
-        '[sources]\ntorque_constant = "the test plant"\n'
+        'drive_efficiency = 0.95\nbus = "bleeder"\n[sources]\ntorque_constant = "the test plant"\n'
     )
     return {"robot": robot, "both": both, "only": only, "model": model, "drives": drives}
 
@@ -191,8 +191,9 @@ def test_cli_evaluate_reads_the_drives_file_beside_the_model(plant, tmp_path, ca
 
 
 def test_cli_evaluate_without_drives_says_what_to_provide(plant, tmp_path, capsys):
-    out = tmp_path / "ev"
-    assert main(["evaluate", str(plant["both"]), "--robot", "irb120", "--out", str(out)]) == 0
+    out, model = tmp_path / "ev", tmp_path / "irb120.irml"
+    shutil.copy(plant["model"], model)  # no drives file beside this copy
+    assert main(["evaluate", str(plant["both"]), "--robot", str(model), "--out", str(out)]) == 0
     summary = json.loads((out / "evaluate.json").read_text())
     assert summary["current"] is None and summary["torque"]["r2_mean"] > 0.99
     assert "torque_constant" in capsys.readouterr().out
@@ -236,3 +237,18 @@ def test_cli_evaluate_refusals_are_one_line_and_write_nothing(plant, tmp_path, c
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and pattern in err, err
     assert not out.exists()
+
+
+def test_controller_log_scores_torque_and_says_it_has_no_currents(tmp_path):
+    from joulepath.sim import simulate
+
+    log = simulate(tmp_path / "lab.csv", plant="lab", n_moves=4, seed=3).log
+    robot = joulepath.load_robot("irb120")
+    ev = evaluate_model(
+        log, robot, robot_source="irb120", drives=DriveGains(torque_constant=tuple(K), origin="k")
+    )
+    assert ev.current_r2 is None and ev.i_measured is None and ev.i_predicted is not None
+    assert any("the log has no motor currents i1..i6" in n for n in ev.notes)
+    assert len(ev.torque_r2) == 6 and ev.energy_from == "tau" and len(ev.moves) >= 4
+    s = ev.summary()
+    assert s["holding"]["current"] is None and s["holding"]["torque"] is not None

@@ -119,7 +119,7 @@ def drives_path(robot_source: str | os.PathLike[str], robot: Robot) -> Path:
     if given.is_dir():
         return given / TWIN_DRIVES_FILE
     described = Path(robot.source) if robot.source else given
-    return described.with_name(described.name.split(".")[0] + DRIVES_SUFFIX)
+    return described.with_name(described.stem + DRIVES_SUFFIX)
 
 
 def read_drive_gains(path: str | os.PathLike[str], n_joints: int) -> DriveGains:
