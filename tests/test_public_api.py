@@ -54,7 +54,7 @@ ALLOWED = {
     "data": {"dynamics", "energy"},  # dynamics: annotations only (TYPE_CHECKING)
     "export": {"description", "kinematics", "dynamics", "trajectory", "data"},
     "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb"},
-    "learn": {"data", "dynamics", "energy"},
+    "learn": {"data", "description", "dynamics", "energy"},
     "identify": {"data", "description", "dynamics", "energy", "trajectory", "sim"},
     "synth": {"data", "description", "kinematics", "dynamics"},
     "evolve": set(),

@@ -133,3 +133,78 @@ def test_read_log_generic_any_column_order(tmp_path):
     assert log.kind == "generic" and log.qdd is None
     np.testing.assert_allclose(log.tau[0], np.arange(1, 7))
     np.testing.assert_array_equal(np.unique(log.move), [3, 7])
+
+
+# --------------------------------------------------------------------------- motor currents
+
+
+@pytest.fixture(scope="module")
+def current_signals(sim_log):
+    log = read_log(sim_log)
+    current = log.tau / np.array([1.2, 1.5, 0.8, 0.3, 0.3, 0.2])  # any joint-side torque constants
+    return log.t, log.q, log.qd, log.tau, current
+
+
+def test_read_log_currents_only(tmp_path, current_signals):
+    from joulepath.data import generic_log_text
+
+    t, q, qd, _, current = current_signals
+    p = tmp_path / "i.csv"
+    p.write_text(generic_log_text(t, q, qd, None, current=current))
+    log = read_log(p)
+    assert log.kind == "generic" and log.tau is None
+    np.testing.assert_allclose(log.current, current, rtol=1e-9, atol=1e-12)
+    with pytest.raises(InvalidLog, match=r"i\.csv: logs motor currents \(i1\.\.i6\) but no joint torques"):
+        log.torques("ingestion")
+
+
+def test_read_log_torques_and_currents(tmp_path, current_signals):
+    from joulepath.data import generic_log_text
+
+    t, q, qd, tau, current = current_signals
+    p = tmp_path / "both.csv"
+    p.write_text(generic_log_text(t, q, qd, tau, current=current))
+    log = read_log(p)
+    np.testing.assert_allclose(log.torques("a test"), tau, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(log.current, current, rtol=1e-9, atol=1e-12)
+
+
+def test_ingest_refuses_a_log_of_currents_only(tmp_path, current_signals):
+    from joulepath.data import generic_log_text, ingest
+
+    t, q, qd, _, current = current_signals
+    p = tmp_path / "i.csv"
+    p.write_text(generic_log_text(t, q, qd, None, current=current))
+    with pytest.raises(InvalidLog, match="ingestion .* needs the torques tau1..tau6"):
+        ingest([p])
+
+
+@pytest.mark.parametrize(
+    ("edit", "pattern"),
+    [
+        (lambda h: h.replace(",i6", ",x6"), r"lacks column\(s\) i6 of a 6-joint log"),
+        (lambda h: h.replace(",tau3", ",torque3"), r"lacks column\(s\) tau3 of a 6-joint log"),
+        (lambda h: h + ",i8", r"column\(s\) i8 name joint\(s\) 8"),
+    ],
+)
+def test_read_log_current_columns_come_for_every_joint(tmp_path, current_signals, edit, pattern):
+    from joulepath.data import generic_log_text
+
+    t, q, qd, tau, current = current_signals
+    lines = generic_log_text(t[:50], q[:50], qd[:50], tau[:50], current=current[:50]).splitlines()
+    extra = lines[0] != edit(lines[0]) and edit(lines[0]).endswith(",i8")
+    lines[0] = edit(lines[0])
+    if extra:
+        lines[1:] = [line + ",0" for line in lines[1:]]
+    with pytest.raises(InvalidLog, match=pattern):
+        read_log(_write(tmp_path, lines))
+
+
+def test_read_log_currents_in_milliamperes_refused(tmp_path, current_signals):
+    from joulepath.data import generic_log_text
+
+    t, q, qd, _, current = current_signals
+    p = tmp_path / "ma.csv"
+    p.write_text(generic_log_text(t, q, qd, None, current=current * 1000 + 2000))
+    with pytest.raises(InvalidLog, match=r"column i1 reaches .*, more than 1000 A.*in mA"):
+        read_log(p)

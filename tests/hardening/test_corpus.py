@@ -635,7 +635,7 @@ def model_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
     from joulepath.learn import EnergyModel, input_columns
 
-    cols = input_columns("full40", "thesis")
+    cols = input_columns("full40", "thesis", 6)
     rng = np.random.default_rng(0)
     X = rng.normal(size=(64, len(cols)))
     y = 1.0 + np.abs(X[:, 0])

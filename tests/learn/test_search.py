@@ -10,7 +10,7 @@ from joulepath.learn import grid_search, input_columns, make_pipeline, make_spli
 @pytest.fixture(scope="module")
 def xy(lab_tables):
     train, _ = lab_tables
-    cols = input_columns("full40", "physics")
+    cols = input_columns("full40", "physics", train.n_joints)
     return (
         train.frame[list(cols)].to_numpy(),
         train.frame["E"].to_numpy(),
@@ -32,7 +32,7 @@ def test_make_splits_grouped_keeps_moves_together(xy):
 
 def test_interrupted_search_resumes_without_refitting(xy, tmp_path):
     X, y, groups, cols = xy
-    pipe = make_pipeline("par", seed=0, columns=cols)
+    pipe = make_pipeline("par", seed=0, columns=cols, robot="irb120")
     first = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3, cache_dir=tmp_path)
     assert first.n_fitted == 4
     files = sorted(tmp_path.glob("*.json"))
@@ -49,7 +49,7 @@ def test_interrupted_search_resumes_without_refitting(xy, tmp_path):
 
 def test_grid_search_on_a_dask_local_cluster(xy, dask_scheduler):
     X, y, groups, cols = xy
-    pipe = make_pipeline("par", seed=0, columns=cols)
+    pipe = make_pipeline("par", seed=0, columns=cols, robot="irb120")
     res = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3, scheduler=dask_scheduler)
     local = grid_search(pipe, GRID, X, y, groups, family="par", n_splits=3)
     assert res.n_fitted == 4
@@ -62,7 +62,7 @@ def test_pending_candidates_counts_what_is_not_cached(xy, tmp_path):
     X, y, groups, cols = xy
     kwargs = {"family": "par", "n_splits": 3, "cache_dir": tmp_path}
     assert pending_candidates(GRID, X, y, groups, **kwargs) == 4
-    grid_search(make_pipeline("par", seed=0, columns=cols), GRID, X, y, groups, **kwargs)
+    grid_search(make_pipeline("par", seed=0, columns=cols, robot="irb120"), GRID, X, y, groups, **kwargs)
     assert pending_candidates(GRID, X, y, groups, **kwargs) == 0
     files = sorted(tmp_path.glob("*.json"))
     files[0].unlink()
@@ -77,7 +77,7 @@ def test_estimate_fit_seconds_is_a_positive_time_from_small_trials(xy):
 
     X, y, _, cols = xy
     for family in ("par", "mlp"):
-        pipe = make_pipeline(family, seed=0, columns=cols)
+        pipe = make_pipeline(family, seed=0, columns=cols, robot="irb120")
         seconds, trial = estimate_fit_seconds(pipe, QUICK_GRIDS[family], X, y, n_rows=50_000, seed=0)
         assert np.isfinite(seconds) and 0 < seconds < 600, (family, seconds)
         assert trial == min(2000, len(y))

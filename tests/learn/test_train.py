@@ -28,6 +28,7 @@ def test_reports_and_files(trained):
     assert (out / "results.csv").exists() and (out / "test_scores_E.png").exists()
     report = json.loads((out / "report.json").read_text())
     assert "par" in report["substitutions"] and "SGDRegressor" in report["substitutions"]["par"]
+    assert report["robot_source"] == "irb120"  # the table's robot "IRB 120", by its bundled name
     labels = [b["label"] for b in report["baselines"]]
     assert labels == ["dynamics model, no friction", "dynamics model + nominal friction"]
     for family in FAMILIES:
@@ -85,3 +86,76 @@ def test_training_again_leaves_only_this_runs_models(lab_tables, tmp_path):
     train(*lab_tables, TrainConfig(families=("par",), targets=("E",), cv=2, seed=0), tmp_path)
     assert set(load_models(tmp_path)) == {"par-E"}
     assert best_model(tmp_path, "E").family == "par"
+
+
+SEVEN_LINK = (
+    '<link name="l{i}"><inertial><mass value="{m}"/><origin xyz="0 0 0.1"/>'
+    '<inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.01"/></inertial></link>'
+)
+SEVEN_JOINT = (
+    '<joint name="joint_{i}" type="revolute"><parent link="l{p}"/><child link="l{i}"/>'
+    '<origin xyz="0 0 0.15" rpy="{rpy}"/><axis xyz="0 0 1"/>'
+    '<limit lower="-3" upper="3" effort="150" velocity="3"/></joint>'
+)
+
+
+@pytest.fixture(scope="module")
+def seven_joint_tables(tmp_path_factory):
+    """Small train/test tables of a 7-joint URDF arm (its name, "arm7", is no bundled robot's)."""
+    import joulepath
+    from joulepath.data import ingest
+    from joulepath.sim import simulate
+
+    folder = tmp_path_factory.mktemp("arm7")
+    body = SEVEN_LINK.format(i=0, m=4.0)
+    for i in range(1, 8):
+        rpy = "1.5708 0 0" if i % 2 == 0 else "0 0 0"
+        body += SEVEN_LINK.format(i=i, m=3.0 - 0.3 * i) + SEVEN_JOINT.format(i=i, p=i - 1, rpy=rpy)
+    path = folder / "arm7.urdf"
+    path.write_text(f'<?xml version="1.0"?><robot name="arm7">{body}</robot>')
+    robot = joulepath.load_robot(path)
+    tables = [
+        ingest([simulate(folder / f"{name}.csv", robot=str(path), n_moves=n, seed=s).log], robot=robot)
+        for name, n, s in (("train", 8, 1), ("test", 4, 2))
+    ]
+    return path, *tables
+
+
+def test_default_inputs_train_on_a_seven_joint_table(seven_joint_tables, tmp_path):
+    """Grey-box (physics) inputs take the table's 7-joint robot, never the 6-joint default."""
+    from joulepath.learn import train
+
+    path, train_table, test_table = seven_joint_tables
+    assert train_table.n_joints == 7 and TrainConfig().inputs == "physics"
+    config = TrainConfig(families=("par",), targets=("E",), cv=2, seed=0, robot=str(path))
+    report = train(train_table, test_table, config, tmp_path / "m")
+    card = json.loads((tmp_path / "m" / "par-E" / "card.json").read_text())
+    assert (
+        card["inputs"] == "physics" and card["robot_source"] == str(path) and "ddq7" in card["input_columns"]
+    )
+    assert np.isfinite(report.results["test_r2"]).all()
+    assert [b["label"] for b in report.baselines] == ["dynamics model, no friction"]
+
+
+@pytest.mark.parametrize(
+    ("robot", "pattern"),
+    [(None, "'arm7' is not a bundled robot or named arm; give its description"), ("irb120", "has 6 joints")],
+)
+def test_train_refuses_a_robot_it_cannot_take_from_the_table(seven_joint_tables, tmp_path, robot, pattern):
+    from joulepath.learn import train
+
+    _, train_table, test_table = seven_joint_tables
+    with pytest.raises(InvalidInput, match=pattern):
+        train(train_table, test_table, TrainConfig(families=("par",), cv=2, robot=robot), tmp_path / "m")
+    assert not (tmp_path / "m").exists()  # refused before anything was written
+
+
+def test_train_refuses_a_table_without_robot_for_physics_inputs(seven_joint_tables, tmp_path):
+    from dataclasses import replace
+
+    from joulepath.learn import train
+
+    _, train_table, test_table = seven_joint_tables
+    bare = replace(train_table, robot=None)
+    with pytest.raises(InvalidInput, match="the table names no robot"):
+        train(bare, test_table, TrainConfig(families=("par",), cv=2), tmp_path / "m")

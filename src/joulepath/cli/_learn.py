@@ -11,7 +11,6 @@ from pathlib import Path
 import typer
 
 from joulepath.cli._common import check_out_folder, console
-from joulepath.description import DEFAULT_ROBOT
 
 
 def _split(
@@ -56,7 +55,9 @@ def train(
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     jobs: int = typer.Option(1, min=1, help="Local processes for the grid search."),
     scheduler: str = typer.Option("", help="Dask scheduler address (tcp://HOST:PORT) for the grid search."),
-    robot: str = typer.Option(DEFAULT_ROBOT, help="Robot of the data."),
+    robot: str = typer.Option(
+        "", help="Robot of the data (name, .irml/.urdf or twin folder); default: the table's robot."
+    ),
 ) -> int:
     """Tune (grid search + CV), refit and test energy models; save them with cards and reports."""
     from joulepath import load_robot
@@ -76,9 +77,10 @@ def train(
         seed=seed,
         n_jobs=jobs,
         scheduler=scheduler or None,
-        robot=robot,
+        robot=robot or None,
     )
-    load_robot(robot)  # an unknown robot fails now, not after the training
+    if robot:
+        load_robot(robot)  # an unknown robot fails now, not after the training
     train_table, test_table = load_table(data), load_table(test)
     if target.strip() == "all":  # every target of the table's arm: E1..En and E
         config = replace(config, targets=train_table.targets)

@@ -9,6 +9,7 @@ import typer
 
 from joulepath.cli._cycle import cycle
 from joulepath.cli._data import ingest, rapid_app, simulate
+from joulepath.cli._evaluate import evaluate
 from joulepath.cli._experiment import demo, run
 from joulepath.cli._identify import identify
 from joulepath.cli._learn import importance, train
@@ -31,6 +32,7 @@ app.add_typer(rapid_app, name="rapid")
 app.command("simulate")(simulate)
 app.command("ingest")(ingest)
 app.command("identify")(identify)
+app.command("evaluate")(evaluate)
 app.command("train")(train)
 app.command("importance")(importance)
 app.command("synth")(synth)

@@ -212,7 +212,7 @@ def log_to_frame(
         dt[gaps - 1] = float(np.median(np.diff(t)))
     idx = np.nonzero(keep)[0]
     t, labels, dt = t[idx], labels[idx], dt[idx]
-    q, qd, tau = log.q[idx], log.qd[idx], log.tau[idx]
+    q, qd, tau = log.q[idx], log.qd[idx], log.torques("ingestion (the energy targets)")[idx]
     first = np.r_[True, labels[1:] != labels[:-1]]
     last = np.r_[labels[1:] != labels[:-1], True]
     cols: dict[str, np.ndarray] = {"move_id": labels + move_offset, "t": t}

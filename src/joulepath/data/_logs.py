@@ -7,7 +7,10 @@ N·m, mm, unit quaternion with ``e1 = w``, RAPID EulerZYX in deg (``psi`` about 
 
 Generic log (``kind="generic"``): a header naming at least ``t`` (s) and, per
 joint, ``q{i}`` (rad), ``dq{i}`` (rad/s), ``tau{i}`` (N·m); optional ``ddq{i}``
-(rad/s²) and ``move`` (an integer move label). Columns may come in any order.
+(rad/s²), ``i{i}`` (motor current, A) and ``move`` (an integer move label). With
+currents for every joint, ``tau{i}`` may be left out (a drive's log often has no
+torque); what needs torques (ingestion, identification, measuring) then says so.
+Columns may come in any order.
 
 Files are parsed block by block with pyarrow's streaming CSV reader. When that
 fails, a line-by-line pass finds the exact line and field to report. Every check
@@ -20,8 +23,9 @@ over :data:`MAX_SAMPLE_PERIOD_S`, or logged speeds about 1000 times the rate of 
 logged positions, mean milliseconds); a speed column that is about 57 times (or 1/57
 of) the rate of its position column means degrees mixed with radians. A generic
 log's header must name joints 1..n of an arm of 5 to 7 joints (``q1..q7``, ``dq1..dq7``,
-``tau1..tau7`` for a 7-joint arm), each with ``q``, ``dq`` and ``tau``: ``tau0`` or
-``q9`` or a missing ``tau3`` is refused, never dropped. Gaps in ``t`` are not
+``tau1..tau7`` for a 7-joint arm), each with ``q``, ``dq`` and ``tau`` (or ``i``):
+``tau0`` or ``q9`` or ``i8`` or a missing ``tau3`` is refused, never dropped; a current
+column is refused above :data:`MAX_CURRENT_A` (milliamperes, most likely). Gaps in ``t`` are not
 refused here: ingestion splits the moves there (:func:`joulepath.data.find_gaps`).
 """
 
@@ -49,7 +53,6 @@ from joulepath.data._schema import (
     MOVES_SIDECAR_COLUMNS,
     MOVES_SIDECAR_SUFFIX,
     N_JOINTS,
-    generic_required,
 )
 from joulepath.errors import InvalidLog
 from joulepath.units import DEG, MM
@@ -63,7 +66,10 @@ MIN_ROWS = 3
 MAX_SAMPLE_PERIOD_S = 1.0
 """Largest median sample period, s; above it ``t`` is taken for milliseconds and refused."""
 
-_JOINT_COLUMN = re.compile(r"^(q|dq|ddq|tau)(\d+)$")
+MAX_CURRENT_A = 1000.0
+"""Largest plausible motor current, A; a current column beyond it is taken for mA and refused."""
+
+_JOINT_COLUMN = re.compile(r"^(q|dq|ddq|tau|i)(\d+)$")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -76,8 +82,13 @@ class JointLog:
     kind : {"controller", "generic"}
     t : ndarray of shape (n,)
         s.
-    q, qd, tau : ndarray of shape (n, n_joints)
-        rad, rad/s, N·m (a controller log has 6 joints, a generic log 5 to 7).
+    q, qd : ndarray of shape (n, n_joints)
+        rad, rad/s (a controller log has 6 joints, a generic log 5 to 7).
+    tau : ndarray of shape (n, n_joints) or None
+        Joint torques, N·m; None for a generic log of currents only
+        (:meth:`torques` refuses it in one line).
+    current : ndarray of shape (n, n_joints) or None
+        Motor currents, A (generic logs with ``i{k}`` columns).
     qdd : ndarray of shape (n, n_joints) or None
         Logged accelerations (generic logs only), rad/s².
     tcp_position : ndarray of shape (n, 3) or None
@@ -95,16 +106,33 @@ class JointLog:
     t: FloatArray
     q: FloatArray
     qd: FloatArray
-    tau: FloatArray
+    tau: FloatArray | None
     qdd: FloatArray | None = None
     tcp_position: FloatArray | None = None
     tcp_quaternion: FloatArray | None = None
     tcp_euler: FloatArray | None = None
     move: np.ndarray | None = None
+    current: FloatArray | None = None
 
     @property
     def n_rows(self) -> int:
         return int(self.t.size)
+
+    def torques(self, purpose: str) -> FloatArray:
+        """The logged joint torques, or InvalidLog naming ``purpose`` for a log of currents only.
+
+        Raises
+        ------
+        InvalidLog
+            The log has motor currents ``i{k}`` but no torques ``tau{k}``.
+        """
+        if self.tau is None:
+            raise InvalidLog(
+                f"{self.source}: logs motor currents (i1..i{self.q.shape[1]}) but no joint torques; "
+                f"{purpose} needs the torques tau1..tau{self.q.shape[1]} (N·m): log them too "
+                "(`joulepath evaluate` scores a model on currents alone)"
+            )
+        return self.tau
 
 
 def _fail(source: str, problems: list[str], fix: str = "") -> InvalidLog:
@@ -205,12 +233,27 @@ def _check_joint_columns(header: list[str], source: str) -> None:
             f"but joulepath reads logs of arms of {MIN_JOINTS} to {MAX_JOINTS} joints, numbered from 1 "
             "(q1..qn, dq1..dqn, tau1..taun): remove those columns if they are not joints of the arm"
         )
-    missing = [c for c in generic_required(n) if c not in header]
+    joints = range(1, n + 1)
+    # torques, currents or both, each for every joint (torques when neither is there)
+    kinds = [p for p in ("tau", "i") if any(f"{p}{k}" in header for k in joints)] or ["tau"]
+    wanted = ("t", *(f"{p}{k}" for k in joints for p in ("q", "dq", *kinds)))
+    missing = [c for c in wanted if c not in header]
     if missing:
         raise InvalidLog(
             f"{source}: line 1: header lacks column(s) {', '.join(missing)} of a {n}-joint log; a generic "
-            f"log needs t and q{{i}}, dq{{i}}, tau{{i}} for i = 1..{n} (s, rad, rad/s, N·m)"
+            f"log needs t and q{{i}}, dq{{i}}, tau{{i}} for i = 1..{n} (s, rad, rad/s, N·m), or motor "
+            "currents i{i} (A) in place of (or beside) tau{i}"
         )
+
+
+def _is_generic(header: list[str]) -> bool:
+    """Whether a header has the generic log's columns for at least :data:`MIN_JOINTS` joints."""
+    joints = range(1, MIN_JOINTS + 1)
+    return (
+        "x" not in header
+        and all(c in header for c in ("t", *(f"{p}{k}" for k in joints for p in ("q", "dq"))))
+        and (all(f"tau{k}" in header for k in joints) or all(f"i{k}" in header for k in joints))
+    )
 
 
 def detect_kind(header: list[str], source: str) -> str:
@@ -222,7 +265,7 @@ def detect_kind(header: list[str], source: str) -> str:
             f"{source}: line 1: this is the list of programmed moves that `joulepath simulate` writes "
             f"beside its log (*{MOVES_SIDECAR_SUFFIX}), not a joint log; give the log itself"
         )
-    if "x" not in header and all(c in header for c in generic_required(MIN_JOINTS)):
+    if _is_generic(header):
         dup = sorted({h for h in header if header.count(h) > 1})
         if dup:
             raise InvalidLog(f"{source}: line 1: duplicated column(s) {', '.join(dup)}")
@@ -248,7 +291,8 @@ def detect_kind(header: list[str], source: str) -> str:
     missing = [c for c in GENERIC_REQUIRED if c not in header]
     raise InvalidLog(
         f"{source}: line 1: header lacks column(s) {', '.join(missing)}; a generic log needs "
-        "t and q{i}, dq{i}, tau{i} for i = 1..6 (s, rad, rad/s, N·m)"
+        "t and q{i}, dq{i}, tau{i} for i = 1..6 (s, rad, rad/s, N·m), or motor currents i{i} (A) "
+        "in place of tau{i}"
     )
 
 
@@ -422,6 +466,18 @@ def _check_units(q: FloatArray, qd: FloatArray, t: FloatArray, source: str, kind
         raise _fail(source, problems, fix)
 
 
+def _check_currents(current: FloatArray, source: str) -> None:
+    """Refuse current columns beyond :data:`MAX_CURRENT_A` (milliamperes, most likely)."""
+    peak = np.abs(current).max(axis=0)
+    big = np.nonzero(peak > MAX_CURRENT_A)[0]
+    if big.size:
+        raise _fail(
+            source,
+            [f"column i{j + 1} reaches {peak[j]:g}, more than {MAX_CURRENT_A:g} A" for j in big],
+            "motor currents are in A: is the column in mA? divide it by 1000",
+        )
+
+
 def read_log(path: str | os.PathLike[str]) -> JointLog:
     """Read and validate one controller or generic joint log.
 
@@ -440,7 +496,7 @@ def read_log(path: str | os.PathLike[str]) -> JointLog:
     joints = range(1, (N_JOINTS if kind == "controller" else generic_joints(header)) + 1)
     q = np.column_stack([cols[f"q{i}"] for i in joints])
     qd = np.column_stack([cols[f"dq{i}"] for i in joints])
-    tau = np.column_stack([cols[f"tau{i}"] for i in joints])
+    tau = np.column_stack([cols[f"tau{i}"] for i in joints]) if "tau1" in cols else None
     _check_time_unit(t, q, qd, source)
     _check_units(q, qd, t, source, kind)
     if kind == "controller":
@@ -467,7 +523,10 @@ def read_log(path: str | os.PathLike[str]) -> JointLog:
     if all(f"ddq{i}" in cols for i in joints):
         qdd = np.column_stack([cols[f"ddq{i}"] for i in joints])
     move = cols["move"].astype(np.int64) if "move" in cols else None
-    return JointLog(source=source, kind=kind, t=t, q=q, qd=qd, tau=tau, qdd=qdd, move=move)
+    current = np.column_stack([cols[f"i{i}"] for i in joints]) if "i1" in cols else None
+    if current is not None:
+        _check_currents(current, source)
+    return JointLog(source=source, kind=kind, t=t, q=q, qd=qd, tau=tau, qdd=qdd, move=move, current=current)
 
 
 def _numtostr(values: FloatArray) -> np.ndarray:
@@ -499,13 +558,25 @@ def controller_log_text(
     return ",".join(LOG_COLUMNS) + "\n" + body + "\n"
 
 
-def generic_log_text(t: FloatArray, q: FloatArray, qd: FloatArray, tau: FloatArray) -> str:
-    """A generic joint log's CSV text (s, rad, rad/s, N·m; 10 significant digits) for any joint count."""
+def generic_log_text(
+    t: FloatArray,
+    q: FloatArray,
+    qd: FloatArray,
+    tau: FloatArray | None,
+    *,
+    current: FloatArray | None = None,
+) -> str:
+    """A generic joint log's CSV text (s, rad, rad/s, N·m, A; 10 significant digits) for any joint count.
+
+    ``tau`` may be None when ``current`` is given (a log of currents only).
+    """
     n = q.shape[1]
-    head = ["t", *(f"{p}{i}" for i in range(1, n + 1) for p in ("q", "dq", "tau"))]
+    signals = [("q", q), ("dq", qd), ("tau", tau), ("i", current)]
+    present = [(name, s) for name, s in signals if s is not None]
+    head = ["t", *(f"{name}{i}" for i in range(1, n + 1) for name, _ in present)]
     cols = [t[:, None]]
     for i in range(n):
-        cols += [q[:, i : i + 1], qd[:, i : i + 1], tau[:, i : i + 1]]
+        cols += [s[:, i : i + 1] for _, s in present]
     data = np.concatenate(cols, axis=1)
     body = "\n".join(",".join(f"{v:.10g}" for v in row) for row in data.tolist())
     return ",".join(head) + "\n" + body + "\n"

@@ -347,6 +347,7 @@ def ingest(
                 )
             continue
         log = read_log(p)
+        log.torques("ingestion (the energy targets)")  # a log of currents only is refused here
         n_log = log.q.shape[1]
         if robot is not None and robot.n_joints != n_log:
             raise InvalidInput(

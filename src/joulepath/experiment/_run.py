@@ -443,7 +443,7 @@ def _study_utility(exp: Experiment, train: Any, test: Any) -> tuple[float, float
 
     from joulepath.learn import input_columns, make_pipeline
 
-    cols = list(input_columns(train.feature_set, exp.train.inputs))
+    cols = list(input_columns(train.feature_set, exp.train.inputs, train.n_joints))
     pipe = make_pipeline("mlp", seed=exp.seed, inputs=exp.train.inputs, columns=tuple(cols), robot=exp.robot)
     pipe.set_params(model__hidden_layer_sizes=(50,), model__activation="relu", model__alpha=0.1)
     with warnings.catch_warnings():

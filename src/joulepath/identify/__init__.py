@@ -15,6 +15,16 @@ from joulepath.identify._consistency import (
     triangle_margins,
 )
 from joulepath.identify._data import IdentificationData, data_from_logs
+from joulepath.identify._evaluate import (
+    EVALUATE_FILES,
+    DriveGains,
+    EvaluateConfig,
+    Evaluation,
+    drives_path,
+    evaluate_model,
+    read_drive_gains,
+    write_evaluation,
+)
 from joulepath.identify._excitation import (
     ExcitationDesign,
     FourierExcitation,
@@ -28,6 +38,7 @@ from joulepath.identify._fit import (
     IdentifyOptions,
     identify,
     joint_side,
+    r2_per_joint,
     score_prediction,
 )
 from joulepath.identify._regressor import (
@@ -43,6 +54,10 @@ from joulepath.identify._twin import CARD_FORMAT, link_inertials, twin_descripti
 __all__ = [
     "BaseParameters",
     "CARD_FORMAT",
+    "DriveGains",
+    "EVALUATE_FILES",
+    "EvaluateConfig",
+    "Evaluation",
     "ExcitationDesign",
     "FitScores",
     "FourierExcitation",
@@ -54,6 +69,8 @@ __all__ = [
     "base_parameters",
     "data_from_logs",
     "design_excitation",
+    "drives_path",
+    "evaluate_model",
     "friction_regressor",
     "from_log_cholesky",
     "identify",
@@ -62,6 +79,8 @@ __all__ = [
     "link_inertials",
     "min_eigenvalues",
     "pseudo_inertia",
+    "r2_per_joint",
+    "read_drive_gains",
     "score_prediction",
     "simulate_excitation",
     "to_log_cholesky",
@@ -69,5 +88,6 @@ __all__ = [
     "true_parameters",
     "twin_description",
     "twin_robot",
+    "write_evaluation",
     "write_twin",
 ]

@@ -142,6 +142,7 @@ def data_from_logs(paths: Sequence[str | os.PathLike[str]], robot: Robot) -> Ide
     n_stretch = 0
     for path in files:
         log = read_log(path)
+        tau = log.torques("identification")
         if log.q.shape[1] != robot.n_joints:
             raise InvalidInput(
                 f"{path}: the log has {log.q.shape[1]} joints but robot {robot.name!r} has "
@@ -159,7 +160,7 @@ def data_from_logs(paths: Sequence[str | os.PathLike[str]], robot: Robot) -> Ide
             keep = slice(0, b - a) if log.qdd is not None else slice(1, b - a - 1)
             tt = t[sl]
             dt = np.r_[np.diff(tt), np.diff(tt)[-1:]]
-            parts.append((log.q[sl][keep], log.qd[sl][keep], qdd[keep], log.tau[sl][keep], dt[keep]))
+            parts.append((log.q[sl][keep], log.qd[sl][keep], qdd[keep], tau[sl][keep], dt[keep]))
             labels.append(np.full(parts[-1][0].shape[0], n_stretch, dtype=np.int64))
             n_stretch += 1
     if not parts:

@@ -241,12 +241,36 @@ def _excitation(A: FloatArray, names: tuple[str, ...]) -> tuple[float, str]:
     return cond, names[int(np.argmax(np.abs(vt[-1])))]
 
 
+def r2_per_joint(measured: FloatArray, predicted: FloatArray) -> FloatArray:
+    """Coefficient of determination per column: ``1 - Σ(pred - meas)² / Σ(meas - mean)²``.
+
+    Parameters
+    ----------
+    measured, predicted : ndarray of shape (N, n)
+
+    Returns
+    -------
+    ndarray of shape (n,)
+        1 for a perfect prediction; NaN for a column of constant measured values
+        (no variance to explain).
+
+    Examples
+    --------
+    >>> r2_per_joint(np.array([[0.0], [1.0], [2.0]]), np.array([[0.0], [1.0], [3.0]])).round(3).tolist()
+    [0.5]
+    """
+    res = predicted - measured
+    sst = ((measured - measured.mean(axis=0)) ** 2).sum(axis=0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out: FloatArray = np.where(sst > 0, 1.0 - (res**2).sum(axis=0) / np.where(sst > 0, sst, 1.0), np.nan)
+    return out
+
+
 def score_prediction(pred: FloatArray, data: IdentificationData) -> FitScores:
     """Scores of predicted (motor-side) torques ``pred`` ``(N, n)`` against the data's."""
     tau = data.tau
     res = pred - tau
-    sst = ((tau - tau.mean(axis=0)) ** 2).sum(axis=0)
-    r2 = 1.0 - (res**2).sum(axis=0) / np.where(sst > 0, sst, np.inf)
+    r2 = r2_per_joint(tau, pred)
     e_true = joint_energy(tau, data.qd, data.dt).sum(axis=1)
     e_pred = joint_energy(pred, data.qd, data.dt).sum(axis=1)
     sse = float(((e_pred - e_true) ** 2).sum())
@@ -474,5 +498,6 @@ __all__ = [
     "REST_SPEED",
     "identify",
     "joint_side",
+    "r2_per_joint",
     "score_prediction",
 ]

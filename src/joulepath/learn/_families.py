@@ -27,7 +27,6 @@ from sklearn.neural_network import MLPRegressor
 from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
 
-from joulepath.dynamics import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.learn._features import PhysicsFeatures
 from joulepath.learn._svr import ScalableSVR
@@ -143,11 +142,16 @@ def make_pipeline(
     seed: int,
     inputs: str = "physics",
     columns: tuple[str, ...] | None = None,
-    robot: str = DEFAULT_ROBOT,
+    robot: str | None = None,
 ) -> Pipeline:
-    """The family's pipeline with its default hyperparameters."""
+    """The family's pipeline with its default hyperparameters.
+
+    ``robot`` (the robot of the data) is required for ``inputs="physics"``.
+    """
     steps: list[tuple[str, Any]] = []
     if inputs == "physics":
+        if robot is None:
+            raise InvalidInput("physics inputs need the robot of the data; give robot=<name or path>")
         steps.append(("physics", PhysicsFeatures(robot=robot, columns=columns)))
     elif inputs != "thesis":
         raise InvalidInput(f"inputs must be 'thesis' or 'physics', got {inputs!r}")

@@ -21,15 +21,11 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from joulepath._typing import FloatArray
 from joulepath.data import feature_columns, joints_in
-from joulepath.dynamics import DEFAULT_ROBOT
 from joulepath.energy import joint_energy
 
 INPUTS = ("thesis", "physics")
 PHYSICS_VERSION = 2
 """Version of the physics inputs; a model card records it and loading refuses another."""
-N_JOINTS = 6
-N_PHYSICS_TERMS = 4 * N_JOINTS + 1
-"""Columns :func:`physics_transform` appends for a 6-joint arm (:func:`n_physics_terms`)."""
 
 
 def n_physics_terms(n_joints: int) -> int:
@@ -40,7 +36,7 @@ def n_physics_terms(n_joints: int) -> int:
     return 4 * n_joints + 1
 
 
-def input_columns(feature_set: str, inputs: str, n_joints: int = N_JOINTS) -> tuple[str, ...]:
+def input_columns(feature_set: str, inputs: str, n_joints: int) -> tuple[str, ...]:
     """Table columns a model reads, in order."""
     base = feature_columns(feature_set, n_joints)
     return (*base, "dt") if inputs == "physics" else base
@@ -51,26 +47,37 @@ class PhysicsFeatures(TransformerMixin, BaseEstimator):  # type: ignore[misc]
 
     Parameters
     ----------
-    robot : str, default="irb120"
-        Bundled robot name or path to an .irml/.urdf file.
+    robot : str or None, default=None
+        The robot of the data: a bundled robot's name, a named arm, a path to an
+        .irml/.urdf file or a twin folder. Required: ``fit`` refuses None rather than
+        guess a robot (another arm's dynamics would make meaningless inputs).
     columns : tuple of str or None
         Names of the input columns, in order; must contain ``q{i}``, ``dq{i}``,
-        ``ddq{i}`` for i = 1..n and ``dt``. None: the physics inputs of ``full40`` (6 joints).
+        ``ddq{i}`` for i = 1..n and ``dt``, with n the robot's joint count. None: the
+        physics inputs of ``full40`` for the robot's joint count.
+
+    Raises
+    ------
+    ValueError
+        From ``fit``: no robot, columns that do not match X, or columns of another
+        number of joints than the robot has.
     """
 
-    def __init__(self, robot: str = DEFAULT_ROBOT, columns: tuple[str, ...] | None = None) -> None:
+    def __init__(self, robot: str | None = None, columns: tuple[str, ...] | None = None) -> None:
         self.robot = robot
         self.columns = columns
 
-    def _cols(self) -> tuple[str, ...]:
-        return self.columns if self.columns is not None else input_columns("full40", "physics")
-
     def fit(self, X: Any, y: Any = None) -> PhysicsFeatures:
         X = validate_data(self, X, reset=True, dtype=np.float64)
-        cols = self._cols()
+        n = self._robot().n_joints
+        cols = self.columns if self.columns is not None else input_columns("full40", "physics", n)
         if len(cols) != X.shape[1]:
             raise ValueError(f"X has {X.shape[1]} columns but `columns` names {len(cols)}")
-        n = joints_in(cols) or N_JOINTS
+        if joints_in(cols) != n:
+            raise ValueError(
+                f"the columns name {joints_in(cols)} joints, but robot {self.robot!r} has {n}; "
+                "give the robot of the data"
+            )
         need = [f"{p}{i}" for p in ("q", "dq", "ddq") for i in range(1, n + 1)] + ["dt"]
         missing = [c for c in need if c not in cols]
         if missing:
@@ -83,6 +90,8 @@ class PhysicsFeatures(TransformerMixin, BaseEstimator):  # type: ignore[misc]
         if robot is None:
             from joulepath.dynamics import load_robot
 
+            if self.robot is None:
+                raise ValueError("PhysicsFeatures needs the robot of the data; give robot=<name or path>")
             robot = load_robot(self.robot)
             self._robot_cache = robot
         return robot

@@ -9,7 +9,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -19,7 +19,6 @@ from sklearn.model_selection import ParameterGrid
 from joulepath._io import atomic_write_text
 from joulepath.data import EnergyTable, target_columns
 from joulepath.data._schema import MAX_JOINTS
-from joulepath.dynamics import DEFAULT_ROBOT
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._evaluate import physics_baseline, score
 from joulepath.learn._families import FAMILIES, GRIDS, SUBSTITUTIONS, grid_for, make_pipeline
@@ -34,6 +33,9 @@ from joulepath.learn._search import (
     pending_candidates,
 )
 from joulepath.learn._svr import KERNEL_SVR_MAX_ROWS, SubsampleWarning
+
+if TYPE_CHECKING:
+    from joulepath.dynamics import Robot
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -55,8 +57,10 @@ class TrainConfig:
         Local processes for the grid search.
     scheduler : str or None
         Dask scheduler address; the grid search then runs on that cluster.
-    robot : str
-        Robot of the data (for ``inputs="physics"`` and the physics baseline).
+    robot : str or None
+        Robot of the data (for ``inputs="physics"`` and the physics baselines): a
+        bundled robot, a named arm, a robot file or a twin folder. None: the robot the
+        training table was ingested with (never a default robot).
     """
 
     families: tuple[str, ...] = FAMILIES
@@ -67,7 +71,7 @@ class TrainConfig:
     seed: int = 0
     n_jobs: int = 1
     scheduler: str | None = None
-    robot: str = DEFAULT_ROBOT
+    robot: str | None = None
 
     def __post_init__(self) -> None:
         bad = [f for f in self.families if f not in FAMILIES]
@@ -93,6 +97,46 @@ class TrainingReport:
     baselines: list[dict[str, Any]]
     out_dir: Path
     models: dict[str, Path] = field(default_factory=dict)
+
+
+def _table_robot(table: EnergyTable, robot: str | None = None) -> tuple[str, Robot]:
+    """The robot of a table's data, as ``(source, robot)``: ``robot`` if given, else the table's own.
+
+    A table names the robot it was ingested with (:attr:`EnergyTable.robot`, the
+    robot's name). That name is loaded when it is a bundled robot's or a named arm's
+    (``"irb120"``'s robot is named ``"IRB 120"``); any other robot (a file of one's
+    own) must be given. Never falls back to a default robot.
+
+    Raises
+    ------
+    InvalidInput
+        The table names no robot and none is given, the table's robot is not a
+        bundled one, or the robot has another number of joints than the table.
+    """
+    from joulepath.description import NAMED_ARMS, PRESETS
+    from joulepath.dynamics import load_robot
+
+    source = robot
+    if source is None:
+        if table.robot is None:
+            raise InvalidInput(
+                f"the table names no robot (it was ingested without --robot) and no robot was given; "
+                f"give the robot of the data (--robot), e.g. {PRESETS[0]} or a .urdf/.irml file"
+            )
+        by_name = {load_robot(p).name: p for p in PRESETS}
+        source = table.robot if table.robot in (*PRESETS, *NAMED_ARMS) else by_name.get(table.robot)
+        if source is None:
+            raise InvalidInput(
+                f"the table's robot {table.robot!r} is not a bundled robot or named arm; give its "
+                "description (--robot path/to/robot.urdf or .irml)"
+            )
+    loaded = load_robot(source)
+    if loaded.n_joints != table.n_joints:
+        raise InvalidInput(
+            f"robot {source!r} has {loaded.n_joints} joints, but the table holds a {table.n_joints}-joint "
+            "arm; give the robot of the data (--robot)"
+        )
+    return source, loaded
 
 
 def _duration(seconds: float) -> str:
@@ -203,8 +247,6 @@ def train(
         Receives the grid search's progress as numbers (for progress bars; no
         need to parse ``progress`` messages).
     """
-    from joulepath.dynamics import load_robot
-
     for name, table in (("training", train_table), ("test", test_table)):
         if len(table.frame) == 0:
             raise InvalidInput(
@@ -215,10 +257,6 @@ def train(
             f"train table has feature set {train_table.feature_set!r}, test table "
             f"{test_table.feature_set!r}; ingest both the same way"
         )
-    if config.scheduler is not None:  # an unreachable scheduler fails before anything is written
-        connect_scheduler(config.scheduler).close()
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     if train_table.n_joints != test_table.n_joints:
         raise InvalidInput(
             f"the training table holds a {train_table.n_joints}-joint arm, the test table a "
@@ -230,17 +268,27 @@ def train(
             f"targets {', '.join(beyond)} name joints the {train_table.n_joints}-joint arm of the table "
             f"does not have; use any of {', '.join(train_table.targets)}"
         )
+    say = progress or (lambda _msg: None)
+    robot_source: str | None = None
+    robot: Robot | None = None
+    if config.inputs == "physics" or config.robot is not None or train_table.robot is not None:
+        robot_source, robot = _table_robot(train_table, config.robot)
+    else:
+        say("no robot given and the table names none: the physics baselines are left out")
+    if config.scheduler is not None:  # an unreachable scheduler fails before anything is written
+        connect_scheduler(config.scheduler).close()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
     cols = input_columns(train_table.feature_set, config.inputs, train_table.n_joints)
     X = train_table.frame[list(cols)].to_numpy(dtype=np.float64)
     groups = train_table.frame["move_id"].to_numpy()
     rows: list[dict[str, Any]] = []
     saved: dict[str, Path] = {}
-    say = progress or (lambda _msg: None)
     for family in config.families:
         for target in config.targets:
             y = train_table.frame[target].to_numpy(dtype=np.float64)
             pipeline = make_pipeline(
-                family, seed=config.seed, inputs=config.inputs, columns=cols, robot=config.robot
+                family, seed=config.seed, inputs=config.inputs, columns=cols, robot=robot_source
             )
             grid = grid_for(family, config.grid)
             cache_dir = out / ".gridcache" / f"{family}-{target}"
@@ -280,7 +328,7 @@ def train(
                 "physics_version": PHYSICS_VERSION,
                 "input_columns": list(cols),
                 "robot": train_table.robot,
-                "robot_source": config.robot,
+                "robot_source": robot_source,
                 "units": {"inputs": "SI (rad, rad/s, rad/s^2, m, m/s, s)", "target": "J per row"},
                 "training_data_sha256": train_table.fingerprint(),
                 "training_rows": len(y),
@@ -345,11 +393,12 @@ def train(
     plot_importance(imp, out / "importance_E.png", title="Feature importance for E (training data)")
     joints = rank_joints(imp)
     atomic_write_text(out / "joints.json", json.dumps({"target": "E", "joints_by_influence": joints}))
-    robot = load_robot(config.robot)
-    baselines = [
-        physics_baseline(test_table, robot, friction=None, label="dynamics model, no friction"),
-    ]
-    if robot.friction is not None:
+    baselines = (
+        []
+        if robot is None
+        else [physics_baseline(test_table, robot, friction=None, label="dynamics model, no friction")]
+    )
+    if robot is not None and robot.friction is not None:
         baselines.append(
             physics_baseline(
                 test_table, robot, friction=robot.friction, label="dynamics model + nominal friction"
@@ -359,6 +408,7 @@ def train(
     atomic_write_text(out / "results.csv", results.to_csv(index=False))
     report = {
         "config": asdict(config),
+        "robot_source": robot_source,
         "train": {
             "rows": len(train_table.frame),
             "moves": train_table.n_moves,

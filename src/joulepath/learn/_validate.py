@@ -358,7 +358,11 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
         phys = steps["physics"]
         if not isinstance(phys, PhysicsFeatures) or not hasattr(phys, "index_"):
             raise InvalidModel(f"{where}: the physics step is not a fitted PhysicsFeatures")
-        trained = tuple(phys.columns) if phys.columns is not None else input_columns("full40", "physics")
+        trained = (
+            tuple(phys.columns)
+            if phys.columns is not None
+            else input_columns("full40", "physics", card_joints(cols))
+        )
         if trained != cols:
             raise InvalidModel(
                 f"{where}: the model was trained on other input columns than its card lists "

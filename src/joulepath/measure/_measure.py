@@ -105,7 +105,7 @@ class Measurement:
 def _energy(log: JointLog, w: Window) -> float:
     sl = slice(w.first, w.last)
     dt = np.diff(log.t[w.first : w.last + 1])
-    return float(total_energy(log.tau[sl], log.qd[sl], dt).sum())
+    return float(total_energy(log.torques("measuring")[sl], log.qd[sl], dt).sum())
 
 
 def _classify(
@@ -214,6 +214,7 @@ def measure_run(log: str | os.PathLike[str], plan: str | os.PathLike[str]) -> Me
     """
     the_plan = read_plan(plan)
     the_log = read_log(log)
+    the_log.torques("measuring")  # a log of currents only is refused before the search
     source = the_log.source
     n = the_plan.start.size
     if the_log.q.shape[1] != n:
@@ -300,7 +301,8 @@ def power_figure(run: MeasureRun) -> Any:
     log = run.log
     for rep, w in zip(run.measurement.repetitions, run.windows, strict=True):
         t = log.t[w.first : w.last + 1]
-        p = joint_power(log.tau[w.first : w.last + 1], log.qd[w.first : w.last + 1]).sum(axis=1)
+        tau = log.torques("measuring")
+        p = joint_power(tau[w.first : w.last + 1], log.qd[w.first : w.last + 1]).sum(axis=1)
         style = ("--", "tab:gray") if rep.kind == "default" else ("-", "tab:green")
         ax.plot(t - t[0], p, style[0], color=style[1], alpha=0.8, lw=1.0)
     ax.plot([], [], "--", color="tab:gray", label=f"default ({run.measurement.default.n})")
