@@ -1,0 +1,223 @@
+"""The written module keeps the program: a diff against the input shows only the optimized moves and
+the additions; parse -> write -> parse gives the motion written; a re-taught target moves the robot."""
+
+import difflib
+import re
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import joulepath
+from joulepath.optimize import GradientSettings
+from joulepath.program import CycleSettings, optimize_cycle, parse_module, read_cycle_program, resolve_module
+from joulepath.program._output import check_written, reads_back, written_rapid
+from joulepath.program._rapid_write import motion_model, planned_model, same_model
+
+FAST = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), max_iter=60, coarse_factor=1)
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+TWICE = """MODULE Twice
+    CONST jointtarget jA := [[-30, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST jointtarget jB := [[40, 25, -5, 20, 50, 30], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    PROC main()
+        WHILE TRUE DO
+            Swing;
+            WaitTime 0.5;
+            Swing;
+            WaitTime 0.5;
+        ENDWHILE
+    ENDPROC
+    PROC Swing()
+        MoveAbsJ jB, v1000, fine, tool0;
+        MoveAbsJ jA, v1000, fine, tool0;
+    ENDPROC
+ENDMODULE
+"""
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return joulepath.load_robot("irb120")
+
+
+@pytest.fixture(scope="module")
+def palletizing(robot):
+    spec, _ = read_cycle_program(EXAMPLES / "palletizing.mod", robot)
+    result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
+    return result
+
+
+@pytest.fixture(scope="module")
+def twice(robot):
+    spec = resolve_module(parse_module(TWICE, path="twice.mod"), robot)
+    result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, cycle_time=4.5))
+    return result
+
+
+def _changes(before: str, after: str) -> tuple[list[tuple[int, str, str]], list[str]]:
+    """(line, old, new) for lines changed in place, and the lines added, by difflib."""
+    a, b = before.splitlines(), after.splitlines()
+    changed: list[tuple[int, str, str]] = []
+    added: list[str] = []
+    for tag, i1, i2, j1, j2 in difflib.SequenceMatcher(None, a, b, autojunk=False).get_opcodes():
+        if tag == "equal":
+            continue
+        old, new = a[i1:i2], b[j1:j2]
+        for k, line in enumerate(old):
+            twin = next((n for n in new if n.strip().startswith(line.strip().rstrip(";)").strip())), None)
+            changed.append((i1 + k + 1, line, twin or ""))
+        added.extend(n for n in new if n not in {c[2] for c in changed})
+    return changed, added
+
+
+def _check_diff(source: str, layout) -> None:
+    """Every changed line is an optimized move line or a call / PROC line of a procedure given
+    jpRun (the same line with one more argument); every added line is an addition."""
+    changed, added = _changes(source, layout.text)
+    optimized = {m.line for m in layout.moves}
+    indexed = [p.lower() for p in layout.indexed]
+    for line, old, new in changed:
+        if line in optimized:
+            continue
+        word = re.sub(r"^\s*(PROC\s+)?", "", old).split("(")[0].split()[0].rstrip(";").lower()
+        assert word in indexed, f"line {line} changed: {old.strip()!r}"
+        assert new.strip().startswith(old.strip().rstrip(";)")), (old, new)
+        assert "jpRun" in new or new.rstrip().endswith(";"), new
+    text = layout.text.splitlines()
+    decl_at = next(k for k, t in enumerate(text) if "via points of the optimized moves" in t)
+    decl_end = next(k for k in range(decl_at, len(text)) if not text[k].strip())
+    procs_at = next(k for k, t in enumerate(text) if "the optimized moves (additions" in t)
+    additions = set(text[decl_at:decl_end]) | set(text[procs_at:-1])
+    for line in added:
+        s = line.strip()
+        assert line in additions or s.startswith("!") or re.fullmatch(r"jp_opt_\w+( .*)?;", s) or not s, (
+            f"added outside the additions: {line!r}"
+        )
+    assert all(
+        re.fullmatch(r"(CONST jointtarget jp_\w+\{\d+\} := \[|\[\[.*\]\],?|\];|!.*)", t.strip())
+        for t in text[decl_at:decl_end]
+    )
+
+
+def test_palletizing_keeps_its_loops_procedures_and_targets(palletizing):
+    """The written palletizing module keeps its FOR loops, its procedures and its named targets; a diff
+    against the input shows only the optimized moves and the additions; it reads back as written."""
+    source = (EXAMPLES / "palletizing.mod").read_text()
+    layout = written_rapid(palletizing)
+    text = layout.text
+    for kept in (
+        "FOR row FROM 0 TO 1 DO",
+        "FOR col FROM 0 TO 2 DO",
+        "MoveL pPick, v300, fine, tVacuum;",
+        "MoveL pPlace, v300, fine, tVacuum;",
+        "WaitTime 3; ! joulepath: idle",
+    ):
+        assert kept in text
+    for decl in [ln for ln in source.splitlines() if ln.strip().startswith(("CONST", "PERS"))]:
+        assert decl in text.splitlines()  # every declaration verbatim
+    assert (
+        re.search(r"PROC PickPart\(num jpRun\)", text)
+        and "PROC PlacePart(robtarget pPlace, num jpRun)" in text
+    )
+    _check_diff(source, layout)
+    assert reads_back(palletizing, text) is None
+    # the runs of the pick approach differ (each from another place): per run, each run its own via points
+    pick = next(m for m in layout.moves if m.procedure == "PickPart")
+    assert pick.runs == 6 and pick.selection == "per run" and pick.shapes == pick.optimized_runs
+    assert "TEST jpCtx" in text and "DEFAULT:" in text
+    # a target the robot stops at ends with the program's own target
+    home = next((m for m in layout.moves if m.final_target == "jHome"), None)
+    if home is not None:
+        assert re.search(r"MoveAbsJ jHome, v7000 \\T:=[\d.]+, fine, tVacuum;", text)
+    assert set(layout.reteach) <= {"pPick", "pPallet", "jHome"} and "pPick" in layout.reteach
+
+
+def test_reteaching_the_pick_moves_the_written_program(palletizing, robot):
+    """Re-teach pPick in the written module (its value, as on the FlexPendant): parsed back, the
+    program's pick moves go to the new pick, exactly where the taught program with the same edit goes,
+    and the optimized via points stay."""
+    old = "CONST robtarget pPick := [[175, -375, 140],"
+    new = "CONST robtarget pPick := [[180, -370, 150],"
+    source = (EXAMPLES / "palletizing.mod").read_text()
+    text = written_rapid(palletizing).text
+    assert old in text
+    moved = resolve_module(parse_module(text.replace(old, new), path="w.mod"), robot)
+    kept = resolve_module(parse_module(text, path="w.mod"), robot)
+    taught = resolve_module(parse_module(source.replace(old, new), path="t.mod"), robot)
+    picks = lambda spec: [s.q for s in spec.steps if s.kind == "move" and s.label == "MoveL pPick"]  # noqa: E731
+    assert len(picks(moved)) == 6
+    for q_new, q_taught, q_old in zip(picks(moved), picks(taught), picks(kept), strict=True):
+        np.testing.assert_allclose(q_new, q_taught, atol=1e-12)
+        assert np.abs(q_new - q_old).max() > 1e-3
+    tcp = moved.steps[next(i for i, s in enumerate(moved.steps) if s.label == "MoveL pPick")]
+    fk = robot.fk(tcp.q[None, :])
+    p = fk.position_m[0] + fk.rotation[0] @ tcp.tcp[:3, 3]
+    np.testing.assert_allclose(1000 * p, [180, -370, 150], atol=1e-6)
+    vias = lambda spec: [s.q for s in spec.steps if s.label.startswith("MoveAbsJ jp_")]  # noqa: E731
+    np.testing.assert_allclose(np.array(vias(moved)), np.array(vias(kept)), atol=0)
+
+
+def test_stop_target_is_the_programs_own_and_is_retaught(twice, robot):
+    """A move that stops at its target ends with the program's own move to it (same target, tool,
+    timed): re-teaching jA moves the written program's stop there."""
+    layout = written_rapid(twice)
+    assert reads_back(twice, layout.text) is None
+    named = [m for m in layout.moves if m.final_target is not None]
+    assert named, "a stop at a target ends at the named target"
+    for m in named:
+        assert re.search(rf"MoveAbsJ {m.final_target}, v7000 \\T:=[\d.]+, fine, tool0;", layout.text)
+    old = "[[-30, 10, 10, 0, 40, 0]"
+    moved = resolve_module(
+        parse_module(layout.text.replace(old, "[[-35, 10, 10, 0, 40, 0]"), path="w.mod"), robot
+    )
+    ends = [s.q for s in moved.steps if s.label == "MoveAbsJ jA"]
+    assert ends and all(np.degrees(q[0]) == pytest.approx(-35.0) for q in ends)
+    assert "jA" in layout.reteach
+
+
+def test_procedure_called_twice_same_motion_is_one_shared_shape(twice):
+    """Where every run of a move is the same motion, one shared shape is written (no TEST, no jpRun);
+    where they differ, one per run, picked by the run number its call sites pass; both read back."""
+    spec = twice.spec
+    runs: dict[int, list[int]] = {}
+    for i in twice.paths:
+        runs.setdefault(spec.steps[i].line, []).append(i)
+    line, (a, b) = next((ln, ix) for ln, ix in runs.items() if len(ix) == 2)
+    same = replace(twice, paths={**twice.paths, b: twice.paths[a]}, vias={**twice.vias, b: twice.vias[a]})
+    layout = written_rapid(same)
+    move = next(m for m in layout.moves if m.line == line)
+    assert move.selection == "shared" and move.shapes == 1 and move.runs == 2
+    assert reads_back(same, layout.text) is None
+    differ = written_rapid(twice)
+    m2 = next(m for m in differ.moves if m.line == line)
+    if m2.selection == "per run":
+        assert "Swing" in differ.indexed and "Swing 1;" in differ.text and "Swing 2;" in differ.text
+    assert reads_back(twice, differ.text) is None
+    _check_diff(TWICE, differ)
+    _check_diff(TWICE, layout)
+
+
+def test_round_trip_is_checked_against_the_written_motion(twice, robot):
+    """The round trip compares the motion itself: a written module with one via point's time changed
+    does not read back as written."""
+    text = written_rapid(twice).text
+    spec = resolve_module(parse_module(text, path="w.mod"), robot)
+    assert same_model(motion_model(spec), planned_model(twice)) is None
+    tampered = re.sub(r"\\T:=([\d.]+)", lambda m: f"\\T:={float(m.group(1)) + 0.01:g}", text, count=1)
+    spec2 = resolve_module(parse_module(tampered, path="w.mod"), robot)
+    assert same_model(motion_model(spec2), planned_model(twice)) is not None
+
+
+def test_written_module_goes_through_the_check(twice):
+    """The structure-keeping module is what the controller emulation runs: the check's verdict is
+    consistent with its numbers (whether it passes is reported, not assumed)."""
+    check = check_written(twice, written_rapid(twice).text)
+    tol = check["tolerances"]
+    expected = (
+        check["emulated_cycle_s"] <= twice.target_cycle_s + tol["slower_than_taught_s"]
+        and check["emulated_energy_J"] <= twice.default_energy_J * (1 - tol["saved_at_least_pct"] / 100)
+        and check["tcp_path_deviation_mm"] <= tol["path_mm"]
+    )
+    assert check["within_tolerances"] == expected
