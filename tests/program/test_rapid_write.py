@@ -221,3 +221,68 @@ def test_written_module_goes_through_the_check(twice):
         and check["tcp_path_deviation_mm"] <= tol["path_mm"]
     )
     assert check["within_tolerances"] == expected
+
+
+def test_run_number_expression_counts_the_runs_in_order():
+    """The run number written for a position inside FOR loops (any first value and step, and a
+    procedure's jpRun) counts 1, 2, ... in the order the loops run: the expression, evaluated by the
+    program reader, against the mixed-radix count."""
+    from joulepath.program._model import ForLoop
+    from joulepath.program._parse import Names, _evaluate
+    from joulepath.program._rapid_write import _run_expression, _run_value
+
+    outer = ForLoop(1, 9, "i", (5, 3, 1), ())  # FOR i FROM 5 TO 1 STEP -2
+    inner = ForLoop(2, 8, "j", (-1, 0, 1, 2), ())  # FOR j FROM -1 TO 2
+    third = ForLoop(3, 7, "k", (0, 3, 6), ())  # FOR k FROM 0 TO 6 STEP 3
+    loops = (outer, inner, third)
+    for indexed in (False, True):
+        expr = _run_expression(list(loops), indexed)
+        count = 0
+        for run in (1, 2) if indexed else (None,):
+            for a in range(3):
+                for b in range(4):
+                    for c in range(3):
+                        count += 1
+                        names = Names(loop={"i": outer.values[a], "j": inner.values[b], "k": third.values[c]})
+                        if run is not None:
+                            names.params["jprun"] = float(run)
+                        value = _evaluate("t.mod", 1, expr, names, "run")
+                        here = ((outer, a), (inner, b), (third, c))
+                        assert value == count == _run_value(here, run)
+
+
+def test_payload_tool_procedure_with_arguments_reads_back(robot):
+    """payload_tool: a procedure with two target arguments called twice, moves in a work object. Its
+    written module keeps the procedure and its arguments, ends the stops at the program's own targets
+    (with their work object), shows only optimized moves and additions in a diff, and reads back."""
+    spec, _ = read_cycle_program(EXAMPLES / "payload_tool.mod", robot)
+    result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
+    source = (EXAMPLES / "payload_tool.mod").read_text()
+    layout = written_rapid(result)
+    assert "PROC Transfer(robtarget pFrom, robtarget pTo" in layout.text
+    assert reads_back(result, layout.text) is None
+    _check_diff(source, layout)
+    for m in layout.moves:
+        assert m.runs == 2
+        if m.final_target is not None:
+            end = r"\w+, tGripper2 \\WObj:=wobjFixture;"
+            assert re.search(rf"Move[JL] {re.escape(m.final_target)}, v7000 \\T:=[\d.]+, {end}", layout.text)
+
+
+def test_cycle_json_says_what_the_module_holds(twice, tmp_path):
+    """cycle.json's rapid_structure names each optimized line, its procedure and how its runs are
+    written, and the lines to optimize again per re-taught target, as the module holds them."""
+    import json
+
+    from joulepath.program import write_cycle_run
+
+    files = write_cycle_run(tmp_path, twice, pareto=None, write_rapid=True, write_anyway=True)
+    data = json.loads(files["cycle.json"].read_text())
+    if "optimized.mod" not in files:
+        assert data["rapid_structure"] is None
+        return
+    text = files["optimized.mod"].read_text()
+    structure = data["rapid_structure"]
+    for m in structure["optimized_lines"]:
+        assert f"PROC {m['call']}(" in text and m["procedure"] == "Swing"
+    assert set(structure["reteach"]) == {"jA", "jB"}

@@ -241,6 +241,8 @@ def _run_value(loops: Sequence[tuple[ForLoop, int]], run: int | None) -> int:
 
 
 def _site_argument(run_expr: str, sites: int, site: int) -> str:
+    if run_expr == "1":
+        return str(site + 1)
     if sites == 1:
         return run_expr
     return f"({run_expr} - 1) * {sites} + {site + 1}"
@@ -380,7 +382,7 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
                     finals.add(final)
             if len(groups) == 1:
                 body.extend(part)
-            else:
+            elif final != "taught":  # the taught runs go to DEFAULT
                 body.append(f"CASE {', '.join(map(str, sorted(vals)))}:")
                 body.extend("    " + t for t in part)
         if len(groups) > 1:
@@ -391,13 +393,10 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
             args.append(_run_expression(loops, needs.get(first.proc, False)))
         opt_runs = sum(1 for i in steps_l if i in result.paths)
         shapes = sum(1 for k in groups if k[2] != "taught")
-        selection = (
-            "shared" if len(groups) == 1 else f"per run ({CONTEXT_PARAM}: TEST picks the run's via points)"
-        )
+        selection = "shared" if len(groups) == 1 else "per run"
+        how = "shared" if len(groups) == 1 else f"per run: TEST {CONTEXT_PARAM}"
         new_procs.append(f"PROC {call_name}({', '.join(params)})")
-        new_procs.append(
-            f"    ! joulepath: {original} optimized; {len(steps_l)} run(s) per cycle, {selection}"
-        )
+        new_procs.append(f"    ! joulepath: optimized {original} ({len(steps_l)} run(s) per cycle, {how})")
         new_procs.extend("    " + t for t in body)
         new_procs.append("ENDPROC")
         call = call_name + (" " + ", ".join(args) if args else "") + ";"
@@ -411,7 +410,7 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
                 len(steps_l),
                 opt_runs,
                 shapes,
-                selection.split(" (")[0],
+                selection,
                 final_target,
                 tuple(sorted(k for k, v in reteach_of.items() if ln in v)),
             )
