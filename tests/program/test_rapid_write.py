@@ -286,3 +286,23 @@ def test_cycle_json_says_what_the_module_holds(twice, tmp_path):
     for m in structure["optimized_lines"]:
         assert f"PROC {m['call']}(" in text and m["procedure"] == "Swing"
     assert set(structure["reteach"]) == {"jA", "jB"}
+
+
+def test_a_name_the_module_already_uses_is_refused_in_one_line(twice, tmp_path):
+    """The names joulepath adds must be new: one that the module already declares refuses the module in
+    one line naming it (cycle.json's rapid_refused), nothing half-written."""
+    import json
+
+    from joulepath.errors import LimitViolation
+    from joulepath.program import write_cycle_run
+
+    lines = TWICE.splitlines()
+    lines[2] += " CONST num jp_Swing_1 := 1;"  # same line numbers: the cycle's steps still fit
+    clash = "\n".join(lines) + "\n"
+    result = replace(twice, spec=replace(twice.spec, module=parse_module(clash, path="twice.mod")))
+    with pytest.raises(LimitViolation, match=r"jp_swing_1\) are already used") as err:
+        written_rapid(result)
+    assert "\n" not in str(err.value)
+    files = write_cycle_run(tmp_path, result, pareto=None, write_rapid=True, egm="never")
+    assert "optimized.mod" not in files
+    assert "already used" in json.loads(files["cycle.json"].read_text())["rapid_refused"]

@@ -15,6 +15,7 @@ from joulepath._io import atomic_write_text, finite_json
 from joulepath.errors import LimitViolation
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._cycle import CycleResult, ParetoPoint
+from joulepath.program._model import RapidError
 from joulepath.program._rapid_write import (
     WrittenModule,
     motion_model,
@@ -46,7 +47,9 @@ ASSUMPTIONS = (
     "fly-by targets (each passed within its zone: the zone radius reduced to half of either move's TCP "
     "length, as a joint box; or exactly with --exact-targets), with its taught motion kept as a candidate "
     "at its taught duration, so the taught cycle time is always reachable (at worst 0 % saved); written as "
-    "MoveAbsJ via points with \\T in z200 zones, the last via point of a unit keeps its stop (fine)",
+    "MoveAbsJ via points with \\T in z200 zones in an added PROC jp_opt_<proc>_<n> per move line, called "
+    "where the move stood (the rest of the program as written); the last point of a unit keeps its stop "
+    "(fine), and where the plan ends at the target it is the program's own move to its named target",
     "segments with a MoveL, and moves that occur more than once: run as taught (the controller's own "
     "blends and timing, as emulated)",
     "waits are process time; only waits declared idle (`! joulepath: idle` or --idle-wait LINE) are "
@@ -375,7 +378,10 @@ def _rapid_attempt(
         first = written_rapid(result)
     except LimitViolation as err:
         return None, None, str(err), None
-    differs = reads_back(result, first.text)
+    try:
+        differs = reads_back(result, first.text)
+    except RapidError as err:
+        differs = f"it cannot be read: {err}"
     if differs is not None:
         return (
             None,

@@ -415,15 +415,15 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
                 tuple(sorted(k for k, v in reteach_of.items() if ln in v)),
             )
         )
-    taken = {d.name.lower() for d in module.declarations} | set(procs)
+    taken = {w.lower() for w in re.findall(r"[A-Za-z]\w*", "\n".join(source))}  # any name the module uses
     added = [m.call.lower() for m in written] + [
         d.split()[2].split("{")[0].lower() for d in decls if d.startswith("CONST jointtarget")
     ]
     clash = sorted((set(added) & taken) | {a for a in added if added.count(a) > 1})
     if clash:
         raise LimitViolation(
-            f"the names joulepath adds ({', '.join(clash)}) are already taken in the module (or shortened "
-            "to the same name); the program is not written (rename them)"
+            f"the names joulepath adds ({', '.join(clash)}) are already used in the module (or shortened "
+            "to the same name); the program is not written (rename them in the module)"
         )
     for p in indexed:
         proc = procs[p]
