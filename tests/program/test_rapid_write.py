@@ -13,7 +13,7 @@ import joulepath
 from joulepath.optimize import GradientSettings
 from joulepath.program import CycleSettings, optimize_cycle, parse_module, read_cycle_program, resolve_module
 from joulepath.program._output import check_written, reads_back, written_rapid
-from joulepath.program._rapid_write import motion_model, planned_model, same_model
+from joulepath.program._rapid_write import motion_model, planned_model, restore_program, same_model
 
 FAST = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), max_iter=60, coarse_factor=1)
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -261,6 +261,7 @@ def test_payload_tool_procedure_with_arguments_reads_back(robot):
     layout = written_rapid(result)
     assert "PROC Transfer(robtarget pFrom, robtarget pTo" in layout.text
     assert reads_back(result, layout.text) is None
+    assert restore_program(layout.text) == source
     _check_diff(source, layout)
     for m in layout.moves:
         assert m.runs == 2
@@ -306,3 +307,24 @@ def test_a_name_the_module_already_uses_is_refused_in_one_line(twice, tmp_path):
     files = write_cycle_run(tmp_path, result, pareto=None, write_rapid=True, egm="never")
     assert "optimized.mod" not in files
     assert "already used" in json.loads(files["cycle.json"].read_text())["rapid_refused"]
+
+
+def test_written_module_restores_the_program_it_was_written_from(palletizing, twice, robot, tmp_path):
+    """restore(write(program)) is the program, to the character; a written module re-taught on the
+    pendant is read by `cycle` as the program with the re-taught target, ready to optimize again."""
+    source = (EXAMPLES / "palletizing.mod").read_text()
+    text = written_rapid(palletizing).text
+    assert restore_program(text) == source
+    assert restore_program(written_rapid(twice).text) == TWICE
+    assert restore_program(source) is None  # not written by joulepath: read as it is
+    # with its waits spent (--use-waits): the wait comes back as written, its idle mark included
+    spent = replace(twice, waits=tuple((line, s, s / 2) for line, s, _ in twice.waits))
+    assert "WaitTime 0.25;" in written_rapid(spent).text
+    assert restore_program(written_rapid(spent).text) == TWICE
+    old, new = "[[175, -375, 140],", "[[180, -370, 150],"
+    (tmp_path / "w.mod").write_text(text.replace(old, new))
+    (tmp_path / "t.mod").write_text(source.replace(old, new))
+    again, _ = read_cycle_program(tmp_path / "w.mod", robot)
+    taught, _ = read_cycle_program(tmp_path / "t.mod", robot)
+    assert "the program it was optimized from" in again.source
+    assert same_model(motion_model(again), motion_model(taught), atol_rad=0.0) is None

@@ -123,7 +123,9 @@ class WrittenModule:
             "'shared' = one motion for every run of the line; 'per run' = TEST jpCtx picks the run's via "
             "points (procedures_given_jpRun pass the run number). reteach: for each named target, the "
             "optimized lines whose via points were planned from it; after re-teaching it, run joulepath "
-            "cycle again (the named target moves the final point, the via points before it stay as planned)",
+            "cycle on the re-taught optimized.mod (read as the program it was written from, each replaced "
+            "line kept in a '! joulepath: was:' comment) to plan them again; until then the named target "
+            "moves the final point and the via points before it stay as planned",
         }
 
 
@@ -400,7 +402,7 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
         new_procs.extend("    " + t for t in body)
         new_procs.append("ENDPROC")
         call = call_name + (" " + ", ".join(args) if args else "") + ";"
-        replace[ln] = (move.end_line, [f"! joulepath: {original} -> {call_name}", call])
+        replace[ln] = (move.end_line, [*_was(source, move.line, move.end_line), call])
         final_target = mv_args[0] if finals else None
         written.append(
             WrittenMove(
@@ -448,12 +450,27 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
                 end,
                 [
                     f"! joulepath: WaitTime {_num(before)} s spent on the moves (--use-waits)",
+                    *_was(source, wline, end),
                     f"WaitTime {_num(after)};",
                 ],
             )
     text = _assemble(source, replace, edits, header, decls, new_procs)
     reteach = {k: tuple(sorted(v)) for k, v in reteach_of.items() if v}
     return WrittenModule(text, tuple(written), tuple(procs[p].name for p in indexed), reteach)
+
+
+WAS = "! joulepath: was: "
+"""Marks a line of the input that the written module replaces, kept verbatim (see :func:`restore_program`)."""
+
+
+def _was(source: tuple[str, ...], line: int, end_line: int) -> list[str]:
+    """The input's lines ``line..end_line`` as comments, relative to the first line's indentation."""
+    first = source[line - 1]
+    indent = first[: len(first) - len(first.lstrip())]
+    return [
+        WAS + (raw[len(indent) :] if raw.startswith(indent) else raw.lstrip())
+        for raw in source[line - 1 : end_line]
+    ]
 
 
 def _statements_of(module: Module) -> list[Statement]:
@@ -514,8 +531,8 @@ def _add_argument(text: str, name: str, arg: str, line: int) -> str:
     m = re.match(rf"^(\s*{re.escape(name)})(\s*)([^;]*);", text, re.IGNORECASE)
     if m is None:
         raise LimitViolation(f"line {line}: cannot extend the call of {name}; write it on one line")
-    rest = m.group(3).strip()
-    new = f"{m.group(1)} {rest}, {arg};" if rest else f"{m.group(1)} {arg};"
+    rest = m.group(3).rstrip()
+    new = f"{m.group(1)}{m.group(2)}{rest}, {arg};" if rest else f"{m.group(1)} {arg};"
     return new + text[m.end() :]
 
 
@@ -630,6 +647,77 @@ def _reteach(result: Any, spec: Any, module: Module) -> dict[str, set[int]]:
     return out
 
 
+HEADERS = ("! Optimized by joulepath", "! The program is kept as written;", "! WARNING: run by joulepath")
+_DECLS_MARK = "! joulepath: via points of the optimized moves (additions)"
+_PROCS_MARK = "! joulepath: the optimized moves (additions"
+_USED_WAIT = re.compile(r"^! joulepath: WaitTime \S+ s spent on the moves \(--use-waits\)$")
+
+
+def restore_program(text: str) -> str | None:
+    """The program a module written by joulepath was written from, with whatever was changed in it
+    since (a re-taught target); None when ``text`` is not such a module.
+
+    The header, the added arrays and procedures go; each replaced line comes back from its
+    ``! joulepath: was:`` comment; ``num jpRun`` leaves the procedures that gained it and the
+    run number their call sites.
+    """
+    lines = text.splitlines()
+    if not any(ln.strip().startswith(HEADERS[1]) for ln in lines):
+        return None
+    indexed: dict[str, bool] = {}  # procedure -> had parameters before jpRun
+    for ln in lines:
+        m = re.match(rf"^\s*(?:LOCAL\s+)?PROC\s+(\w+)\s*\((.*?)\bnum\s+{RUN_PARAM}\s*\)", ln, re.IGNORECASE)
+        if m:
+            indexed[m.group(1).lower()] = bool(m.group(2).strip())
+    out: list[str] = []
+    k = 0
+    while k < len(lines):
+        raw = lines[k]
+        s = raw.strip()
+        indent = raw[: len(raw) - len(raw.lstrip())]
+        if s.startswith(HEADERS):
+            k += 1
+        elif s == _DECLS_MARK:
+            while k < len(lines) and lines[k].strip():
+                k += 1
+            k += 1  # and the blank line after the block
+        elif s.startswith(_PROCS_MARK):
+            if out and not out[-1].strip():
+                out.pop()
+            while k < len(lines) and not lines[k].strip().upper().startswith("ENDMODULE"):
+                k += 1
+        elif s.startswith(WAS) or _USED_WAIT.match(s):
+            k += 1 if _USED_WAIT.match(s) else 0
+            prefix = indent + WAS
+            while k < len(lines) and lines[k].startswith(prefix):
+                out.append(indent + lines[k][len(prefix) :])
+                k += 1
+            k += 1  # the call (or the shortened WaitTime) that stood for them
+        else:
+            out.append(_restore_line(raw, indexed))
+            k += 1
+    return "\n".join(out) + "\n"
+
+
+def _restore_line(raw: str, indexed: dict[str, bool]) -> str:
+    m = re.match(r"^(\s*)(?:LOCAL\s+)?PROC\s+(\w+)\s*\(", raw, re.IGNORECASE)
+    if m and m.group(2).lower() in indexed:
+        return re.sub(rf"(?:,\s*|\b)num\s+{RUN_PARAM}\s*\)", ")", raw, count=1)
+    m = re.match(r"^(\s*)(\w+)(\s*)([^;!]*);(.*)$", raw)
+    if m is None or m.group(2).lower() not in indexed:
+        return raw
+    if not indexed[m.group(2).lower()]:
+        return f"{m.group(1)}{m.group(2)};{m.group(5)}"
+    args = m.group(4)
+    depth, cut = 0, -1
+    for i, ch in enumerate(args):
+        depth += ch in "([{"
+        depth -= ch in ")]}"
+        if ch == "," and depth == 0:
+            cut = i
+    return f"{m.group(1)}{m.group(2)}{m.group(3)}{args[:cut]};{m.group(5)}"
+
+
 def motion_model(spec: Any) -> list[tuple[Any, ...]]:
     """What the controller runs, in order, without source lines: moves (joints rad, speed, ``\\T``,
     zone, linear), waits (s) and kept instructions (their text)."""
@@ -700,4 +788,12 @@ def same_model(a: list[tuple[Any, ...]], b: list[tuple[Any, ...]], *, atol_rad: 
     return None
 
 
-__all__ = ["WrittenModule", "WrittenMove", "motion_model", "planned_model", "same_model", "written_module"]
+__all__ = [
+    "WrittenModule",
+    "WrittenMove",
+    "motion_model",
+    "planned_model",
+    "restore_program",
+    "same_model",
+    "written_module",
+]
