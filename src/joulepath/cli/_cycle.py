@@ -202,8 +202,8 @@ def cycle(
         )
         for target, again in layout["reteach"].items():
             console.print(
-                f"re-teaching {target} asks to optimize line(s) {', '.join(map(str, again))} again (their via "
-                "points were planned from it): `joulepath cycle` on the re-taught optimized.mod does"
+                f"re-teaching {target} asks to optimize line(s) {', '.join(map(str, again))} again (their "
+                "via points were planned from it): `joulepath cycle` on the re-taught optimized.mod does"
             )
     if "egm.mod" in files:
         console.print(
