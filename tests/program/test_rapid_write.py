@@ -328,3 +328,36 @@ def test_written_module_restores_the_program_it_was_written_from(palletizing, tw
     taught, _ = read_cycle_program(tmp_path / "t.mod", robot)
     assert "the program it was optimized from" in again.source
     assert same_model(motion_model(again), motion_model(taught), atol_rad=0.0) is None
+
+
+LOOP = """MODULE Loop
+    CONST jointtarget jA := [[-30, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pRow := [[350, 0, 300], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    PROC main()
+        WHILE TRUE DO
+            MoveAbsJ jA, v1000, fine, tool0;
+            FOR k FROM 0 TO 1 DO
+                MoveJ Offs(pRow, 0, k * 120, 0), v1000, fine, tool0;
+            ENDFOR
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+
+
+def test_move_inside_a_for_loop_gets_its_runs_by_the_loop_variable(robot):
+    """A move directly inside a FOR loop: its optimized procedure receives the loop variable (for its
+    Offs target) and the run number computed from it; it reads back and restores to the program."""
+    spec = resolve_module(parse_module(LOOP, path="loop.mod"), robot)
+    result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
+    layout = written_rapid(result)
+    assert reads_back(result, layout.text) is None
+    assert restore_program(layout.text) == LOOP
+    _check_diff(LOOP, layout)
+    move = next((m for m in layout.moves if m.line == 8), None)
+    if move is not None:
+        assert move.runs == 2
+        call = next(ln.strip() for ln in layout.text.splitlines() if ln.strip().startswith(move.call + " "))
+        expected = f"{move.call} k, k + 1;" if move.selection == "per run" else f"{move.call} k;"
+        assert call == expected
+        assert f"PROC {move.call}(num k" in layout.text
