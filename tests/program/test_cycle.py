@@ -374,9 +374,12 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):
     np.testing.assert_allclose(a.fine.qd[0], 0.0, atol=1e-9)  # the chain starts and ends at rest
     np.testing.assert_allclose(b.fine.qd[-1], 0.0, atol=1e-9)
     text = optimized_module(result)
-    line = spec.steps[first].line
-    via = [ln for ln in text.splitlines() if f"jpL{line}_" in ln and "MoveAbsJ" in ln]
-    assert via and via[-1].rstrip().endswith("z20, tool0;")  # the program's own zone at the target
+    lines = text.splitlines()
+    at = next(k for k, ln in enumerate(lines) if ln.strip().startswith("PROC jp_opt_main_1("))
+    body = lines[at : next(k for k in range(at, len(lines)) if lines[k].strip() == "ENDPROC")]
+    moves = [ln.strip() for ln in body if ln.strip().startswith("MoveAbsJ")]
+    # passed exactly: the chain's piece ends with the program's own target, in its own zone
+    assert moves and moves[-1].startswith("MoveAbsJ jA, v7000") and moves[-1].endswith("z20, tool0;")
     resolve_module(parse_module(text, path="o.mod"), robot)  # reads back
     rest, opt_rest = optimize_cycle(
         spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, fly_by=False, cycle_time=REACHABLE)

@@ -190,6 +190,21 @@ def cycle(
             f"{saved['executed_saved_pct']:.1f} % saved ({saved['executed_saved_lab_pct']:.1f} % on the lab "
             f"robot); its via points follow {saved['rapid_follows']}"
         )
+    layout = saved.get("rapid_structure")
+    if "optimized.mod" in files and layout is not None:
+        lines = layout["optimized_lines"]
+        per_run = [str(m["line"]) for m in lines if m["selection"] == "per run"]
+        console.print(
+            f"optimized.mod keeps the program: {len(lines)} optimized move line(s) call added jp_opt_* "
+            "procedures"
+            + (f" (per run, selected by jpCtx: line(s) {', '.join(per_run)})" if per_run else "")
+            + ", the rest is as written"
+        )
+        for target, again in layout["reteach"].items():
+            console.print(
+                f"re-teaching {target} asks to optimize line(s) {', '.join(map(str, again))} again (their "
+                "via points were planned from it): `joulepath cycle` on the re-taught optimized.mod does"
+            )
     if "egm.mod" in files:
         console.print(
             f"egm.mod streams the plan (cycle_path.csv: {result.optimized_cycle_s:.3f} s, "

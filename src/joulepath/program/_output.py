@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -13,12 +12,17 @@ import numpy as np
 
 from joulepath import __version__
 from joulepath._io import atomic_write_text, finite_json
-from joulepath.abb import EXTERNAL_AXES_UNUSED, VIA_ZONE_MM
 from joulepath.errors import LimitViolation
 from joulepath.program._cell import Cell, clearance
-from joulepath.program._cycle import CycleResult, ParetoPoint, Solved
-from joulepath.program._model import Move, WaitTime
-from joulepath.program._write import _num, format_move, write_module
+from joulepath.program._cycle import CycleResult, ParetoPoint
+from joulepath.program._model import RapidError
+from joulepath.program._rapid_write import (
+    WrittenModule,
+    motion_model,
+    planned_model,
+    same_model,
+    written_module,
+)
 
 CYCLE_FILES = (
     "cycle.json",
@@ -43,7 +47,9 @@ ASSUMPTIONS = (
     "fly-by targets (each passed within its zone: the zone radius reduced to half of either move's TCP "
     "length, as a joint box; or exactly with --exact-targets), with its taught motion kept as a candidate "
     "at its taught duration, so the taught cycle time is always reachable (at worst 0 % saved); written as "
-    "MoveAbsJ via points with \\T in z200 zones, the last via point of a unit keeps its stop (fine)",
+    "MoveAbsJ via points with \\T in z200 zones in an added PROC jp_opt_<proc>_<n> per move line, called "
+    "where the move stood (the rest of the program as written); the last point of a unit keeps its stop "
+    "(fine), and where the plan ends at the target it is the program's own move to its named target",
     "segments with a MoveL, and moves that occur more than once: run as taught (the controller's own "
     "blends and timing, as emulated)",
     "waits are process time; only waits declared idle (`! joulepath: idle` or --idle-wait LINE) are "
@@ -57,52 +63,26 @@ ASSUMPTIONS = (
 )
 
 
-def _jt(q_deg: np.ndarray) -> str:
-    ext = ", ".join([EXTERNAL_AXES_UNUSED] * 6)
-    return "[[" + ", ".join(_num(float(v)) for v in q_deg) + f"], [{ext}]]"
-
-
 def optimized_module(result: CycleResult, check: dict[str, Any] | None = None) -> str:
-    """The module with each optimized move replaced by its via points; refused outside a limit.
+    """The module that keeps the program, its optimized moves calling added procedures
+    (:func:`joulepath.program._rapid_write.written_module`); refused outside a limit.
 
     The header states the saving of the module as the controller emulation runs it
     (``check``, from :func:`check_written`), else that of the plan, named as such.
     """
+    return written_rapid(result, check).text
+
+
+def written_rapid(result: CycleResult, check: dict[str, Any] | None = None) -> WrittenModule:
+    """:func:`optimized_module` with what it holds (which lines, shared or per run, re-teaching)."""
     spec = result.spec
-    module = spec.module
-    assert module is not None
+    assert spec.module is not None
     if not result.limits_ok:
         bad = "; ".join(e for m in result.moves for e in m.limit_excess)
         raise LimitViolation(
             f"the optimized cycle breaks a limit or the cell's margin ({bad or 'clearance'}); "
             "the program is not written"
         )
-    again = sorted({spec.steps[i].line for i in result.paths if spec.steps[i].repeated})
-    if again:
-        raise LimitViolation(
-            f"line(s) {', '.join(map(str, again))}: a move that runs more than once in the cycle "
-            "(a procedure called more than once) is optimized in each call, which one statement's "
-            "via points cannot hold; the program is not written (the streamed cycle, --export egm, runs it)"
-        )
-    replace: dict[int, list[str]] = {}
-    decls: list[str] = []
-    through = {j for chain in result.chains.values() for j in chain[:-1]} | set(result.open_ends)
-    for i, solved in result.paths.items():
-        step = spec.steps[i]
-        move = step.statement
-        assert isinstance(move, Move) and step.robot is not None
-        # a target inside a fly-by chain keeps the program's own zone; a move's last point stops
-        own = move.zone + ("" if move.z_tcp is None else f" \\Z:={_num(move.z_tcp)}")
-        end = own if i in through else "fine" if step.zone_mm is None else "z1"
-        lines, names = _via_lines(move, solved, result.vias[i], end, step.robot)
-        replace[move.line] = lines
-        decls.extend(names)
-    for wline, before, after in result.waits:
-        if after != before:
-            replace[wline] = [
-                f"! joulepath: WaitTime {_num(before)} s spent on the moves (--use-waits)",
-                f"WaitTime {_num(after)};",
-            ]
     if check is not None:
         e = check["emulated_energy_J"]
         header = [
@@ -118,42 +98,12 @@ def optimized_module(result: CycleResult, check: dict[str, Any] | None = None) -
             f"{result.default_energy_J:.2f} -> {result.optimized_energy_J:.2f} J planned "
             f"({result.saved_pct:.1f} %). See cycle.json.",
         ]
-    # every replaced statement must be a move or WaitTime of the module (never a verbatim one)
-    for line in replace:
-        stmt = next(
-            (s.statement for s in spec.steps if s.statement is not None and s.statement.line == line), None
-        )
-        assert isinstance(stmt, Move | WaitTime)
-    return write_module(module, replace=replace, declarations=decls, header=header)
+    header.append(
+        "! The program is kept as written; each optimized move calls jp_opt_<proc>_<n> (at the module's "
+        "end). Re-teaching a target: see cycle.json rapid_structure.reteach, then optimize again."
+    )
+    return written_module(result, header)
 
-
-def _via_lines(
-    move: Move, solved: Solved, idx: Sequence[int], end: str, robot: Any
-) -> tuple[list[str], list[str]]:
-    samples = solved.fine
-    lo, hi = robot.joint_ranges()
-    q = samples.q[list(idx)]
-    if np.any(q < lo - 1e-9) or np.any(q > hi + 1e-9):
-        raise LimitViolation(
-            f"line {move.line}: a via point leaves a joint range; the program is not written"
-        )
-    times = np.diff([0.0, *samples.t[list(idx)]])
-    prev = np.vstack([samples.q[0], q[:-1]])
-    speed = np.abs(q - prev) / times[:, None]
-    if np.any(speed > robot.velocity_limit * (1 + 1e-9)):
-        raise LimitViolation(f"line {move.line}: a via segment exceeds a joint speed limit; not written")
-    names = []
-    lines = [f"! joulepath: {format_move(move)} reshaped: {len(idx)} via points in {solved.duration:.3f} s"]
-    for k, (qk, tk) in enumerate(zip(q, times, strict=True), start=1):
-        name = f"jpL{move.line}_{k}"
-        names.append(f"CONST jointtarget {name} := {_jt(np.degrees(qk))};")
-        zone = end if k == len(idx) else VIA_ZONE
-        lines.append(f"MoveAbsJ {name}, v7000 \\T:={_num(float(tk))}, {zone}, {move.tool};")
-    return lines, names
-
-
-VIA_ZONE = f"z{VIA_ZONE_MM:.0f}"
-"""Zone of the via points inside an optimized move (:data:`joulepath.abb.VIA_ZONE_MM`)."""
 
 CHECK_TOLERANCES = {"slower_than_taught_s": 0.001, "path_mm": 5.0, "saved_at_least_pct": 0.1}
 """What the written module, run by the controller emulation, must keep: its cycle never longer than
@@ -409,17 +359,39 @@ def pareto_plot(points: list[ParetoPoint], default: tuple[float, float, float], 
     return path
 
 
+def reads_back(result: CycleResult, text: str) -> str | None:
+    """None when the written module, parsed and resolved again, runs the motion it was written
+    for (:func:`joulepath.program._rapid_write.planned_model`); else what differs."""
+    from joulepath.program._parse import parse_module
+    from joulepath.program._resolve import resolve_module
+
+    spec = result.spec
+    again = resolve_module(parse_module(text, path=f"{spec.source} (optimized)"), spec.robot)
+    return same_model(motion_model(again), planned_model(result))
+
+
 def _rapid_attempt(
     result: CycleResult, cell: Cell | None, write_anyway: bool
-) -> tuple[str | None, dict[str, Any] | None, str | None]:
-    """The module of ``result`` and its check, or None and why it is not written."""
+) -> tuple[str | None, dict[str, Any] | None, str | None, WrittenModule | None]:
+    """The module of ``result``, its check and its structure, or None and why it is not written."""
     try:
-        text: str | None = optimized_module(result)
+        first = written_rapid(result)
     except LimitViolation as err:
-        return None, None, str(err)
-    assert text is not None
-    check = check_written(result, text, cell)
-    text = optimized_module(result, check)  # the header states what the emulation measured
+        return None, None, str(err), None
+    try:
+        differs = reads_back(result, first.text)
+    except RapidError as err:
+        differs = f"it cannot be read: {err}"
+    if differs is not None:
+        return (
+            None,
+            None,
+            f"the written module does not read back as the motion written ({differs}); not written",
+            None,
+        )
+    check = check_written(result, first.text, cell)
+    layout = written_rapid(result, check)  # the header states what the emulation measured
+    text = layout.text
     inside = check["cell_clearance_mm"]
     if inside is not None and inside < 0.0:
         return (
@@ -427,12 +399,13 @@ def _rapid_attempt(
             check,
             f"the written program, run by the controller emulation, comes {-inside:.1f} mm "
             "inside the cell's margin (its via points do not follow the plan closely enough); not written",
+            layout,
         )
     if not check["within_tolerances"]:
         if write_anyway:
-            return _mark_unfaithful(text, check), check, None
-        return None, check, _unfaithful_reason(check)
-    return text, check, None
+            return _mark_unfaithful(text, check), check, None, layout
+        return None, check, _unfaithful_reason(check), layout
+    return text, check, None, layout
 
 
 def write_cycle_run(
@@ -454,7 +427,7 @@ def write_cycle_run(
     if egm not in ("always", "fallback", "never"):
         raise ValueError(f"egm must be always, fallback or never, got {egm!r}")
     files: dict[str, Path] = {}
-    text = refused = check = None
+    text = refused = check = layout = None
     follows = None
     if write_rapid:
         plans = [("the plan", result)]
@@ -467,7 +440,7 @@ def write_cycle_run(
                 )
             )
         for k, (name, plan) in enumerate(plans):
-            text, check, refused = _rapid_attempt(plan, cell, write_anyway and k == len(plans) - 1)
+            text, check, refused, layout = _rapid_attempt(plan, cell, write_anyway and k == len(plans) - 1)
             if text is not None:
                 follows = name
                 break
@@ -501,6 +474,7 @@ def write_cycle_run(
         "moves, planned within 3/(2π) of the acceleration limit (rapid_plan_saved_pct: its planned saving); "
         "cycle_path.csv and --export egm always stream the plan"
     )
+    data["rapid_structure"] = None if layout is None or text is None else layout.summary()
     files["cycle.json"] = atomic_write_text(
         out / "cycle.json", json.dumps(finite_json(data), indent=2, allow_nan=False)
     )

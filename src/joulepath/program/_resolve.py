@@ -488,12 +488,21 @@ def read_cycle_program(
     """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID module.
 
     ``idle_waits``: lines of ``WaitTime`` instructions that are idle time (see
-    :func:`resolve_module`); for a ``.toml`` file, numbers of ``wait_s`` steps.
+    :func:`resolve_module`); for a ``.toml`` file, numbers of ``wait_s`` steps. A module
+    joulepath wrote is read as the program it was written from (its targets as they are
+    now: re-taught ones included; :func:`joulepath.program._rapid_write.restore_program`).
     """
     p = Path(path)
     rapid = p.suffix.lower() != ".toml"
     if rapid:
-        return resolve_module(read_module(p), robot, idle_waits=idle_waits), True
+        module = read_module(p)
+        from joulepath.program._parse import parse_module
+        from joulepath.program._rapid_write import restore_program
+
+        original = restore_program("\n".join(module.source))
+        if original is not None:  # written by joulepath: optimize the program it was written from
+            module = parse_module(original, path=f"{p} (the program it was optimized from)")
+        return resolve_module(module, robot, idle_waits=idle_waits), True
     spec = read_cycle_toml(p, robot)
     if not idle_waits:
         return spec, False
