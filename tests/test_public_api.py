@@ -53,7 +53,7 @@ ALLOWED = {
     "trajectory": {"description", "kinematics", "dynamics"},
     "data": {"dynamics", "energy"},  # dynamics: annotations only (TYPE_CHECKING)
     "export": {"description", "kinematics", "dynamics", "trajectory", "data"},
-    "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb"},
+    "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb", "energy"},
     "learn": {"data", "dynamics", "energy"},
     "identify": {"data", "description", "dynamics", "energy", "trajectory", "sim"},
     "synth": {"data", "description", "kinematics", "dynamics"},
