@@ -25,9 +25,10 @@ Per sample and joint ``i`` (arrays ``(..., n)``; SI units, :mod:`joulepath.units
 
 :func:`chain_power` evaluates stages 1–6 exactly (``eps = 0``) or smoothed
 (``eps > 0``, W): every ``|x|`` becomes ``sqrt(x² + eps²) - eps``, every
-``max(x, 0)`` its half-sum with ``x`` and every step ``1[x > 0]`` its derivative,
-so that the optimizer gets exact gradients of a smooth function that tends to the
-true one as ``eps -> 0``.
+``max(x, 0)`` its half-sum with ``x`` and its step ``1[x > 0]`` that sum's
+derivative; the gears' switch between driving and braking becomes ``p³ / (p³ + eps³)``
+for ``p > 0`` (0 at rest, as exactly), so that the optimizer gets exact gradients of a
+smooth function that tends to the true one as ``eps -> 0``, at rest too.
 """
 
 from __future__ import annotations
@@ -115,6 +116,18 @@ def _step(x: FloatArray, eps: float) -> tuple[FloatArray, FloatArray]:
     return (x > 0).astype(float), np.zeros_like(x)
 
 
+def _driving(x: FloatArray, eps: float) -> tuple[FloatArray, FloatArray]:
+    """The gears' switch ``1[p > 0]`` and its derivative; smoothed one-sided, ``p³ / (p³ + eps³)``
+    for ``p > 0``: exactly 0 at rest (``p = 0``: the motor holds ``tau * eta``), twice continuously
+    differentiable."""
+    if eps > 0:
+        pos = np.maximum(x, 0.0)
+        e3 = eps * eps * eps
+        d = pos * pos * pos + e3
+        return pos * pos * pos / d, 3.0 * pos * pos * e3 / (d * d)
+    return (x > 0).astype(float), np.zeros_like(x)
+
+
 def _pos(x: FloatArray, eps: float) -> tuple[FloatArray, FloatArray]:
     """``max(x, 0)`` and its derivative."""
     a, _ = _abs(x, eps)
@@ -169,7 +182,7 @@ def _gear(
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """``tau_m``, ``p_m`` and their derivatives with respect to ``tau`` and ``qd``."""
     p = tau * qd
-    h, dh = _step(p, eps)
+    h, dh = _driving(p, eps)
     gain = eta + (1.0 / eta - eta) * h
     dgain = (1.0 / eta - eta) * dh  # d gain / d p
     tau_m = tau * gain
