@@ -92,3 +92,21 @@ def test_drive_model_checks_its_values():
         DriveModel(torque_constant=(0.0,), resistance=(1.0,), drive_efficiency=(1.0,))
     with pytest.raises(InvalidInput, match="one per joint"):
         DriveModel(torque_constant=(1.0, 1.0), resistance=(1.0,), drive_efficiency=(1.0, 1.0))
+
+
+def test_the_readme_drives_example_reads(tmp_path):
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    block = next(b for b in re.findall(r"```toml\n(.*?)```", readme, flags=re.S) if "torque_constant" in b)
+    d = read_drives_file(_write(tmp_path, block), 6)
+    assert d.bus == "bleeder" and d.standby_W == 90.0 and d.source("standby_W").startswith("UR5")
+
+
+def test_bundled_drives_files_read(tmp_path):
+    from joulepath.description import preset_path
+
+    for name in ("irb120", "ur5"):
+        d = read_drives_file(preset_path("irb120").with_name(f"{name}.drives.toml"), 6)
+        assert d.gear_efficiency is not None and d.standby_W > 0
