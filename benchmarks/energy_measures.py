@@ -30,6 +30,7 @@ import csv
 import statistics
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -55,8 +56,10 @@ def _pct(a: float, b: float) -> float:
     return 100.0 * (a / b - 1.0)
 
 
-def tasks_rows(robot: joulepath.Robot, n: int) -> list[dict[str, float]]:
-    rows = []
+def tasks_rows(
+    robot: joulepath.Robot, n: int, done: Callable[[list[dict[str, float]]], None]
+) -> list[dict[str, float]]:
+    rows: list[dict[str, float]] = []
     for k, (q0, qf, T) in enumerate(random_tasks(robot, n, seed=SEED, range_set="lab")):
         t0 = time.perf_counter()
         by = {}
@@ -97,6 +100,7 @@ def tasks_rows(robot: joulepath.Robot, n: int) -> list[dict[str, float]]:
             f"{row['electrical_opt_vs_thesis_opt_thesis_pct']:+.1f} % vs the thesis optimum ({row['wall_s']:.0f} s)",
             flush=True,
         )
+        done(rows)
     return rows
 
 
@@ -133,14 +137,29 @@ def main() -> None:
     robot = joulepath.load_robot("irb120")
     t0 = time.perf_counter()
     cycles = cycle_rows(robot)
-    rows = tasks_rows(robot, args.tasks)
+
+    def report(rows: list[dict[str, float]]) -> None:  # after every task: a long run leaves its rows
+        _report(robot, rows, cycles, args.tasks, time.perf_counter() - t0, write=not args.no_report)
+
+    tasks_rows(robot, args.tasks, report)
+
+
+def _report(
+    robot: joulepath.Robot,
+    rows: list[dict[str, float]],
+    cycles: list[dict[str, object]],
+    n_tasks: int,
+    wall: float,
+    *,
+    write: bool,
+) -> None:
     med = {k: statistics.median(float(r[k]) for r in rows) for k in rows[0] if k not in ("task", "limits_ok")}
     drives = robot.drives
     assert drives is not None
     text = (
-        f"Machine: {machine()}. {args.tasks} random feasible IRB 120 tasks (seed {SEED}, lab ranges), the "
+        f"Machine: {machine()}. {len(rows)} of {n_tasks} random feasible IRB 120 tasks (seed {SEED}, lab ranges), the "
         "default gradient search on the thesis' and on the electrical measure, each optimum measured on "
-        f"both; wall {time.perf_counter() - t0:.0f} s in all. Drive data: the bundled IRB 120 estimate "
+        f"both; wall {wall:.0f} s in all (a shared machine). Drive data: the bundled IRB 120 estimate "
         f"(every value assumed: k = {', '.join(f'{v:g}' for v in drives.torque_constant)} N·m/A, "
         f"R = {drives.resistance[0]:g} Ω, drive efficiency {drives.drive_efficiency[0]:g}, gear efficiency "
         f"{drives.gear_efficiency[0] if drives.gear_efficiency else 'none'}, {drives.bus} bus, standby "
@@ -168,8 +187,8 @@ def main() -> None:
         )
         + f"\nPer-task rows: `benchmarks/results/{SECTION}.csv`.\n"
     )
-    print(text)
-    if not args.no_report:
+    print(text, flush=True)
+    if write:
         out = ROOT / "benchmarks" / "results" / f"{SECTION}.csv"
         out.parent.mkdir(parents=True, exist_ok=True)
         with out.open("w", newline="") as fh:

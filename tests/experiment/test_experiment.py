@@ -306,6 +306,10 @@ def test_cycle_stage_matches_its_files_and_the_report(tiny_run):
     assert f"{data['default_cycle_s']:.4g} s" in text
     assert ("REFUSED" in text) != data["limits_ok"]
     assert len(re.findall(r"<tr>", section.group(0))) >= len(data["moves"]) + 1
+    # every measure of the cycle, named with its stage, in cycle.json and the report
+    assert data["energies"]["thesis"]["default_J"] == pytest.approx(data["energy_default_J"])
+    for name, m in data["energies"].items():
+        assert f"{name} ({m['stage']})" in text
 
 
 def test_cycle_section_is_checked_before_running(tmp_path, tiny_demo_toml):

@@ -224,6 +224,8 @@ def cycle(
             f"{e.saved_pct:.1f} % saved{lab}{standby}",
             markup=False,
         )
+    if any(e.measure == "electrical" for e in result.energies):
+        console.print(f"  drive data: {r.drivetrain.drives_source}", markup=False)
     waits = "" if b.by_waits_pct is None else f", idle waits {b.by_waits_pct:.1f} %"
     console.print(
         f"breakdown: shape {b.by_shape_pct:.1f} %, time allocation {b.by_allocation_pct:.1f} %{waits}"

@@ -223,6 +223,8 @@ def optimize(
         )
     for name in s.energies_unavailable:
         console.print(f"  {name:<10} not computed: no data (see energies_unavailable in result.json)")
+    if s.measure("electrical") is not None:
+        console.print(f"  drive data: {r.drivetrain.drives_source}", markup=False)
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
     return 0
 

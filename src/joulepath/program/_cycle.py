@@ -298,7 +298,7 @@ LAB_MEASURE = "mechanical"
 
 
 def _energy(
-    robot: Robot, plant: Plant, traj: Trajectory, measure: str, *, half_open: bool = False
+    robot: Robot, plant: Plant, traj: Trajectory, measure: str = DEFAULT_MEASURE, *, half_open: bool = False
 ) -> tuple[float, float]:
     """Physics (on ``measure``) and lab J of ``traj``; ``half_open``: without its last sample (a window
     that the rest of the cycle continues from, so that windows and their surroundings add up)."""
