@@ -662,7 +662,9 @@ def write_run(
                 from joulepath.optimize._execute import rapid_execution
 
                 exporter.render(robot, result.optimized, s.duration_s)  # the plan's own limit check
-                execution, written = rapid_execution(robot, result.optimized, s.energy_optimized_fine_J)
+                execution, written = rapid_execution(
+                    robot, result.optimized, s.energy_optimized_fine_J, measure=s.energy_measure
+                )
                 refused = execution.refusal()
             if refused is None:
                 programs = exporter.render(robot, written, s.duration_s)
