@@ -14,6 +14,7 @@ PACKAGES = [
     "joulepath.description",
     "joulepath.kinematics",
     "joulepath.dynamics",
+    "joulepath.energy",
     "joulepath.identify",
     "joulepath.trajectory",
     "joulepath.data",
