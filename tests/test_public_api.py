@@ -14,6 +14,7 @@ PACKAGES = [
     "joulepath.description",
     "joulepath.kinematics",
     "joulepath.dynamics",
+    "joulepath.energy",
     "joulepath.identify",
     "joulepath.trajectory",
     "joulepath.data",
@@ -53,7 +54,7 @@ ALLOWED = {
     "trajectory": {"description", "kinematics", "dynamics"},
     "data": {"dynamics", "energy"},  # dynamics: annotations only (TYPE_CHECKING)
     "export": {"description", "kinematics", "dynamics", "trajectory", "data"},
-    "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb"},
+    "sim": {"description", "kinematics", "dynamics", "trajectory", "data", "export", "abb", "energy"},
     "learn": {"data", "description", "dynamics", "energy"},
     "identify": {"data", "description", "dynamics", "energy", "trajectory", "sim"},
     "synth": {"data", "description", "kinematics", "dynamics"},

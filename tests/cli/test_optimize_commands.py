@@ -126,3 +126,21 @@ def test_bench_optimizers_quick_physics(tmp_path, capsys, monkeypatch):
 def test_synth_and_compare_are_registered(capsys):
     assert main(["synth", "--help"]) == 0
     assert main(["compare", "--help"]) == 0
+
+
+def test_optimize_energy_electrical_without_drive_data_is_refused_in_one_line(tmp_path, capsys):
+    import shutil
+
+    from joulepath.description import preset_path
+
+    urdf = tmp_path / "arm.urdf"  # the IRB 120 without its drives file beside it
+    shutil.copy(preset_path("irb120", fmt="urdf"), urdf)
+    out = str(tmp_path / "run")
+    args = ["optimize", *FIXED, "--robot", str(urdf), "--energy", "electrical", "--out", out]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0
+    assert "needs drive data" in err and "arm.drives.toml" in err
+    assert not (tmp_path / "run").exists()
+    assert main([*args[:-4], "--energy", "meter", "--out", str(tmp_path / "run")]) == 2
+    assert "thesis, mechanical, electrical" in capsys.readouterr().err

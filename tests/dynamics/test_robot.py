@@ -114,3 +114,29 @@ def test_summary_shows_torque_limits_column(irb120):
     lines = irb120.summary().splitlines()
     assert "torque N·m" in lines[1]
     assert all("not given" in line for line in lines[2:8])
+
+
+def test_drives_come_from_a_file_beside_the_description(tmp_path):
+    import shutil
+
+    urdf = tmp_path / "arm.urdf"
+    shutil.copy(preset_path("irb120", fmt="urdf"), urdf)
+    bare = joulepath.load_robot(urdf)
+    assert bare.drives is None and "no arm.drives.toml beside the description" in bare.drives_note
+    assert bare.drivetrain.gear_efficiency is None
+    (tmp_path / "arm.drives.toml").write_text(
+        'torque_constant = 20.0\nresistance = 1.0\ndrive_efficiency = 0.9\nbus = "bleeder"\n'
+        'gear_efficiency = 0.7\n[sources]\ngear_efficiency = "bench test"\n'
+    )
+    robot = joulepath.load_robot(urdf)
+    assert robot.drives is not None and robot.drives.torque_constant == (20.0,) * robot.n_joints
+    assert "arm.drives.toml" in robot.drives_note
+    assert robot.drivetrain.gear_efficiency == (0.7,) * robot.n_joints
+    assert "bench test" in robot.drivetrain.gear_source
+
+
+def test_bundled_irb120_drives_are_a_labelled_estimate(irb120):
+    drives = irb120.drives
+    assert drives is not None and drives.n_joints == irb120.n_joints
+    assert all(drives.source(k).startswith("assumed (estimate)") for k in ("torque_constant", "standby_W"))
+    assert "every value assumed" in irb120.drivetrain.drives_source

@@ -76,6 +76,14 @@ def _write(tmp_path, text, name="exp.toml"):
             r"fitness = 'surrogate' needs models of E",
         ),
         (
+            lambda t: t.replace("[optimize]", '[optimize]\nenergy = "meter"'),
+            r"energy = 'meter' is not allowed; use one of thesis, mechanical, electrical",
+        ),
+        (
+            lambda t: t.replace("[optimize]", '[optimize]\nenergy = "electrical"\nfitness = "surrogate"'),
+            r"energy = 'electrical' needs fitness = 'physics'",
+        ),
+        (
             lambda t: t.replace("[data]", "[data]\ntrain_logs = ['nothere.csv']\ntest_logs = ['x.csv']"),
             r"train_logs names 'nothere.csv', which does not exist",
         ),
@@ -84,6 +92,19 @@ def _write(tmp_path, text, name="exp.toml"):
 def test_load_experiment_errors(tmp_path, edit, pattern):
     with pytest.raises(InvalidInput, match=pattern):
         load_experiment(_write(tmp_path, edit(TINY)))
+
+
+def test_electrical_energy_without_drive_data_is_refused_before_running(tmp_path):
+    from joulepath.description import preset_path
+
+    shutil.copy(preset_path("irb120", fmt="urdf"), tmp_path / "arm.urdf")  # no arm.drives.toml beside it
+    text = TINY.replace("seed = 1", f"seed = 1\nrobot = '{tmp_path / 'arm.urdf'}'").replace(
+        "[optimize]", '[optimize]\nrange_set = "nominal"\nenergy = "electrical"'
+    )
+    with pytest.raises(InvalidInput, match=r"\[optimize\] energy = 'electrical': .*needs drive data"):
+        load_experiment(_write(tmp_path, text))
+    exp = load_experiment(_write(tmp_path, text.replace('"electrical"', '"thesis"')))
+    assert exp.optimize.energy == "thesis"
 
 
 def test_bundled_demo_experiment_is_valid():
@@ -285,6 +306,10 @@ def test_cycle_stage_matches_its_files_and_the_report(tiny_run):
     assert f"{data['default_cycle_s']:.4g} s" in text
     assert ("REFUSED" in text) != data["limits_ok"]
     assert len(re.findall(r"<tr>", section.group(0))) >= len(data["moves"]) + 1
+    # every measure of the cycle, named with its stage, in cycle.json and the report
+    assert data["energies"]["thesis"]["default_J"] == pytest.approx(data["energy_default_J"])
+    for name, m in data["energies"].items():
+        assert f"{name} ({m['stage']})" in text
 
 
 def test_cycle_section_is_checked_before_running(tmp_path, tiny_demo_toml):

@@ -58,6 +58,18 @@ def test_optimize_on_the_twin_is_verified_on_the_lab_robot(twin, tmp_path, capsy
     assert on_twin["energy_optimized_lab_J"] is not None
     # the twin's physics energy of the default path is not the nominal model's
     assert on_twin["energy_default_J"] != pytest.approx(on_nominal["energy_default_J"], rel=1e-3)
+    # predicted and logged energy are the same quantity: the lab's logged energy is named, and the
+    # twin's energy on that measure includes its identified gear efficiency
+    assert on_twin["energy_lab_measure"] == "mechanical"
+    mech = on_twin["energies"]["mechanical"]
+    assert mech["stage"] == "gear" and "identified" in mech["source"]
+    assert mech["lab_default_J"] == pytest.approx(on_twin["energy_default_lab_J"], rel=1e-12)
+    assert mech["lab_optimized_J"] == pytest.approx(on_twin["energy_optimized_lab_J"], rel=1e-12)
+    like_for_like = abs(mech["default_J"] / mech["lab_default_J"] - 1)
+    mixed = abs(on_twin["energy_default_J"] / on_twin["energy_default_lab_J"] - 1)
+    assert like_for_like < mixed
+    assert set(on_twin["energies"]) == {"thesis", "mechanical", "electrical"}
+    assert "drives" in on_twin["energies"]["electrical"]["source"]
 
 
 def test_identify_refuses_without_writing(twin, lab_log, tmp_path, capsys):

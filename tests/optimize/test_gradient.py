@@ -373,3 +373,47 @@ def test_infeasible_jerk_alone_is_refused_with_the_shortest_duration(irb120):
     check_default_feasible(irb120, q0, qf, shortest, jerk_time=0.3)
     with pytest.raises(LimitViolation, match="jerk"):
         check_default_feasible(irb120, q0, qf, round(shortest - 0.025, 3), jerk_time=0.3)
+
+
+@pytest.mark.parametrize("measure", ["mechanical", "electrical"])
+def test_energy_gradient_matches_finite_differences_on_every_measure(irb120, rng, measure):
+    """The pluggable energy term: the measure's smoothed power (gears, copper, drives, the bleeder's
+    max(·, 0)) chained through the dynamics; its gradient against central differences."""
+    basis = SplineBasis(1.0, knot_spacing=0.1)
+    problem = SplineProblem(irb120, Q0, QF, 1.0, NOMINAL_FRICTION, basis, energy_measure=measure)
+    x = rng.standard_normal(problem.n_var) * 0.05
+    eps = 0.05
+    _, g = problem.smooth_energy(x, eps)
+    h = 1e-6
+    for i in rng.choice(problem.n_var, size=10, replace=False):
+        e = np.zeros_like(x)
+        e[i] = h
+        fd = (problem.smooth_energy(x + e, eps)[0] - problem.smooth_energy(x - e, eps)[0]) / (2 * h)
+        assert g[i] == pytest.approx(fd, rel=1e-4, abs=1e-6)
+    # smoothing tends to the measure's exact motion energy
+    exact = problem.true_energy(x)
+    assert problem.smooth_energy(x, 1e-4)[0] == pytest.approx(exact, rel=1e-3)
+
+
+def test_electrical_search_saves_electrical_energy_and_reports_every_measure(irb120):
+    res = optimize_move(
+        irb120,
+        Q0,
+        QF,
+        1.6,
+        OptimizeConfig(energy="electrical", knot_spacing=0.1, accel_time=0.0),
+    )
+    s = res.summary
+    assert s.energy_measure == "electrical" and s.limits_ok
+    electrical = s.measure("electrical")
+    assert electrical is not None and electrical.stage == "bus"
+    # the headline is the meter-level figure: the standby over the move is part of both energies
+    assert s.energy_default_J == pytest.approx(electrical.default_J)
+    assert electrical.standby_J == pytest.approx(irb120.drives.standby_W * 1.6)
+    assert s.energy_optimized_J < s.energy_default_J
+    assert {m.measure for m in s.energies} == {"thesis", "mechanical", "electrical"}
+    thesis = s.measure("thesis")
+    assert thesis is not None and thesis.stage == "joint" and thesis.standby_J == 0.0
+    assert "irb120.drives.toml" in electrical.source
+    out = s.to_json()
+    assert set(out["energies"]) == {"thesis", "mechanical", "electrical"}

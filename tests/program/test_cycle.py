@@ -253,6 +253,20 @@ def test_plain_cycle_file(tmp_path, robot):
     assert [round(m.profile.duration, 9) for m in plan.moves] == [1.2, 1.0]
     result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
     assert result.limits_ok and result.optimized_cycle_s <= result.target_cycle_s + 1e-9
+    # every measure of the whole cycle, the optimized one (thesis) agreeing with the headline
+    thesis = {e.measure: e for e in result.energies}["thesis"]
+    assert thesis.default_J == pytest.approx(result.default_energy_J, rel=1e-9)
+    assert thesis.optimized_J == pytest.approx(result.optimized_energy_J, rel=1e-9)
+    # the cycle optimized on the electrical energy: the meter-level figure includes the standby
+    # power over the cycle time; the reshaped motion never costs more than the taught one
+    electric, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, energy="electrical"))
+    by = {e.measure: e for e in electric.energies}
+    assert electric.energy_measure == "electrical" and set(by) == {"thesis", "mechanical", "electrical"}
+    meter = by["electrical"]
+    assert meter.standby_J == pytest.approx(robot.drives.standby_W * electric.default_cycle_s)
+    assert meter.default_J == pytest.approx(electric.default_energy_J + meter.standby_J, rel=1e-9)
+    assert electric.optimized_energy_J <= electric.default_energy_J + 1e-9
+    assert 0 < meter.saved_pct < electric.saved_pct  # standby dilutes the motion's saving
     bad = tmp_path / "bad.toml"
     bad.write_text("[[step]]\njoints_deg = [0, 0, 0]\nduration_s = 1\n")
     with pytest.raises(joulepath.errors.InvalidInput, match="step 1"):

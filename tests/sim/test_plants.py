@@ -58,3 +58,16 @@ def test_lab_instance_is_fixed_and_physical(irb120):
     np.testing.assert_array_equal(a.robot.chain.masses, b.robot.chain.masses)
     assert not np.allclose(a.robot.chain.masses, irb120.chain.masses)
     assert [f for f in a.robot.check_physical() if f.severity == "error"] == []
+
+
+def test_plant_mechanical_energy_is_its_logged_torque_times_speed(irb120, rng):
+    """Two implementations of the lab's logged energy agree: the energy chain's gear stage on the
+    plant's joint torque, and ``Σ |drive_torque · qd| dt``."""
+    from joulepath.energy import measure_energy, path_energy
+
+    plant = make_plant("lab", irb120)
+    q, qd, qdd = rng.normal(size=(3, 40, 6)) * 0.5
+    logged = path_energy(plant.drive_torque(q, qd, qdd), qd, 0.01).total
+    chain = measure_energy("mechanical", plant.joint_torque(q, qd, qdd), qd, 0.01, plant.drivetrain)
+    assert chain.total_J == pytest.approx(float(logged), rel=1e-12)
+    assert plant.drivetrain.drives is irb120.drives  # the lab robot keeps the IRB 120's drive data

@@ -108,6 +108,12 @@ def cycle(
         "every move must clear it.",
     ),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
+    energy: str = typer.Option(
+        "thesis",
+        "--energy",
+        help="Energy measure to minimize: thesis, mechanical or electrical (needs the robot's drive data); "
+        "every measure the robot has the data for is reported, electrical with the standby over the cycle.",
+    ),
     unchecked: bool = unchecked_option(),
 ) -> int:
     """Optimize a program's cycle for energy at the same (or a given) cycle time; verify; write RAPID.
@@ -116,6 +122,7 @@ def cycle(
     the cell's margin, or the controller emulation does not run the via points as planned; see
     --write-anyway); 2: bad input (unreadable program, unreachable target, infeasible cycle time).
     """
+    from joulepath.energy import check_measure
     from joulepath.optimize import GradientSettings
     from joulepath.program import (
         CYCLE_FILES,
@@ -133,6 +140,7 @@ def cycle(
     if not program.is_file():
         raise typer.BadParameter(f"{program}: no such file", param_hint="PROGRAM")
     r = load_robot_for_cli(robot, unchecked=unchecked)
+    check_measure(energy, r.drivetrain)  # one line saying what to provide
     spec, rapid = read_cycle_program(program, r, idle_waits=idle_wait)
     if use_waits and not any(s.idle for s in spec.steps if s.kind == "wait"):
         console.print(
@@ -154,6 +162,7 @@ def cycle(
         table_points=table_points,
         corridor_mm=corridor or None,
         gradient=GradientSettings(knot_spacing=knot_spacing),
+        energy=energy,
     )
     if jerk_time is not None:  # else the controller's default (CycleSettings')
         settings = replace(settings, jerk_time=jerk_time)
@@ -213,10 +222,25 @@ def cycle(
         )
     console.print(
         f"the plan: cycle {result.default_cycle_s:.3f} s -> {result.optimized_cycle_s:.3f} s; energy on "
-        f"physics {result.default_energy_J:.2f} -> {result.optimized_energy_J:.2f} J "
+        f"physics ({result.energy_measure}, motion) {result.default_energy_J:.2f} -> "
+        f"{result.optimized_energy_J:.2f} J "
         f"({result.saved_pct:.1f} % saved), on the lab robot {result.saved_lab_pct:.1f} % saved"
         + (" (every unit kept as taught)" if len(result.taught_units) == len(opt.optimizable) else "")
     )
+    for e in result.energies:
+        lab = "" if e.lab_saved_pct is None else f"; lab {e.lab_saved_pct:.1f} %"
+        standby = (
+            f", standby {e.standby_J:.1f} J included ({100 * e.standby_J / e.default_J:.0f} % of the default)"
+            if e.standby_J and e.default_J > 0
+            else ""
+        )
+        console.print(
+            f"  {e.measure:<10} (at the {e.stage}): {e.default_J:.2f} J -> {e.optimized_J:.2f} J per cycle, "
+            f"{e.saved_pct:.1f} % saved{lab}{standby}",
+            markup=False,
+        )
+    if any(e.measure == "electrical" for e in result.energies):
+        console.print(f"  drive data: {r.drivetrain.drives_source}", markup=False)
     waits = "" if b.by_waits_pct is None else f", idle waits {b.by_waits_pct:.1f} %"
     console.print(
         f"breakdown: shape {b.by_shape_pct:.1f} %, time allocation {b.by_allocation_pct:.1f} %{waits}"

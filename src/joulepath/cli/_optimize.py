@@ -111,6 +111,13 @@ def optimize(
         help="Program to write: rapid, egm (ABB EGM streaming), urscript, urscript-cb3 or ros2 "
         "(default: the robot's own controller).",
     ),
+    energy: str = typer.Option(
+        "thesis",
+        "--energy",
+        help="Energy measure to minimize: thesis (Σ|τ·qd| at the joints), mechanical (at the motor side of "
+        "the gears) or electrical (at the cabinet; needs the robot's drive data). Every measure the robot "
+        "has the data for is reported.",
+    ),
     lock: list[str] = lock_option(),
     unchecked: bool = unchecked_option(),
     out: Path = typer.Option(..., "--out", help="Run folder."),
@@ -123,6 +130,7 @@ def optimize(
     program was written; 1: it ran, but the result breaks a limit and no program was
     written; 2: bad input (an infeasible task included).
     """
+    from joulepath.energy import check_measure
     from joulepath.export import select_exporter
     from joulepath.optimize import MAX_DURATION, OptimizeConfig, optimize_move, write_run
     from joulepath.trajectory import sample_times
@@ -146,7 +154,9 @@ def optimize(
         pop_size=population,
         seed=seed,
         follow=exporter.follows,
+        energy=energy,
     )
+    check_measure(energy, r.drivetrain)  # refused before any model is loaded: one line, what to provide
     if jerk_time is not None:  # else the controller's default (OptimizeConfig's)
         config = replace(config, jerk_time=jerk_time)
     if np.isfinite(duration) and 0 < duration <= MAX_DURATION:
@@ -175,7 +185,7 @@ def optimize(
         return 1
     plan = (
         f"default path {s.energy_default_J:.3f} J, optimized {s.energy_optimized_J:.3f} J "
-        f"on physics: {s.saved_pct:.1f} % saved at equal cycle time "
+        f"on physics ({s.energy_measure} energy): {s.saved_pct:.1f} % saved at equal cycle time "
         f"({s.algorithm}, {s.iterations} iterations, {s.evaluations:,} evaluations, {s.wall_s:.2f} s); "
         f"within every limit; largest TCP deviation {s.max_tcp_deviation_mm:.1f} mm, "
         f"largest jerk {s.max_jerk_rad_s3:.0f} rad/s³"
@@ -198,10 +208,23 @@ def optimize(
         console.print(f"physics: no friction modelled for {r.name}; friction: {r.friction_note}")
     if s.saved_lab_pct is not None:
         what = "the plan" if exporter.follows == "via-points" else "the optimized path"
+        measured = f"{s.energy_lab_measure} energy, what its torque log integrates to"
         if s.lab_plant.startswith("emulated IRB 120"):
-            console.print(f"{what} on the emulated lab robot: {s.saved_lab_pct:.1f} % saved")
+            console.print(f"{what} on the emulated lab robot: {s.saved_lab_pct:.1f} % saved ({measured})")
         else:
-            console.print(f"{what} on a {s.lab_plant}: {s.saved_lab_pct:.1f} % saved")
+            console.print(f"{what} on a {s.lab_plant}: {s.saved_lab_pct:.1f} % saved ({measured})")
+    for m in s.energies:
+        lab = "" if m.lab_saved_pct is None else f"; lab {m.lab_saved_pct:.1f} %"
+        standby = f", standby {m.standby_J:.3f} J included" if m.standby_J else ""
+        console.print(
+            f"  {m.measure:<10} (at the {m.stage}): {m.default_J:.3f} J -> {m.optimized_J:.3f} J, "
+            f"{m.saved_pct:.1f} % saved{lab}{standby}",
+            markup=False,
+        )
+    for name in s.energies_unavailable:
+        console.print(f"  {name:<10} not computed: no data (see energies_unavailable in result.json)")
+    if s.measure("electrical") is not None:
+        console.print(f"  drive data: {r.drivetrain.drives_source}", markup=False)
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
     return 0
 

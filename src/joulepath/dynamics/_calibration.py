@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from joulepath._typing import FloatArray
+from joulepath.energy import motor_side_torque
 from joulepath.errors import InvalidRobotDescription
 
 TWIN_ROBOT_FILE = "robot.irml"
@@ -101,8 +102,7 @@ def motor_torque(tau: FloatArray, qd: FloatArray, gear_efficiency: float) -> Flo
     """
     if gear_efficiency == 1.0:
         return tau
-    out: FloatArray = np.where(tau * qd > 0, tau / gear_efficiency, tau * gear_efficiency)
-    return out
+    return motor_side_torque(tau, qd, gear_efficiency)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -187,6 +187,70 @@ class Robot:
             return f"identified (twin {self.source})"
         return self._friction[1]
 
+    @cached_property
+    def _drives(self) -> tuple[_energy.DriveModel | None, str]:
+        cal = self.calibration
+        if cal is not None:
+            if cal.folder is not None:
+                own = Path(cal.folder) / _energy.TWIN_DRIVES_FILE
+                if own.is_file():
+                    return _energy.read_drives_file(own, self.n_joints), f"drives file {own}"
+            if cal.twin_of is not None:
+                drives, note = load_robot(cal.twin_of)._drives
+                return drives, f"{note}, of {cal.twin_of} (the robot this twin twins)"
+            return None, "none (the twin has no drives.toml and names no robot it twins)"
+        beside = None
+        if self.source and Path(self.source).is_file():
+            src = Path(self.source)
+            beside = src.with_name(src.stem + _energy.DRIVES_SUFFIX)
+            if beside.is_file():
+                return _energy.read_drives_file(beside, self.n_joints), f"drives file {beside}"
+        if self.name in NAMED_ARMS:
+            bundled = preset_path("irb120").with_name(self.name + _energy.DRIVES_SUFFIX)
+            if bundled.is_file():
+                return _energy.read_drives_file(bundled, self.n_joints), f"bundled drives file {bundled}"
+        where = f"no {beside.name} beside the description" if beside else "no drives file"
+        return None, f"none ({where})"
+
+    @property
+    def drives(self) -> _energy.DriveModel | None:
+        """The robot's drive data, or None (:attr:`drives_note` says where they come from, or why not).
+
+        From, in order: a twin folder's ``drives.toml`` (else the drives of the robot it
+        twins); a drives file beside the description (``ur5.urdf`` -> ``ur5.drives.toml``,
+        see :func:`~joulepath.energy.read_drives_file`); for a named arm, the bundled one.
+        """
+        return self._drives[0]
+
+    @property
+    def drives_note(self) -> str:
+        """Where :attr:`drives` come from, in words (shown with every electrical figure)."""
+        return self._drives[1]
+
+    @property
+    def drivetrain(self) -> _energy.Drivetrain:
+        """Gear efficiency and drives for the energy measures beyond the joint (:mod:`joulepath.energy`).
+
+        The gear efficiency is a twin's identified one, else its drives file's, else unknown.
+        """
+        drives, note = self._drives
+        cal = self.calibration
+        if cal is not None:
+            gear: tuple[float, ...] | None = (cal.gear_efficiency,) * self.n_joints
+            gear_source = f"identified (twin {cal.folder or self.source})"
+        elif drives is not None and drives.gear_efficiency is not None:
+            gear = drives.gear_efficiency
+            gear_source = f"{drives.source('gear_efficiency')} ({note})"
+        else:
+            gear = None
+            gear_source = f"none known (drives: {note})" if drives is None else f"not in {drives.origin}"
+        return _energy.Drivetrain(
+            gear_efficiency=gear,
+            gear_source=gear_source,
+            drives=drives,
+            drives_source=note if drives is None else f"{drives.describe()}",
+        )
+
     # ------------------------------------------------------------- kinematics
     def fk(self, q: ArrayLike) -> Pose:
         """Tool0 pose for ``q`` of shape ``(..., n)`` (rad)."""

@@ -30,6 +30,7 @@ Example (``joulepath/experiment/presets/demo.toml``, abridged)::
     tasks = 3
     algorithm = "auto"     # gradient on physics, cmaes on a learned model; or ga, de, ma-*
     fitness = "physics"
+    energy = "thesis"      # or "mechanical", "electrical" (needs the robot's drive data)
     reference = true       # also solve each task to the optimum (needs the `reference` extra)
 
     [bench]               # optional: every GA/DE/MA configuration on the same random tasks
@@ -65,6 +66,7 @@ from pathlib import Path
 from typing import Any
 
 from joulepath.description import DEFAULT_ROBOT
+from joulepath.energy import DEFAULT_MEASURE, MEASURES, energy_measure
 from joulepath.errors import InvalidInput
 from joulepath.export import EXPORTERS
 from joulepath.optimize import ALGORITHMS, AUTO, FITNESS, fitness_kind, resolve_algorithm
@@ -129,7 +131,8 @@ class OptimizeStage:
     also solves every task with the reference solver (CasADi + IPOPT, slow) so the
     report can state the share of the optimum's saving reached. ``export`` names the
     program each task folder gets (:data:`joulepath.export.EXPORTERS`; empty: the
-    controller the robot declares, RAPID for the IRB 120).
+    controller the robot declares, RAPID for the IRB 120). ``energy`` is the measure
+    minimized (:data:`joulepath.energy.MEASURES`; ``electrical`` needs the robot's drive data).
     """
 
     tasks: int = 3
@@ -140,6 +143,7 @@ class OptimizeStage:
     range_set: str = "lab"
     reference: bool = False
     export: str = ""
+    energy: str = DEFAULT_MEASURE
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -234,6 +238,7 @@ _ALLOWED: dict[str, tuple[str, ...]] = {
     "families": ("mlp", "svr", "par", "xgb"),
     "targets": ALL_TARGETS,
     "export": ("", *EXPORTERS),
+    "energy": tuple(MEASURES),
 }
 BOUNDS: dict[str, dict[str, tuple[int, int]]] = {
     "": {"seed": (0, 2**32 - 1), "jobs": (1, 256)},
@@ -378,6 +383,11 @@ def _check_together(exp: Experiment, source: str) -> None:
         resolve_algorithm(o.algorithm, o.fitness)
     except InvalidInput as err:
         raise InvalidInput(f"{source}: [optimize] {err}") from None
+    if o.energy != DEFAULT_MEASURE and o.fitness != "physics":
+        raise InvalidInput(
+            f"{source}: [optimize] energy = {o.energy!r} needs fitness = 'physics' (the learned models "
+            "predict the thesis' energy)"
+        )
     if o.reference and o.fitness != "physics":
         raise InvalidInput(
             f"{source}: [optimize] reference = true needs fitness = 'physics' (a physics optimum)"
@@ -494,6 +504,9 @@ def _check_robot(exp: Experiment, source: str) -> None:
         robot = load_robot(exp.robot)
     except JoulepathError as err:
         raise InvalidInput(f"{source}: robot = {exp.robot!r}: {err}") from err
+    why = energy_measure(exp.optimize.energy).missing(robot.drivetrain)
+    if why is not None:
+        raise InvalidInput(f"{source}: [optimize] energy = {exp.optimize.energy!r}: {why}")
     names = robot.range_set_names
     if exp.optimize.range_set not in (*names, *FALLBACK_RANGE_SETS):
         raise InvalidInput(

@@ -266,7 +266,7 @@ def run_identify(
 
     from joulepath.data import ingest, load_table
     from joulepath.dynamics import NOMINAL_FRICTION, load_robot
-    from joulepath.energy import path_energy
+    from joulepath.errors import InvalidInput
     from joulepath.identify import IdentifyOptions, data_from_logs, identify, twin_robot, write_twin
     from joulepath.optimize import OptimizeConfig, optimize_move, random_tasks
     from joulepath.sim import simulate
@@ -278,13 +278,7 @@ def run_identify(
     ident = identify(data_from_logs(train_logs, robot), robot, IdentifyOptions())
     write_twin(ident, robot, folder / IDENTIFY_TWIN)
     twin = twin_robot(robot, ident)
-    assert twin.calibration is not None
-    cal = twin.calibration
     progress(1, steps)
-
-    def predicted(path: Trajectory) -> float:
-        tau = twin.inverse_dynamics(path.q, path.qd, path.qdd, friction=twin.friction)
-        return float(path_energy(cal.motor_torque(tau, path.qd), path.qd, path.dt).total)
 
     children = np.random.SeedSequence(exp.seed).spawn(9)
     seed = int(children[5].generate_state(1)[0])
@@ -292,8 +286,12 @@ def run_identify(
     optimized: list[Trajectory] = []
     for k, (q0, qf, T) in enumerate(random_tasks(robot, st.loop_tasks, seed=seed, range_set=st.range_set)):
         res = optimize_move(twin, q0, qf, T, OptimizeConfig(seed=exp.seed))
-        e_def, e_opt = predicted(res.default), predicted(res.optimized)
         s = res.summary
+        # the twin's prediction on the lab's logged measure: its identified gears included
+        mech = s.measure(s.energy_lab_measure)
+        if mech is None:  # a twin always has its gear efficiency
+            raise InvalidInput(f"the twin has no {s.energy_lab_measure} energy: {s.energies_unavailable}")
+        e_def, e_opt = mech.default_J, mech.optimized_J
         optimized.append(res.optimized)
         loop.append(
             LoopTask(

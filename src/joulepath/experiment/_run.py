@@ -730,6 +730,7 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
                 max_gen=o.generations,
                 pop_size=o.population,
                 seed=int(seeds[k].generate_state(1)[0]),
+                energy=o.energy,
             )
             res = optimize_move(robot, q0, qf, T, cfg, models=models, joints_ranked=joints)
             write_run(res, robot, folder / f"task-{k:03d}", export=o.export or None)

@@ -18,7 +18,8 @@ from typing import Any
 import numpy as np
 
 from joulepath.dynamics import Robot
-from joulepath.optimize._verify import energy_on_samples, plant_energy
+from joulepath.energy import DEFAULT_MEASURE
+from joulepath.optimize._verify import energy_on_samples, measured_energy, plant_energy
 from joulepath.trajectory import Trajectory
 
 EXECUTION_TOLERANCES = {"duration_pct": 2.0, "tcp_mm": 5.0}
@@ -81,12 +82,17 @@ class Execution:
         )
 
 
-def rapid_execution(robot: Robot, planned: Trajectory, planned_fine_J: float) -> tuple[Execution, Trajectory]:
+def rapid_execution(
+    robot: Robot, planned: Trajectory, planned_fine_J: float, *, measure: str = DEFAULT_MEASURE
+) -> tuple[Execution, Trajectory]:
     """Lay out the via points of ``planned`` and measure the written program on the emulation.
 
-    ``planned_fine_J``: the plan's physics energy on the fine grid (what the executed energy is
-    compared with). Returns the measurement and the via points as a (non-uniform) trajectory:
-    its samples are what the RAPID exporter writes, the first the start.
+    ``planned_fine_J``: the plan's physics energy on the fine grid on ``measure`` (what the
+    executed energy is compared with; with a measure that counts standby, over the plan's
+    duration). The executed physics energies are on the same measure (standby over each
+    move's own duration), the lab's on its logged (``mechanical``) one. Returns the
+    measurement and the via points as a (non-uniform) trajectory: its samples are what the
+    RAPID exporter writes, the first the start.
     """
     from joulepath.sim import make_plant
     from joulepath.sim._via import follow_path, timed_move
@@ -95,8 +101,14 @@ def rapid_execution(robot: Robot, planned: Trajectory, planned_fine_J: float) ->
     followed = follow_path(robot, planned)
     d_end, default = timed_move(robot, planned.q[0], planned.q[-1], duration)
     lab = make_plant("lab", robot)
-    e_opt = energy_on_samples(robot, followed.executed, friction=robot.friction)
-    e_def = energy_on_samples(robot, default, friction=robot.friction)
+    if measure == DEFAULT_MEASURE:
+        e_opt = energy_on_samples(robot, followed.executed, friction=robot.friction)
+        e_def = energy_on_samples(robot, default, friction=robot.friction)
+    else:
+        e_opt, e_def = (
+            measured_energy(robot, path, friction=robot.friction, measure=measure).total_J
+            for path in (followed.executed, default)
+        )
     l_opt, l_def = plant_energy(lab, followed.executed), plant_energy(lab, default)
     from scipy.spatial import cKDTree
 

@@ -4,11 +4,15 @@ The path is the minimum-jerk move plus a rest-to-rest B-spline shape
 (:class:`joulepath.trajectory.SplineBasis`); the search variables are the spline's
 free coefficients, ``x = C.ravel()`` with ``C`` of shape (n_free, n_joints).
 
-Objective: the path energy ``Σ_k Σ_i |tau_ki qd_ki| dt`` with ``|p|`` replaced by
-``sqrt(p² + ε²) - ε`` (smooth), solved for a decreasing sequence of ``ε``
+Objective: the path energy on an energy measure (:data:`joulepath.energy.MEASURES`;
+by default the thesis' ``Σ_k Σ_i |tau_ki qd_ki| dt``) with every ``|p|`` replaced by
+``sqrt(p² + ε²) - ε`` and every ``max(p, 0)`` (a bleeder bus, the gears' and drives'
+switch between driving and braking) by its smooth counterpart
+(:func:`joulepath.energy.measure_power`), solved for a decreasing sequence of ``ε``
 (continuation towards the true objective), each stage warm-started from the last.
-Its gradient is exact: Pinocchio's analytic RNEA derivatives and the friction
-derivative, chained through the linear spline basis.
+Its gradient is exact: the measure's derivatives by torque and speed, Pinocchio's
+analytic RNEA derivatives and the friction derivative, chained through the linear
+spline basis.
 
 Constraints (not penalties), solved by SLSQP:
 
@@ -41,6 +45,7 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Friction, Robot, inverse_dynamics_derivatives
+from joulepath.energy import DEFAULT_MEASURE, check_measure
 from joulepath.errors import InvalidInput
 from joulepath.optimize._verify import energy_on_samples
 from joulepath.trajectory import DEFAULT_KNOT_SPACING, GridBasis, SplineBasis, Trajectory, minimum_jerk
@@ -118,11 +123,6 @@ class GradientResult:
     """The fine-grid constraints the search ended with (flat indices per kind), to warm-start another."""
 
 
-def _smooth_abs(p: FloatArray, eps: float) -> tuple[FloatArray, FloatArray]:
-    r = np.sqrt(p * p + eps * eps)
-    return r - eps, p / r
-
-
 @dataclass(eq=False)
 class SplineProblem:
     """Energy, limits and corridor of one move as functions of the spline coefficients."""
@@ -140,9 +140,13 @@ class SplineProblem:
     jerk_limit: FloatArray | None = None
     waypoint_radius: tuple[FloatArray, ...] = ()
     base: Trajectory | None = None
+    energy_measure: str = DEFAULT_MEASURE
     n_evaluations: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
+        self.drivetrain = self.robot.drivetrain
+        # refused in one line saying what data it needs
+        self.energy_measure_def = check_measure(self.energy_measure, self.drivetrain)
         self.q_start = np.asarray(self.q_start, dtype=float)
         self.q_end = np.asarray(self.q_end, dtype=float)
         self.n = self.robot.n_joints
@@ -262,24 +266,29 @@ class SplineProblem:
 
     # ------------------------------------------------------------------ energy
     def true_energy(self, x: FloatArray) -> float:
-        """The reported metric: ``Σ |tau qd| dt`` on the samples, no smoothing."""
-        return energy_on_samples(self.robot, self.path(x), friction=self.friction)
+        """The reported metric on the samples, unsmoothed: ``Σ |tau qd| dt`` or the measure's motion part."""
+        return energy_on_samples(
+            self.robot, self.path(x), friction=self.friction, measure=self.energy_measure
+        )
 
     def smooth_energy(self, x: FloatArray, eps: float) -> tuple[float, FloatArray]:
-        """Smoothed energy (J) and its exact gradient with respect to ``x``."""
+        """Smoothed energy (J) and its exact gradient with respect to ``x``.
+
+        The energy term is the measure's smoothed power (:func:`joulepath.energy.measure_power`
+        with ``eps``) summed over the samples; its derivatives by ``tau`` and ``qd`` are chained
+        through the inverse dynamics' derivatives and the spline basis.
+        """
         self.n_evaluations += 1
         p = self.path(x)
         d = inverse_dynamics_derivatives(self.robot, p.q, p.qd, p.qdd, friction=self.friction)
-        power = d.tau * p.qd
-        phi, dphi = _smooth_abs(power, eps)
-        w = dphi * self.dt  # dE/dp
-        wq = w * p.qd  # dE/dtau
-        # dE/dq_k = Tq_kᵀ wq_k, dE/dqd_k = Tv_kᵀ wq_k + w_k tau_k, dE/dqdd_k = Ta_kᵀ wq_k
+        power = self.energy_measure_def.power(d.tau, p.qd, self.drivetrain, eps)
+        wq = power.d_tau * self.dt  # dE/dtau
+        # dE/dq_k = Tq_kᵀ wq_k, dE/dqd_k = Tv_kᵀ wq_k + dE/dqd_k (direct), dE/dqdd_k = Ta_kᵀ wq_k
         a = np.einsum("kij,ki->kj", d.dq, wq)
-        b = np.einsum("kij,ki->kj", d.dqd, wq) + w * d.tau
+        b = np.einsum("kij,ki->kj", d.dqd, wq) + power.d_qd * self.dt
         c = np.einsum("kij,ki->kj", d.dqdd, wq)
         g = self.samples.B.T @ a + self.samples.Bd.T @ b + self.samples.Bdd.T @ c
-        return float(phi.sum() * self.dt), g.ravel()
+        return float(power.value.sum() * self.dt), g.ravel()
 
     # ------------------------------------------------------------- constraints
     def _hull(self) -> tuple[FloatArray, FloatArray]:
@@ -623,6 +632,7 @@ def solve_move(
     jerk_limit: FloatArray | None = None,
     waypoint_radius: tuple[FloatArray, ...] = (),
     base: Trajectory | None = None,
+    energy_measure: str = DEFAULT_MEASURE,
 ) -> tuple[GradientResult, SplineProblem]:
     """Coarse-to-fine gradient search of one move; the result and the problem it lives in.
 
@@ -631,6 +641,8 @@ def solve_move(
     within ``waypoint_radius`` (rad per joint, one per waypoint) of each: a zone.
     ``base``: the motion (on the fine grid) the shape is added to instead of the
     minimum-jerk move; its start and end states (q, qd, qdd) are kept.
+    ``energy_measure``: the energy minimized (:data:`joulepath.energy.MEASURES`), its data
+    from :attr:`Robot.drivetrain`.
     """
 
     def make(spacing: float) -> SplineProblem:
@@ -649,6 +661,7 @@ def solve_move(
             jerk_limit=jerk_limit,
             waypoint_radius=waypoint_radius,
             base=base,
+            energy_measure=energy_measure,
         )
 
     fine = make(settings.knot_spacing)

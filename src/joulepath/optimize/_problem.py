@@ -5,8 +5,9 @@ Fitness kinds (each one call for the whole population):
 * ``"surrogate"`` — a learned model of the total energy ``E`` summed over the path's rows;
 * ``"surrogate-joints"`` — the sum of per-joint models ``E1..En``, one per joint (the
   thesis' multi-objective variant);
-* ``"physics"`` — the dynamics model (nominal parameters and friction):
-  ``Σ |tau_i qd_i| dt``.
+* ``"physics"`` — the dynamics model (nominal parameters and friction) on an
+  energy measure (:data:`joulepath.energy.MEASURES`; default the thesis'
+  ``Σ |tau_i qd_i| dt``).
 
 Limits: every candidate's joint positions are checked against the robot's ranges
 and its joint speeds against the speed limits (and, for the physics fitness, its
@@ -27,7 +28,7 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
-from joulepath.energy import path_energy
+from joulepath.energy import DEFAULT_MEASURE, measure_power, path_energy
 from joulepath.errors import InvalidInput
 from joulepath.optimize._features import path_features
 from joulepath.trajectory import GRID_HIGH, GRID_LOW, Trajectory, rest_to_rest, thesis_quintic
@@ -154,16 +155,22 @@ ROBOT_FRICTION = "robot"
 
 
 def physics_energy(
-    robot: Robot, traj: Trajectory, *, friction: Any = ROBOT_FRICTION
+    robot: Robot, traj: Trajectory, *, friction: Any = ROBOT_FRICTION, measure: str = DEFAULT_MEASURE
 ) -> tuple[FloatArray, FloatArray]:
-    """Per-path energy ``Σ |tau qd| dt`` (J) and the torques, for paths (P, n_steps, n).
+    """Per-path motion energy ``Σ_k P_k dt`` (J) on a measure, and the torques, of paths (P, n_steps, n).
 
-    ``friction``: the robot's own by default; None for the rigid body only.
+    ``friction``: the robot's own by default; None for the rigid body only. ``measure``:
+    a name of :data:`joulepath.energy.MEASURES` (default the thesis' ``Σ |tau qd| dt``);
+    its data come from :attr:`Robot.drivetrain`. The standby power, the same for every
+    path of a duration, is not included.
     """
     if isinstance(friction, str) and friction == ROBOT_FRICTION:
         friction = robot.friction
     tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=friction)
-    e = path_energy(tau, traj.qd, traj.dt).total
+    if measure == DEFAULT_MEASURE:
+        e = path_energy(tau, traj.qd, traj.dt).total
+    else:
+        e = measure_power(measure, tau, traj.qd, robot.drivetrain).value.sum(axis=-1) * traj.dt
     return np.atleast_1d(e), tau
 
 
@@ -184,6 +191,7 @@ class TrajectoryProblem:
     dt: float = 0.025
     acceleration_limit: FloatArray | None = None
     jerk_limit: FloatArray | None = None
+    energy_measure: str = DEFAULT_MEASURE
     n_evaluated: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -219,7 +227,7 @@ class TrajectoryProblem:
     def energy(self, traj: Trajectory) -> tuple[FloatArray, FloatArray | None]:
         """Unpenalized fitness energy of paths (J) and torques where computed."""
         if not fitness_kind(self.fitness).needs_models:
-            return physics_energy(self.robot, traj, friction=self.robot.friction)
+            return physics_energy(self.robot, traj, friction=self.robot.friction, measure=self.energy_measure)
         P, n = traj.q.shape[0], traj.q.shape[1]
         total = np.zeros(P)
         cache: dict[tuple[str, ...], FloatArray] = {}

@@ -51,6 +51,7 @@ from scipy.optimize import minimize
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Friction, Robot, friction_derivative
+from joulepath.energy import thesis_power
 from joulepath.errors import InvalidInput
 from joulepath.optimize._verify import check_limits, energy_on_samples
 from joulepath.sim._profile import Profile, evaluate_profile, plan_profile
@@ -365,20 +366,15 @@ class _Search:
         if self.friction is not None:
             tau = tau + self.friction.torque(qd)
             fd = friction_derivative(self.friction, qd)
-        power = tau * qd
-        smooth = np.sqrt(power * power + _EPS_POWER**2)
-        w = power / smooth
+        power = thesis_power(tau, qd, _EPS_POWER)  # Σ |tau qd| smoothed, and its derivatives
         dqd_ds = p["dq1"] * sd
         dtau_ds = p["dm"] * sdd + p["dc"] * sd * sd + p["dg"] + fd * dqd_ds
         dtau_dsd = 2.0 * p["c"] * sd + fd * p["q1"]
-        dp_ds = dtau_ds * qd + tau * dqd_ds
-        dp_dsd = dtau_dsd * qd + tau * p["q1"]
-        dp_dsdd = p["m"] * qd
-        e_s = (w * dp_ds).sum(axis=1)
-        e_sd = (w * dp_dsd).sum(axis=1)
-        e_sdd = (w * dp_dsdd).sum(axis=1)
+        e_s = (power.d_tau * dtau_ds + power.d_qd * dqd_ds).sum(axis=1)
+        e_sd = (power.d_tau * dtau_dsd + power.d_qd * p["q1"]).sum(axis=1)
+        e_sdd = (power.d_tau * p["m"]).sum(axis=1)
         grad = self.dt * (e_s @ self.b0 + e_sd @ self.b1 + e_sdd @ self.b2)
-        return float(self.dt * (smooth - _EPS_POWER).sum()), grad
+        return float(self.dt * power.value.sum()), grad
 
     def constraints(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """``g(x) >= 0`` (relative margins to each limit) and its Jacobian."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -13,7 +13,14 @@ import numpy as np
 from joulepath._io import atomic_write_text, finite_json
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
-from joulepath.energy import joint_power, path_energy
+from joulepath.energy import (
+    DEFAULT_MEASURE,
+    MEASURES,
+    check_measure,
+    energy_measure,
+    joint_power,
+    path_energy,
+)
 from joulepath.errors import InvalidInput, InvalidModel, LimitViolation
 from joulepath.optimize._problem import FITNESS, PARAMETRIZATIONS, TrajectoryProblem
 from joulepath.optimize._search import (
@@ -27,9 +34,10 @@ from joulepath.optimize._search import (
 from joulepath.optimize._verify import (
     check_limits,
     default_fine,
-    energy_on_samples,
+    measured_energy,
     path_jerk,
     plant_energy,
+    plant_measured,
     shortest_feasible_duration,
     tcp_deviation_mm,
 )
@@ -61,6 +69,10 @@ class OptimizeConfig:
     they never return a path their fitness rates worse than the default; the thesis'
     protocol (and ``bench-optimizers``) starts from random chromosomes only.
 
+    ``energy`` is the energy measure minimized and reported first (a name of
+    :data:`joulepath.energy.MEASURES`: ``thesis``, ``mechanical`` or ``electrical``);
+    every other measure the robot has the data for is reported too.
+
     ``follow`` is how the program's controller runs the path (:attr:`Exporter.follows`):
     ``"samples"`` (servoj, a JointTrajectory, EGM) follows the samples, so the path may use
     the whole acceleration limit; ``"via-points"`` (RAPID ``MoveAbsJ`` via points) plans
@@ -90,10 +102,17 @@ class OptimizeConfig:
     inject_default: bool = True
     seed: int = 0
     follow: str = "samples"
+    energy: str = DEFAULT_MEASURE
 
     def __post_init__(self) -> None:
         if self.fitness not in FITNESS:
             raise InvalidInput(f"fitness must be one of {', '.join(FITNESS)}, got {self.fitness!r}")
+        energy_measure(self.energy)
+        if self.energy != DEFAULT_MEASURE and self.fitness != "physics":
+            raise InvalidInput(
+                f"energy {self.energy!r} needs fitness 'physics': the learned models predict the thesis' "
+                "energy; drop --energy, or use --fitness physics"
+            )
         resolve_algorithm(self.algorithm, self.fitness)
         if self.parametrization not in PARAMETRIZATIONS:
             raise InvalidInput(
@@ -129,14 +148,48 @@ class OptimizeConfig:
 
 
 @dataclass(frozen=True, slots=True)
+class MeasureSummary:
+    """One energy measure of a move (J): default and optimized path, on the model and on the lab plant.
+
+    ``stage`` is where the measure is taken (:data:`joulepath.energy.STAGES`); ``source``
+    and ``lab_source`` say where the data beyond the joint come from (the gears, the
+    drives). ``standby_J`` is the standby energy over the move's duration, included in
+    every figure of a measure that counts it (the same for both paths).
+    """
+
+    measure: str
+    stage: str
+    source: str
+    default_J: float
+    optimized_J: float
+    saved_pct: float
+    standby_J: float
+    lab_default_J: float | None
+    lab_optimized_J: float | None
+    lab_saved_pct: float | None
+    lab_source: str
+
+
+def _saved(before: float, after: float) -> float:
+    return 100 * (before - after) / before if before > 0 else 0.0
+
+
+@dataclass(frozen=True, slots=True)
 class MoveSummary:
     """Everything measured about one optimized move (``result.json``, one key per field).
 
-    Energies are ``Σ |tau qd| dt`` on the physics model (nominal rigid body and the
+    Energies ``energy_*_J`` are on the measure ``energy_measure`` (the one optimized;
+    default ``thesis``: ``Σ |tau qd| dt``; with ``electrical`` the standby over the
+    move's duration is included) on the physics model (nominal rigid body and the
     robot's friction, :attr:`Robot.friction`; ``physics_model`` says which) at the 25 ms
     samples; ``*_fine_J`` is the same on a grid ten
     times finer (the integral the samples approximate). ``saved_pct`` compares the
     optimized path with the controller-like minimum-jerk move of the same duration.
+    ``energy_*_lab_J`` are the lab plant's on ``energy_lab_measure`` (``mechanical``:
+    its drive torque, gears included, times speed: what its torque log integrates to).
+    ``energies`` holds every measure the robot has the data for
+    (:class:`MeasureSummary`: model and lab, like for like), ``energies_unavailable``
+    why each other one is not computed.
     Limits are checked on the fine grid. ``saved_vs_initial_best_pct`` is the thesis'
     metric (evolutionary searches only). ``jerk_limit_rad_s3`` is the jerk limit the
     search and the check used (None: none), ``max_jerk_rad_s3`` the optimized path's
@@ -176,10 +229,19 @@ class MoveSummary:
     physics_model: str
     config: dict[str, Any]
     lab_plant: str = ""
+    energy_measure: str = DEFAULT_MEASURE
+    energy_lab_measure: str = "mechanical"
+    energies: tuple[MeasureSummary, ...] = ()
+    energies_unavailable: dict[str, str] = field(default_factory=dict)
+
+    def measure(self, name: str) -> MeasureSummary | None:
+        """The summary of measure ``name``, or None when it was not computed."""
+        return next((m for m in self.energies if m.measure == name), None)
 
     def to_json(self) -> dict[str, Any]:
-        """Plain JSON types; non-finite numbers become ``null`` (strict JSON)."""
+        """Plain JSON types; non-finite numbers become ``null`` (strict JSON); ``energies`` by measure."""
         out: dict[str, Any] = finite_json(asdict(self))
+        out["energies"] = {m["measure"]: m for m in out["energies"]}
         return out
 
 
@@ -298,6 +360,7 @@ def optimize_move(
     """
     q0 = np.asarray(q_start, dtype=float)
     qf = np.asarray(q_end, dtype=float)
+    check_measure(config.energy, robot.drivetrain)  # one line saying what to provide
     _check_ends(robot, q0, qf, duration)
     sample_times(duration, SAMPLE_PERIOD)
     check_default_feasible(robot, q0, qf, duration, accel_time=config.accel_time, jerk_time=config.jerk_time)
@@ -342,11 +405,12 @@ def verify_move(
     optimized = outcome.path
     amax = None if not np.all(np.isfinite(task.acceleration_limit)) else task.acceleration_limit
     friction = robot.friction
-    e_def = energy_on_samples(robot, default, friction=friction)
-    e_opt = energy_on_samples(robot, optimized, friction=friction)
     fine_def = default_fine(task.q_start, task.q_end, task.duration, task.dt)
-    e_def_fine = energy_on_samples(robot, fine_def, friction=friction)
-    e_opt_fine = energy_on_samples(robot, outcome.fine_path, friction=friction)
+    measure = config.energy
+    e_def, e_opt, e_def_fine, e_opt_fine = (
+        measured_energy(robot, path, friction=friction, measure=measure).total_J
+        for path in (default, optimized, fine_def, outcome.fine_path)
+    )
     jmax = task.jerk_limit
     report = check_limits(
         robot, outcome.fine_path, friction=friction, acceleration_limit=amax, jerk_limit=jmax
@@ -378,6 +442,7 @@ def verify_move(
 
     lab = make_plant("lab", robot)  # a twin: the lab robot it twins
     e_lab_def, e_lab_opt = plant_energy(lab, default), plant_energy(lab, optimized)
+    energies, unavailable = measure_summaries(robot, lab, default, optimized)
     summary = MoveSummary(
         robot=robot.name,
         start_rad=tuple(float(v) for v in task.q_start),
@@ -416,6 +481,9 @@ def verify_move(
         physics_model=_physics_model(robot),
         config=asdict(config),
         lab_plant=lab.note,
+        energy_measure=measure,
+        energies=energies,
+        energies_unavailable=unavailable,
     )
     return MoveResult(
         summary=summary,
@@ -424,6 +492,47 @@ def verify_move(
         history=np.asarray(outcome.history),
         parameters=np.asarray(outcome.parameters),
     )
+
+
+def measure_summaries(
+    robot: Robot, lab: Any, default: Trajectory, optimized: Trajectory
+) -> tuple[tuple[MeasureSummary, ...], dict[str, str]]:
+    """Each measure the robot has the data for, on its model and the lab plant; why not, for the rest.
+
+    Model and lab are measured alike: the model's joint torque through the robot's
+    gears and drives (:attr:`Robot.drivetrain`; a twin's identified gear efficiency),
+    the lab plant's through its own gears and the same drives.
+    """
+    out: list[MeasureSummary] = []
+    unavailable: dict[str, str] = {}
+    for name, spec in MEASURES.items():
+        why = spec.missing(robot.drivetrain)
+        if why is not None:
+            unavailable[name] = why
+            continue
+        d, o = (
+            measured_energy(robot, p, friction=robot.friction, measure=name) for p in (default, optimized)
+        )
+        lab_ok = spec.missing(lab.drivetrain) is None
+        ld, lo = (
+            (plant_measured(lab, p, measure=name) for p in (default, optimized)) if lab_ok else (None, None)
+        )
+        out.append(
+            MeasureSummary(
+                measure=name,
+                stage=spec.stage,
+                source=d.source,
+                default_J=d.total_J,
+                optimized_J=o.total_J,
+                saved_pct=_saved(d.total_J, o.total_J),
+                standby_J=d.standby_J,
+                lab_default_J=None if ld is None else ld.total_J,
+                lab_optimized_J=None if lo is None else lo.total_J,
+                lab_saved_pct=None if ld is None or lo is None else _saved(ld.total_J, lo.total_J),
+                lab_source=ld.source if ld is not None else str(spec.missing(lab.drivetrain)),
+            )
+        )
+    return tuple(out), unavailable
 
 
 def _physics_model(robot: Robot) -> str:
@@ -553,7 +662,9 @@ def write_run(
                 from joulepath.optimize._execute import rapid_execution
 
                 exporter.render(robot, result.optimized, s.duration_s)  # the plan's own limit check
-                execution, written = rapid_execution(robot, result.optimized, s.energy_optimized_fine_J)
+                execution, written = rapid_execution(
+                    robot, result.optimized, s.energy_optimized_fine_J, measure=s.energy_measure
+                )
                 refused = execution.refusal()
             if refused is None:
                 programs = exporter.render(robot, written, s.duration_s)

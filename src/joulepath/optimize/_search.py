@@ -98,6 +98,7 @@ def _gradient(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator
         max_deviation_m=None if config.max_deviation_mm is None else config.max_deviation_mm / 1000.0,
         dt=task.dt,
         jerk_limit=task.jerk_limit,
+        energy_measure=config.energy,
     )
     x = res.coefficients.ravel()
     return SearchOutcome(
@@ -124,6 +125,7 @@ def _fitness_problem(task: SearchTask, config: OptimizeConfig, parametrization: 
         dt=task.dt,
         acceleration_limit=task.acceleration_limit,
         jerk_limit=task.jerk_limit,
+        energy_measure=config.energy,
     )
 
 

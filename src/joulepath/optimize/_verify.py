@@ -20,7 +20,7 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Friction, Robot
-from joulepath.energy import path_energy
+from joulepath.energy import DEFAULT_MEASURE, MeasuredEnergy, measure_energy
 from joulepath.optimize._problem import physics_energy
 from joulepath.trajectory import Trajectory, minimum_jerk, sample_times
 
@@ -154,16 +154,43 @@ def check_limits(
     return LimitReport(range_rad=r, overspeed=s, overtorque=e, worst=tuple(worst))
 
 
-def energy_on_samples(robot: Robot, path: Trajectory, *, friction: Friction | None) -> float:
-    """The reported metric: ``Σ |tau qd| dt`` over the path's samples (J)."""
-    energy, _ = physics_energy(robot, path, friction=friction)
+def energy_on_samples(
+    robot: Robot, path: Trajectory, *, friction: Friction | None, measure: str = DEFAULT_MEASURE
+) -> float:
+    """The reported metric over the path's samples (J): ``Σ |tau qd| dt``, or another measure's motion energy.
+
+    The standby power of ``measure`` is not included (:func:`measured_energy` adds it).
+    """
+    energy, _ = physics_energy(robot, path, friction=friction, measure=measure)
     return float(energy[0])
 
 
-def plant_energy(plant: Any, path: Trajectory) -> float:
-    """``Σ |tau qd| dt`` of a plant's drive torque (``plant.drive_torque``) over the path's samples (J)."""
-    tau = plant.drive_torque(path.q, path.qd, path.qdd)
-    return float(path_energy(tau, path.qd, path.dt).total)
+def measured_energy(
+    robot: Robot, path: Trajectory, *, friction: Friction | None, measure: str = DEFAULT_MEASURE
+) -> MeasuredEnergy:
+    """A path's energy on ``measure`` over its samples, on the robot's model, standby over its duration."""
+    tau = robot.inverse_dynamics(path.q, path.qd, path.qdd, friction=friction)
+    return measure_energy(
+        measure, tau, path.qd, path.dt, robot.drivetrain, duration=float(path.t[-1] - path.t[0])
+    )
+
+
+def plant_energy(plant: Any, path: Trajectory, *, measure: str = "mechanical") -> float:
+    """A plant's energy over the path's samples (J), standby included where the measure counts it.
+
+    The default ``"mechanical"`` is ``Σ |tau qd| dt`` of the plant's drive torque
+    (``plant.drive_torque``, the logged torque: its gears included), what a log of the
+    plant integrates to.
+    """
+    return plant_measured(plant, path, measure=measure).total_J
+
+
+def plant_measured(plant: Any, path: Trajectory, *, measure: str) -> MeasuredEnergy:
+    """A plant's energy on ``measure`` over the path's samples: its joint torque through its own gears."""
+    tau = plant.joint_torque(path.q, path.qd, path.qdd)
+    return measure_energy(
+        measure, tau, path.qd, path.dt, plant.drivetrain, duration=float(path.t[-1] - path.t[0])
+    )
 
 
 def tcp_deviation_mm(robot: Robot, path: Trajectory, reference: Trajectory) -> float:

@@ -36,11 +36,12 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Robot
-from joulepath.energy import joint_energy, path_energy
+from joulepath.energy import DEFAULT_MEASURE, MEASURES, energy_measure, measure_energy, measure_power
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize import (
     ACCEL_TIME,
     GradientSettings,
+    MeasureSummary,
     acceleration_limit,
     check_limits,
     jerk_limit,
@@ -122,8 +123,10 @@ class CycleSettings:
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     seed: int = 0
+    energy: str = DEFAULT_MEASURE
 
     def __post_init__(self) -> None:
+        energy_measure(self.energy)
         if self.cycle_time is not None and not (np.isfinite(self.cycle_time) and 0 < self.cycle_time <= 3600):
             raise InvalidInput(f"cycle time must be a positive number of seconds, got {self.cycle_time}")
         if not 2 <= self.table_points <= 20:
@@ -257,6 +260,9 @@ class CycleResult:
     zone_miss_mm: float = 0.0  # largest TCP distance beyond a fly-by target's zone (0: within all)
     open_ends: frozenset[int] = frozenset()  # optimized moves whose piece ends blended into a kept move
     rapid_plan: CycleResult | None = None  # the same with the units inside MoveL segments as taught
+    energy_measure: str = DEFAULT_MEASURE  # the measure of the *_energy_J figures (motion, no standby)
+    energies: tuple[MeasureSummary, ...] = ()  # every measure the robot has data for, whole cycle
+    energies_unavailable: dict[str, str] = field(default_factory=dict)  # why not, for the others
 
     @property
     def saved_pct(self) -> float:
@@ -277,15 +283,30 @@ class ParetoPoint:
     durations: tuple[float, ...]
 
 
-def _energy(robot: Robot, plant: Plant, traj: Trajectory, *, half_open: bool = False) -> tuple[float, float]:
-    """Physics and lab J of ``traj``; ``half_open``: without its last sample (a window that the
-    rest of the cycle continues from, so that windows and their surroundings add up)."""
+def sample_power(robot: Robot, plant: Plant, traj: Trajectory, measure: str) -> tuple[FloatArray, FloatArray]:
+    """Per-sample power (W) of ``traj``: on the physics model (nominal rigid body with the tool's load
+    and NOMINAL_FRICTION, the robot's gears and drives) on ``measure``, standby excluded; and the lab
+    plant's logged power ``Σ |drive torque · qd|`` (its ``mechanical`` energy, gears included)."""
+    tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
+    p = measure_power(measure, tau, traj.qd, robot.drivetrain).value
+    lab = plant.joint_torque(traj.q, traj.qd, traj.qdd)
+    return p, measure_power(LAB_MEASURE, lab, traj.qd, plant.drivetrain).value
+
+
+LAB_MEASURE = "mechanical"
+"""The lab plant's energies are what its torque log integrates to: its drive torque times speed."""
+
+
+def _energy(
+    robot: Robot, plant: Plant, traj: Trajectory, measure: str = DEFAULT_MEASURE, *, half_open: bool = False
+) -> tuple[float, float]:
+    """Physics (on ``measure``) and lab J of ``traj``; ``half_open``: without its last sample (a window
+    that the rest of the cycle continues from, so that windows and their surroundings add up)."""
     if half_open:
         k = traj.t.size - 1
         traj = Trajectory(t=traj.t[:k], q=traj.q[:k], qd=traj.qd[:k], qdd=traj.qdd[:k])
-    tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
-    lab = plant.drive_torque(traj.q, traj.qd, traj.qdd)
-    return float(path_energy(tau, traj.qd, traj.dt).total), float(path_energy(lab, traj.qd, traj.dt).total)
+    p, p_lab = sample_power(robot, plant, traj, measure)
+    return float(p.sum() * traj.dt), float(p_lab.sum() * traj.dt)
 
 
 @dataclass(frozen=True, slots=True)
@@ -593,6 +614,7 @@ class CycleOptimizer:
             jerk_limit=jmax,
             waypoint_radius=self.zone_radius(i),
             base=base,
+            energy_measure=self.settings.energy,
         )
         self.n_solves += 1
         x = res.coefficients.ravel()
@@ -611,11 +633,9 @@ class CycleOptimizer:
             )
         else:
             fine = window
-        w = np.append(np.diff(fine.t), 0.0)[:, None]
-        tau = robot.inverse_dynamics(fine.q, fine.qd, fine.qdd, friction=NOMINAL_FRICTION)
-        lab = self.plant(robot).drive_torque(fine.q, fine.qd, fine.qdd)
-        e = float((np.abs(tau * fine.qd) * w).sum())
-        e_lab = float((np.abs(lab * fine.qd) * w).sum())
+        w = np.append(np.diff(fine.t), 0.0)
+        p, p_lab = sample_power(robot, self.plant(robot), fine, self.settings.energy)
+        e, e_lab = float((p * w).sum()), float((p_lab * w).sum())
         samples = problem.path(x)
         samples = Trajectory(
             t=np.append(samples.t, win.span),
@@ -746,14 +766,13 @@ class CycleOptimizer:
                 pieces.append(Trajectory(t=tr.t[sel] - a, q=tr.q[sel], qd=tr.qd[sel], qdd=tr.qdd[sel]))
             f = pieces[1]
             # the shared sample at a target counts half in each piece: the pieces sum to the chain
-            w = np.ones((f.t.size, 1))
+            w = np.full(f.t.size, s.fine.dt)
             if k > 0:
-                w[0] = 0.5
+                w[0] *= 0.5
             if k < len(members) - 1:
-                w[-1] = 0.5
-            tau = robot.inverse_dynamics(f.q, f.qd, f.qdd, friction=NOMINAL_FRICTION)
-            e = float((w * joint_energy(tau, f.qd, s.fine.dt)).sum())
-            e_lab = float((w * joint_energy(plant.drive_torque(f.q, f.qd, f.qdd), f.qd, s.fine.dt)).sum())
+                w[-1] *= 0.5
+            p, p_lab = sample_power(robot, plant, f, self.settings.energy)
+            e, e_lab = float((w * p).sum()), float((w * p_lab).sum())
             out[j] = replace(
                 s, duration=round(b - a, 9), energy_J=e, energy_lab_J=e_lab, samples=pieces[0], fine=f
             )
@@ -844,6 +863,7 @@ class CycleOptimizer:
             max_deviation_m=None if corridor is None else corridor / 1000,
             acceleration_limit=self._amax(robot),
             jerk_limit=self._jmax(robot),
+            energy_measure=self.settings.energy,
         )
         t_old = problem.fine.t * (warm.duration / T)
         q_old = np.column_stack(
@@ -888,6 +908,7 @@ class CycleOptimizer:
                 jerk_limit=self._jmax(robot),
                 waypoint_radius=self.zone_radius(m.index),
                 base=base,
+                energy_measure=self.settings.energy,
             )
         self.n_solves += 1
         x = res.coefficients.ravel()
@@ -895,7 +916,7 @@ class CycleOptimizer:
         report = check_limits(
             robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=self._jmax(robot)
         )
-        e, e_lab = _energy(robot, self.plant(robot), fine, half_open=inner)
+        e, e_lab = _energy(robot, self.plant(robot), fine, self.settings.energy, half_open=inner)
         samples = problem.path(x)
         # the taught move: the joint-interpolated move, or through a chain's targets the smoothest path
         taught = problem.path(problem.origin)
@@ -926,7 +947,7 @@ class CycleOptimizer:
             tcp=m.step.tcp,
         )
         self.n_solves += 1
-        e, e_lab = _energy(robot, self.plant(robot), r.fine)
+        e, e_lab = _energy(robot, self.plant(robot), r.fine, self.settings.energy)
         return Solved(
             T,
             e,
@@ -965,7 +986,7 @@ class CycleOptimizer:
         every = self.settings.gradient.check_factor
         samples = Trajectory(t=fine.t[::every], q=fine.q[::every], qd=fine.qd[::every], qdd=fine.qdd[::every])
         robot = self._robot(self.by_index[i])
-        e, e_lab = _energy(robot, self.plant(robot), fine, half_open=True)
+        e, e_lab = _energy(robot, self.plant(robot), fine, self.settings.energy, half_open=True)
         out = Solved(
             win.span,
             e,
@@ -1254,17 +1275,72 @@ class CycleOptimizer:
         if moves and moves[0].step.robot is not None:
             robot = moves[0].step.robot
         plant = self.plant(robot)
-        tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
-        lab = plant.drive_torque(traj.q, traj.qd, traj.qdd)
         w = np.append(np.diff(traj.t), 0.0)
-        p = np.abs(tau * traj.qd).sum(axis=1) * w
-        p_lab = np.abs(lab * traj.qd).sum(axis=1) * w
+        p, p_lab = sample_power(robot, plant, traj, self.settings.energy)
+        p, p_lab = p * w, p_lab * w
         bounds = [motion.starts[m.index] for m in moves] + [motion.cycle_time + 1.0]
         out: dict[int, tuple[float, float]] = {}
         for k, m in enumerate(moves):
             sel = (traj.t >= bounds[k] - 1e-12) & (traj.t < bounds[k + 1] - 1e-12)
             out[m.index] = (float(p[sel].sum()), float(p_lab[sel].sum()))
         return out
+
+    def measures(
+        self, default: CycleMotion, optimized: CycleMotion
+    ) -> tuple[tuple[MeasureSummary, ...], dict[str, str]]:
+        """Every measure the robot has the data for, of the default and the optimized cycle's whole
+        motion (model and lab plant, like for like; the standby power over each one's cycle time
+        included where the measure counts it: the meter-level figure); why not, for the rest."""
+        robot = self.spec.robot
+        moves = self.plan.moves
+        if moves and moves[0].step.robot is not None:
+            robot = moves[0].step.robot
+        plant = self.plant(robot)
+        out: list[MeasureSummary] = []
+        unavailable: dict[str, str] = {}
+        for name, spec in MEASURES.items():
+            why = spec.missing(robot.drivetrain)
+            if why is not None:
+                unavailable[name] = why
+                continue
+            model: list[float] = []
+            lab: list[float | None] = []
+            standby = 0.0
+            lab_ok = spec.missing(plant.drivetrain) is None
+            for motion in (default, optimized):
+                traj = motion.trajectory
+                w = np.append(np.diff(traj.t), 0.0)
+                tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
+                e = measure_energy(name, tau, traj.qd, w, robot.drivetrain, duration=motion.cycle_time)
+                model.append(e.total_J)
+                standby = standby or e.standby_J
+                if lab_ok:
+                    lab_tau = plant.joint_torque(traj.q, traj.qd, traj.qdd)
+                    el = measure_energy(
+                        name, lab_tau, traj.qd, w, plant.drivetrain, duration=motion.cycle_time
+                    )
+                    lab.append(el.total_J)
+                else:
+                    lab.append(None)
+            ld, lo = lab
+            out.append(
+                MeasureSummary(
+                    measure=name,
+                    stage=spec.stage,
+                    source=spec.source(robot.drivetrain),
+                    default_J=model[0],
+                    optimized_J=model[1],
+                    saved_pct=100 * (model[0] - model[1]) / model[0] if model[0] > 0 else 0.0,
+                    standby_J=standby,
+                    lab_default_J=ld,
+                    lab_optimized_J=lo,
+                    lab_saved_pct=None if ld is None or lo is None or ld <= 0 else 100 * (ld - lo) / ld,
+                    lab_source=spec.source(plant.drivetrain)
+                    if lab_ok
+                    else str(spec.missing(plant.drivetrain)),
+                )
+            )
+        return tuple(out), unavailable
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -1355,6 +1431,7 @@ def _assemble(
     e0_lab = sum(v[2] for v in default.values())
     motion = opt.motion(final.choice, settings.use_waits)
     spent = opt.move_energies(motion)  # the reported energies: per move, on the cycle's motion
+    energies, unavailable = opt.measures(opt.default_motion(), motion)
     outcomes: list[MoveOutcome] = []
     paths: dict[int, Solved] = {}
     ok = True
@@ -1512,6 +1589,9 @@ def _assemble(
         zone_miss_mm=max(
             [opt.zone_miss_mm(i, s) for i, s in final.choice.items() if not s.taught], default=0.0
         ),
+        energy_measure=settings.energy,
+        energies=energies,
+        energies_unavailable=unavailable,
     )
     return result
 

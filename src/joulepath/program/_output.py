@@ -14,7 +14,7 @@ from joulepath import __version__
 from joulepath._io import atomic_write_text, finite_json
 from joulepath.errors import LimitViolation
 from joulepath.program._cell import Cell, clearance
-from joulepath.program._cycle import CycleResult, ParetoPoint
+from joulepath.program._cycle import LAB_MEASURE, CycleResult, ParetoPoint
 from joulepath.program._model import RapidError
 from joulepath.program._rapid_write import (
     WrittenModule,
@@ -38,8 +38,9 @@ CYCLE_FILES = (
 ``egm.mod`` and ``EGM_SETUP.md`` with ``--export egm``)."""
 
 ASSUMPTIONS = (
-    "energy: sum over joints and 2.5 ms samples of |tau * qd| * dt, physics = nominal rigid body with the "
-    "tool's load and NOMINAL_FRICTION; lab = the emulated lab robot's drive torque on the same motion",
+    "energy: sum over 2.5 ms samples of the energy measure's power times dt (thesis: |tau * qd| summed over "
+    "joints; see energies for every measure and the stage it is taken at), physics = nominal rigid body with "
+    "the tool's load and NOMINAL_FRICTION; lab = the emulated lab robot's drive torque on the same motion",
     "default: the emulated controller (jerk-limited profile, speeddata, joint limits, accel = vmax/0.25 s, "
     "zones blended by superposition, 48 ms dwell at stop points; a move before WaitTime stops)",
     "units: the default cycle is cut where the robot stands still; a segment of MoveJ/MoveAbsJ only (each "
@@ -134,7 +135,7 @@ def check_written(result: CycleResult, text: str, cell: Cell | None = None) -> d
     traj = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
     first = plan.moves[0].step
     assert first.robot is not None and first.tcp is not None
-    energy, energy_lab = _energy(first.robot, make_plant("lab", first.robot), traj)
+    energy, energy_lab = _energy(first.robot, make_plant("lab", first.robot), traj, result.energy_measure)
     assert result.planned is not None
     p_plan, _ = _tcp(first.robot, result.planned.q, first.tcp)
     p_emu, _ = _tcp(first.robot, traj.q, first.tcp)
@@ -266,6 +267,14 @@ def cycle_json(
         "energy_default_lab_J": result.default_lab_J,
         "energy_optimized_lab_J": result.optimized_lab_J,
         "saved_lab_pct": result.saved_lab_pct,
+        "energy_measure": result.energy_measure,
+        "energy_lab_measure": LAB_MEASURE,
+        "energies": {m.measure: asdict(m) for m in result.energies},
+        "energies_unavailable": dict(result.energies_unavailable),
+        "energies_note": "energy_*_J: the cycle's motion energy on energy_measure (no standby), the "
+        "quantity optimized; energies: every measure of the whole cycle (stage: where it is taken), "
+        "standby over each cycle's time included where the measure counts it (the meter-level figure); "
+        "lab figures: the emulated lab plant measured alike",
         "breakdown": {
             "default_J": b.default_J,
             "shapes_at_default_proportions_J": b.shape_J,

@@ -757,6 +757,21 @@ def _cycle(run: _Run) -> str:
         + ". The default is the program as the emulated controller runs it; MoveL moves are kept as "
         "written (path and timing).</p>"
     )
+    measures = data.get("energies") or {}
+    if measures:
+        out += (
+            f"<p>Optimized on the <b>{html.escape(str(data.get('energy_measure', 'thesis')))}</b> energy. "
+            "The whole cycle on every energy measure (the stage each is taken at; standby over the cycle "
+            "time included where counted): "
+            + "; ".join(
+                f"{html.escape(str(name))} ({html.escape(str(m.get('stage')))}) "
+                f"{_fmt(m.get('default_J'), 4)} → {_fmt(m.get('optimized_J'), 4)} J, "
+                f"{_fmt(m.get('saved_pct'), 3)} % saved"
+                for name, m in measures.items()
+                if isinstance(m, dict)
+            )
+            + ".</p>"
+        )
     moves = pd.DataFrame(data.get("moves") or [])
     if len(moves):
         cols = [

@@ -34,6 +34,7 @@ from scipy import signal
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Friction, Robot
+from joulepath.energy import DriveModel, Drivetrain, motor_side_torque
 from joulepath.errors import InvalidInput
 from joulepath.sim._controller import MotionPlan, evaluate_plan
 
@@ -73,17 +74,36 @@ class Plant:
     speed_noise_deg_s: float = 0.0
     tracking_hz: float | None = None
     note: str = ""
+    drives: DriveModel | None = None
+    """The drive data of the robot this plant emulates (None: none known)."""
+    drives_note: str = "none"
 
-    def drive_torque(self, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
-        """Noise-free motor torque (joint side, N·m) the plant needs for a motion."""
+    def joint_torque(self, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
+        """Noise-free joint torque (N·m, friction included, before the gears) of a motion."""
         tau = self.robot.inverse_dynamics(q, qd, qdd)
         if self.friction is not None:
             tau = tau + self.friction.torque(qd)
-        if self.gear_efficiency != 1.0:
-            driving = tau * qd > 0
-            tau = np.where(driving, tau / self.gear_efficiency, tau * self.gear_efficiency)
         out: FloatArray = tau
         return out
+
+    def drive_torque(self, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
+        """Noise-free motor torque (joint side, N·m) the plant needs for a motion: :meth:`joint_torque`
+        through the gears (:func:`joulepath.energy.motor_side_torque`)."""
+        tau = self.joint_torque(q, qd, qdd)
+        if self.gear_efficiency != 1.0:
+            tau = motor_side_torque(tau, qd, self.gear_efficiency)
+        return tau
+
+    @property
+    def drivetrain(self) -> Drivetrain:
+        """The plant's gears and its robot's drive data, for the energy measures (:mod:`joulepath.energy`)."""
+        drives = self.drives
+        return Drivetrain(
+            gear_efficiency=(float(self.gear_efficiency),) * self.robot.n_joints,
+            gear_source=f"the {self.name} plant's ({self.gear_efficiency:g})",
+            drives=drives,
+            drives_source=self.drives_note if drives is None else drives.describe(),
+        )
 
 
 def perturbed_robot(robot: Robot, rng: np.random.Generator) -> Robot:
@@ -135,6 +155,8 @@ def twin_plant(folder: str, robot: Robot) -> Plant:
         friction=twin.friction,
         gear_efficiency=twin.calibration.gear_efficiency,
         torque_noise=(0.0,) * robot.n_joints,
+        drives=twin.drives,
+        drives_note=twin.drives_note,
     )
 
 
@@ -157,6 +179,8 @@ def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
             friction=robot.friction,
             gear_efficiency=calibration.gear_efficiency,
             note=f"identified twin {robot.source}",
+            drives=robot.drives,
+            drives_note=robot.drives_note,
         )
     if calibration is not None and calibration.twin_of is not None:
         # a twin is measured on the lab robot it is a twin of, never on a perturbed copy of itself
@@ -164,7 +188,14 @@ def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
 
         robot = load_robot(calibration.twin_of)
     if name == "sim":
-        return Plant(name="sim", robot=robot, friction=robot.friction, note=f"nominal {robot.name} model")
+        return Plant(
+            name="sim",
+            robot=robot,
+            friction=robot.friction,
+            note=f"nominal {robot.name} model",
+            drives=robot.drives,
+            drives_note=robot.drives_note,
+        )
     if name == "lab":
         n = robot.n_joints
         rng = np.random.default_rng(instance_seed)
@@ -194,6 +225,8 @@ def make_plant(name: str, robot: Robot, *, instance_seed: int = 120) -> Plant:
             speed_noise_deg_s=0.05,
             tracking_hz=12.0,
             note=note,
+            drives=robot.drives,
+            drives_note=robot.drives_note,
         )
     raise InvalidInput(
         f"unknown plant {name!r}; use one of {', '.join(PLANTS)}, or a twin folder (`joulepath identify`)"

@@ -1,4 +1,4 @@
-"""Joint power and energy (foundation: pure array functions).
+"""The thesis' joint power and energy (pure array functions).
 
 The thesis' definition (§2.1) of the energy of joint ``i`` over one sample of
 length ``dt`` is ``E_i = |tau_i * qd_i| * dt`` (J), and a move's energy is the sum
