@@ -303,6 +303,7 @@ ENDMODULE
         acceleration_limit=opt._amax(m.step.robot),
         jerk_limit=opt._jmax(m.step.robot),
         intervals=8,
+        continuation=(0.03,),  # one smoothing stage: within 0.2 % of three here, ten times faster
     )
     assert best.feasible, best.status
     taught = opt.taught(i).energy_J
