@@ -12,7 +12,8 @@ each within the time the plan gives its units). The share is the
 plan's saving on those units over the optimum's. Units inside MoveL segments and re-timed MoveL
 are not in the optimum (their ends or path are fixed); the share covers the units it holds.
 
-Run: ``.venv/bin/python benchmarks/cycle_examples.py`` (one BLAS thread; about 2 minutes).
+Run: ``.venv/bin/python benchmarks/cycle_examples.py`` (one BLAS thread; about 7 minutes, 5 of
+them the cycle optimum on inspection, which stops at its 300 s limit).
 Writes the table to stdout; BENCHMARKS.md holds a copy with the machine.
 """
 
