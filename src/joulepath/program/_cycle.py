@@ -20,6 +20,9 @@
   is fitted to them; SciPy's SLSQP shares the budget on the fitted curves; the moves
   are solved again at the shared durations (25 ms steps), and the better of that and
   the best combination of the solved table (dynamic programming) is kept.
+* Chains through fly-by targets: when the chain passes each target is searched once, at one
+  duration (:meth:`CycleOptimizer.tune_passes`, a pattern search over 25 ms steps, each step a
+  solve), and kept as shares of the duration for its other solves.
 * Verified: every optimized move's path on a 2.5 ms grid against the joint ranges,
   speed and acceleration limits (and the cell's obstacles, with ``cell``); its energy
   on physics and on the lab plant.
