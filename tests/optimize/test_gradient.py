@@ -7,7 +7,7 @@ import pytest
 from scipy.interpolate import BSpline
 
 from joulepath.dynamics import NOMINAL_FRICTION, inverse_dynamics_derivatives
-from joulepath.errors import LimitViolation
+from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize import (
     ACCEL_TIME,
     JERK_TIME,
@@ -22,6 +22,7 @@ from joulepath.optimize import (
     shortest_feasible_duration,
     write_run,
 )
+from joulepath.optimize._verify import energy_on_samples
 from joulepath.trajectory import SplineBasis, minimum_jerk
 
 Q0 = np.array([0.3, 0.2, -0.4, 0.5, -0.6, 1.0])
@@ -48,10 +49,10 @@ def test_rnea_derivatives_match_finite_differences(irb120, rng):
             np.testing.assert_allclose(jac[:, :, j], fd, rtol=1e-5, atol=1e-5)
 
 
-@pytest.mark.parametrize("eps", [0.5, 0.01])
-def test_energy_gradient_matches_finite_differences(irb120, rng, eps):
+@pytest.mark.parametrize(("eps", "every"), [(0.5, 1), (0.01, 1), (0.01, 2)])
+def test_energy_gradient_matches_finite_differences(irb120, rng, eps, every):
     basis = SplineBasis(1.0, knot_spacing=0.1)
-    problem = SplineProblem(irb120, Q0, QF, 1.0, NOMINAL_FRICTION, basis)
+    problem = SplineProblem(irb120, Q0, QF, 1.0, NOMINAL_FRICTION, basis, energy_every=every)
     x = rng.standard_normal(problem.n_var) * 0.05
     _, g = problem.smooth_energy(x, eps)
     h = 1e-6
@@ -60,6 +61,27 @@ def test_energy_gradient_matches_finite_differences(irb120, rng, eps):
         e[i] = h
         fd = (problem.smooth_energy(x + e, eps)[0] - problem.smooth_energy(x - e, eps)[0]) / (2 * h)
         assert g[i] == pytest.approx(fd, rel=1e-5, abs=1e-8)
+
+
+def test_energy_on_a_finer_grid_is_the_energy_of_the_path_sampled_there(irb120, rng):
+    """``energy_every``: the objective is the path's energy on a grid that many times finer than the
+    samples, evaluated here from the fine path's own samples; it tends to the fine grid's energy."""
+    basis = SplineBasis(1.0, knot_spacing=0.1)
+    x = rng.standard_normal(basis.n_free * 6) * 0.05
+    fine_problem = SplineProblem(irb120, Q0, QF, 1.0, NOMINAL_FRICTION, basis)
+    fine = fine_problem.path(x, fine=True)  # every 2.5 ms (check_factor 10)
+    errors = []
+    for every in (1, 2, 5):
+        problem = SplineProblem(irb120, Q0, QF, 1.0, NOMINAL_FRICTION, basis, energy_every=every)
+        k = 10 // every
+        sub = type(fine)(t=fine.t[::k], q=fine.q[::k], qd=fine.qd[::k], qdd=fine.qdd[::k])
+        e = problem.true_energy(x)
+        assert e == pytest.approx(energy_on_samples(irb120, sub, friction=NOMINAL_FRICTION), rel=1e-12)
+        assert problem.smooth_energy(x, 1e-9)[0] == pytest.approx(e, rel=1e-6)
+        errors.append(abs(e - energy_on_samples(irb120, fine, friction=NOMINAL_FRICTION)))
+    assert errors[2] <= errors[0]
+    with pytest.raises(InvalidInput, match="energy_every must divide"):
+        SplineProblem(irb120, Q0, QF, 1.0, NOMINAL_FRICTION, basis, energy_every=3)
 
 
 def test_zero_coefficients_are_the_default_and_every_path_rests_at_both_ends(irb120, rng):

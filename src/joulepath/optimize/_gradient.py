@@ -76,7 +76,10 @@ class GradientSettings:
     the default move's mean ``|tau_i qd_i|`` (W); ``n_starts`` counts the starting
     paths (the minimum-jerk move first, then random smooth shapes drawn with the
     seed); ``check_factor`` is how many times finer than the samples the limits are
-    enforced.
+    enforced; ``energy_every``: the objective is summed on a grid this many times finer
+    than the samples (a divisor of ``check_factor``). ``give_up``: a start whose
+    continuation stage ends outside a limit is not carried through the later stages, nor
+    refined on the fine knots (a probe that may be infeasible costs one stage).
     """
 
     knot_spacing: float = DEFAULT_KNOT_SPACING
@@ -91,6 +94,8 @@ class GradientSettings:
     coarse_factor: int = 2
     refine_stages: int = 1
     coarse_stages: int = 0
+    give_up: bool = False
+    energy_every: int = 1
 
     def __post_init__(self) -> None:
         if self.refine_stages < 1 or self.coarse_stages < 0:
@@ -141,6 +146,7 @@ class SplineProblem:
     waypoint_radius: tuple[FloatArray, ...] = ()
     base: Trajectory | None = None
     energy_measure: str = DEFAULT_MEASURE
+    energy_every: int = 1
     n_evaluations: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -185,11 +191,31 @@ class SplineProblem:
         self.emax = np.asarray(self.robot.effort_limit, dtype=float)
         self.has_effort = bool(np.any(np.isfinite(self.emax)))
         self.dt = self.basis.dt
+        self._energy_grid()
         self.origin = np.zeros(self.n_var)
         self._waypoint_rows()
         if self.max_deviation_m is not None:
             self.tcp_default = self.robot.fk(self.path(self.origin).q).position_m
         self.hull = self._hull()
+
+    def _energy_grid(self) -> None:
+        """The grid the objective is summed on: the samples, or ``energy_every`` times finer (a
+        divisor of ``check_factor``; on the samples alone the search can place power peaks between
+        them, and a finer grid's energy is what the move spends)."""
+        f = self.energy_every
+        if f < 1 or self.check_factor % f:
+            raise InvalidInput(f"energy_every must divide check_factor ({self.check_factor}), got {f}")
+        if f == 1:
+            self.egrid, self.edefault, self.edt = self.samples, self.default, self.dt
+            return
+        every = self.check_factor // f
+        fine = self.fine
+        self.egrid = GridBasis(
+            t=fine.t[::every], B=fine.B[::every], Bd=fine.Bd[::every], Bdd=fine.Bdd[::every]
+        )
+        d = self.default_fine
+        self.edefault = Trajectory(t=d.t[::every], q=d.q[::every], qd=d.qd[::every], qdd=d.qdd[::every])
+        self.edt = self.dt / f
 
     def _waypoint_rows(self) -> None:
         """``A_w x = b_w``: the path through each waypoint; ``origin``: the smoothest such ``x``.
@@ -266,10 +292,17 @@ class SplineProblem:
 
     # ------------------------------------------------------------------ energy
     def true_energy(self, x: FloatArray) -> float:
-        """The reported metric on the samples, unsmoothed: ``Σ |tau qd| dt`` or the measure's motion part."""
+        """The reported metric, unsmoothed, on the samples (or the energy grid): the measure's motion part."""
         return energy_on_samples(
-            self.robot, self.path(x), friction=self.friction, measure=self.energy_measure
+            self.robot, self._energy_path(x), friction=self.friction, measure=self.energy_measure
         )
+
+    def _energy_path(self, x: FloatArray) -> Trajectory:
+        if self.energy_every == 1:
+            return self.path(x)
+        c = self.coefficients(x)
+        g, b = self.egrid, self.edefault
+        return Trajectory(t=g.t, q=b.q + g.B @ c, qd=b.qd + g.Bd @ c, qdd=b.qdd + g.Bdd @ c)
 
     def smooth_energy(self, x: FloatArray, eps: float) -> tuple[float, FloatArray]:
         """Smoothed energy (J) and its exact gradient with respect to ``x``.
@@ -279,16 +312,16 @@ class SplineProblem:
         through the inverse dynamics' derivatives and the spline basis.
         """
         self.n_evaluations += 1
-        p = self.path(x)
+        p = self._energy_path(x)
         d = inverse_dynamics_derivatives(self.robot, p.q, p.qd, p.qdd, friction=self.friction)
         power = self.energy_measure_def.power(d.tau, p.qd, self.drivetrain, eps)
-        wq = power.d_tau * self.dt  # dE/dtau
+        wq = power.d_tau * self.edt  # dE/dtau
         # dE/dq_k = Tq_kᵀ wq_k, dE/dqd_k = Tv_kᵀ wq_k + dE/dqd_k (direct), dE/dqdd_k = Ta_kᵀ wq_k
         a = np.einsum("kij,ki->kj", d.dq, wq)
-        b = np.einsum("kij,ki->kj", d.dqd, wq) + power.d_qd * self.dt
+        b = np.einsum("kij,ki->kj", d.dqd, wq) + power.d_qd * self.edt
         c = np.einsum("kij,ki->kj", d.dqdd, wq)
-        g = self.samples.B.T @ a + self.samples.Bd.T @ b + self.samples.Bdd.T @ c
-        return float(power.value.sum() * self.dt), g.ravel()
+        g = self.egrid.B.T @ a + self.egrid.Bd.T @ b + self.egrid.Bdd.T @ c
+        return float(power.value.sum() * self.edt), g.ravel()
 
     # ------------------------------------------------------------- constraints
     def _hull(self) -> tuple[FloatArray, FloatArray]:
@@ -538,6 +571,8 @@ def _solve_from(
             active = _merge(active, problem.screen(x, SCREEN_BAND))
             if problem.violation(x) == 0.0:
                 break
+        if settings.give_up and problem.violation(x) > 0.0:
+            break
     return x, n_iter, active
 
 
@@ -662,6 +697,7 @@ def solve_move(
             waypoint_radius=waypoint_radius,
             base=base,
             energy_measure=energy_measure,
+            energy_every=settings.energy_every,
         )
 
     fine = make(settings.knot_spacing)
@@ -678,6 +714,8 @@ def solve_move(
         else settings.continuation[: -settings.refine_stages] or settings.continuation[:1]
     )
     first = optimize_spline(coarse, replace(settings, continuation=head), rng=rng)
+    if settings.give_up and not first.feasible:
+        return first, coarse
     # the coarse path in the fine basis: least squares on the fine grid (exact for nested knots)
     target = coarse.fine.B @ first.coefficients
     start: FloatArray = np.asarray(np.linalg.lstsq(fine.fine.B, target, rcond=None)[0], dtype=float)

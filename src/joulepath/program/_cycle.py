@@ -20,6 +20,9 @@
   is fitted to them; SciPy's SLSQP shares the budget on the fitted curves; the moves
   are solved again at the shared durations (25 ms steps), and the better of that and
   the best combination of the solved table (dynamic programming) is kept.
+* Chains through fly-by targets: when the chain passes each target is searched once, at one
+  duration (:meth:`CycleOptimizer.tune_passes`, a pattern search over 25 ms steps, each step a
+  solve), and kept as shares of the duration for its other solves.
 * Verified: every optimized move's path on a 2.5 ms grid against the joint ranges,
   speed and acceleration limits (and the cell's obstacles, with ``cell``); its energy
   on physics and on the lab plant.
@@ -102,7 +105,14 @@ class CycleSettings:
     within :data:`joulepath.sim._via.RAPID_ACCEL_SHARE` of the acceleration limit, as for a
     single move's ``path.mod``). ``rapid_plan``: with ``"samples"`` and a RAPID program, also
     plan for via points (:attr:`CycleResult.rapid_plan`), the module written where the
-    emulation runs the plan itself as the checks ask.
+    emulation runs the plan itself as the checks ask. ``energy_every``: the gradient search of a
+    unit from rest to rest sums its objective on a grid this many times finer than the 25 ms
+    samples (a divisor of the ``gradient``'s ``check_factor``; on the samples alone it places power
+    peaks between them, and the verified energy, on 2.5 ms, is up to about 0.5 % higher than it
+    planned). A shape added to the taught motion keeps the ``gradient``'s own (measured: on the
+    bundled examples the finer grid there saved less, e.g. payload_tool 3.8 % against 4.2 %). ``pass_search``:
+    solves per inner target, at most, of the search for when a chain passes its targets
+    (:meth:`CycleOptimizer.tune_passes`; 0: in proportion to each move's shortest duration).
     """
 
     cycle_time: float | None = None
@@ -120,6 +130,8 @@ class CycleSettings:
     max_time_s: float | None = None
     follow: str = "samples"
     rapid_plan: bool = True
+    energy_every: int = 2
+    pass_search: int = 3
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     seed: int = 0
@@ -139,6 +151,13 @@ class CycleSettings:
             raise InvalidInput(f"accel_time must be in (0, 10] s, got {self.accel_time}")
         if not 0 <= self.jerk_time <= 10:
             raise InvalidInput(f"jerk_time must be in [0, 10] s (0: no jerk limit), got {self.jerk_time}")
+        if self.energy_every < 1 or self.gradient.check_factor % self.energy_every:
+            raise InvalidInput(
+                f"energy_every must divide the gradient's check_factor ({self.gradient.check_factor}), "
+                f"got {self.energy_every}"
+            )
+        if not 0 <= self.pass_search <= 20:
+            raise InvalidInput(f"pass_search must be 0..20 solves per target, got {self.pass_search}")
         if self.follow not in ("samples", "via-points"):
             raise InvalidInput(f"follow must be samples or via-points, got {self.follow!r}")
         if self.max_time_s is not None and not (np.isfinite(self.max_time_s) and self.max_time_s > 0):
@@ -341,6 +360,10 @@ ON_TAUGHT_KNOTS = 0.1
 """s between knots, at least, of a shape added to the taught motion: the taught motion runs at the
 joints' speed limits, so nearly every speed row is active, and SLSQP's cost grows with their number."""
 
+PROBE_ROUNDS = 3
+"""Rounds of new limit rows per continuation stage, at most, of a probe of that search (one whose
+pass times cannot be met spends them all; a probe's result is verified like any solve)."""
+
 TIME_UNIT = FINE_DT
 """s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
 
@@ -371,6 +394,7 @@ class CycleOptimizer:
         self.deadline = deadline  # time.perf_counter() after which no new move is solved
         self.timed_out = False
         self.plan: PlannedCycle = plan_cycle(spec, settings.controller)
+        self.gradient = replace(settings.gradient, energy_every=settings.energy_every)
         self._plants: dict[int, Plant] = {}
         self._default_motion: CycleMotion | None = None
         self._default_energies: dict[int, tuple[float, float, float]] | None = None
@@ -387,6 +411,8 @@ class CycleOptimizer:
         self.segment_of: dict[int, Segment] = {}  # by unit: the window of the default cycle it replaces
         self.within: set[int] = set()  # units inside a segment with MoveL: fixed duration, taught ends
         self.linear: set[int] = set()  # MoveL units: re-timed along their line (retime_on_path)
+        self.shares: dict[int, tuple[float, ...]] = {}  # by chain: when it passes its targets (tune_passes)
+        self.tuned: set[int] = set()  # chains whose pass times were searched
         for seg in self.segments:
             for members, window, inner in self._units_of(seg):
                 self.chains[members[0]] = members
@@ -523,17 +549,21 @@ class CycleOptimizer:
 
     # ------------------------------------------------------------ chains
     def waypoints(self, i: int, T: float) -> tuple[tuple[float, FloatArray], ...]:
-        """The chain's inner targets and when it passes them: ``T`` shared in proportion to each
-        move's shortest rest-to-rest duration, in whole 25 ms samples, each leg at least two
-        samples long (at the sum of those durations, each leg gets its own)."""
+        """The chain's inner targets and when it passes them, in whole 25 ms samples, each leg at least
+        two samples long: at the shares of ``T`` :meth:`tune_passes` found; else (a unit inside a
+        MoveL segment) where the taught motion passes them; else ``T`` shared in proportion to each
+        move's shortest rest-to-rest duration (at the sum of those durations, each leg gets its own)."""
         members = self.chains[i]
         if len(members) == 1:
             return ()
-        if i in self.within:
-            return self._taught_passes(i)
-        base = np.array(self.leg_lo[i])
         units = int(round(T / STEP))
-        edges = np.round(np.cumsum(base)[:-1] / base.sum() * units).astype(int)
+        if i in self.shares:
+            edges = np.round(np.asarray(self.shares[i]) * units).astype(int)
+        elif i in self.within:
+            return self._taught_passes(i)
+        else:
+            base = np.array(self.leg_lo[i])
+            edges = np.round(np.cumsum(base)[:-1] / base.sum() * units).astype(int)
         for k in range(edges.size):  # at least 2 samples per leg
             edges[k] = max(edges[k], (edges[k - 1] if k else 0) + 2)
         for k in range(edges.size - 1, -1, -1):
@@ -541,6 +571,90 @@ class CycleOptimizer:
         return tuple(
             (float(e * STEP), self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
         )
+
+    def tune_passes(self, i: int, T: float) -> None:
+        """When chain ``i`` passes its inner targets, searched at duration ``T``: a pattern search over
+        the pass times in whole 25 ms samples from those :meth:`waypoints` gives (each candidate a
+        solve, ``give_up`` and at most :data:`PROBE_ROUNDS` rounds; a step along one target's time is
+        kept when it lowers the verified energy below the best so far, the steps halve down to one
+        sample, at most ``pass_search`` probes per target). Pass times that beat the solve at the
+        pass times it starts from are kept as shares of the duration (:meth:`waypoints`) for the
+        chain's solves at every duration; the better solve at ``T`` is cached. Nothing for a single
+        move or a MoveL."""
+        members = self.chains[i]
+        if len(members) < 2 or i in self.linear or i in self.tuned or not self.settings.pass_search:
+            return
+        self.tuned.add(i)
+        units = int(round(T / STEP))
+        m = self.by_index[i]
+        corridor = self.settings.corridor_mm
+        first = self._solve_once(m, units * STEP, units, corridor)  # where it passes them untuned
+        untuned = [t for t, _ in self.waypoints(i, units * STEP)]
+        start = tuple(int(round(t / STEP)) for t in untuned)
+        seen: dict[tuple[int, ...], Solved] = {}
+        if all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
+            seen[start] = first
+        probe = replace(self.gradient, give_up=True, max_rounds=min(self.gradient.max_rounds, PROBE_ROUNDS))
+
+        def energy(edges: tuple[int, ...]) -> float:
+            if not self._passes_reachable(i, edges, units):
+                return np.inf
+            if edges not in seen:
+                way = tuple(
+                    (e * STEP, self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
+                )
+                seen[edges] = self._solve_once(m, units * STEP, units, corridor, way=way, gradient=probe)
+            s = seen[edges]
+            return s.energy_J if s.usable else np.inf
+
+        best, e_best = start, first.energy_J if first.usable else np.inf
+        won = False
+        step = max(1, units // (4 * len(members)) if i not in self.within else 2)
+        cap = self.settings.pass_search * len(start)
+        while step >= 1 and len(seen) < cap:
+            moved = False
+            for k in range(len(best)):
+                for d in (-step, step):
+                    cand = tuple(e + d if n == k else e for n, e in enumerate(best))
+                    if len(seen) >= cap:
+                        break
+                    e = energy(cand)
+                    if e < e_best - 1e-9:
+                        best, e_best, moved, won = cand, e, True, True
+                        break
+            if not moved:
+                step //= 2
+        if won:
+            self.shares[i] = tuple(e / units for e in best)
+            self.cache[(i, units)] = seen[best]
+        elif first.usable:
+            self.cache[(i, units)] = first
+
+    def _passes_reachable(self, i: int, edges: tuple[int, ...], units: int) -> bool:
+        """Whether chain ``i`` can pass its inner targets at samples ``edges`` of ``units``, by a bound
+        from kinematics alone: each leg at least two samples; each joint covers its travel between
+        two targets, less their zones' radii, within the speed limit, and from rest (a unit from
+        rest to rest: its first and last leg) within the acceleration limit, ``d ≤ a t² / 2``."""
+        cuts = (0, *edges, units)
+        if np.any(np.diff(cuts) < 2):
+            return False
+        members = self.chains[i]
+        robot = self._robot(self.by_index[i])
+        v = np.asarray(robot.velocity_limit, dtype=float)
+        a = self._amax_array(robot)
+        radius = [np.zeros(robot.n_joints), *self.zone_radius(i), np.zeros(robot.n_joints)]
+        rest = i not in self.within  # else its ends are the taught motion's, inside the first and last legs
+        for k, j in enumerate(members):
+            if not rest and k in (0, len(members) - 1):
+                continue
+            path = self.by_index[j].path
+            d = np.maximum(np.abs(path.q1 - path.q0) - radius[k] - radius[k + 1], 0.0)
+            t = (cuts[k + 1] - cuts[k]) * STEP
+            if np.any(d > v * t + 1e-12):
+                return False
+            if rest and k in (0, len(members) - 1) and np.any(d > 0.5 * a * t * t + 1e-12):
+                return False
+        return True
 
     def _taught_passes(self, i: int, traj: Trajectory | None = None) -> tuple[tuple[float, FloatArray], ...]:
         """Inner targets of a unit at the times (from the window's start, on the 2.5 ms grid of
@@ -565,7 +679,7 @@ class CycleOptimizer:
         """The taught motion over unit ``i``'s window (or its first ``n_steps`` 25 ms samples), on
         the optimizer's fine grid (from 0)."""
         win = self.segment_of[i]
-        h = STEP / self.settings.gradient.check_factor
+        h = STEP / self.gradient.check_factor
         length = win.span if n_steps is None else n_steps * STEP
         n = int(round(length / h)) + 1
         t = np.linspace(0.0, (n - 1) * h, n)
@@ -599,7 +713,7 @@ class CycleOptimizer:
         amax, jmax = self._amax(robot), self._jmax(robot)
         seq = np.random.SeedSequence([self.settings.seed, m.index, 10_000 + n])
         corridor = self.settings.corridor_mm
-        g = self.settings.gradient
+        g = self.settings.gradient  # on the taught motion: the objective on the samples (see energy_every)
         res, problem = solve_move(
             robot,
             base.q[0],
@@ -714,7 +828,7 @@ class CycleOptimizer:
         """The chain's problem at ``T``: fine knots, no corridor (its smoothest path is ``origin``)."""
         m0, m1 = self.by_index[i], self.by_index[self.chains[i][-1]]
         robot = self._robot(m0)
-        g = self.settings.gradient
+        g = self.gradient
         return SplineProblem(
             robot,
             m0.path.q0,
@@ -849,7 +963,7 @@ class CycleOptimizer:
         self, m: PlannedMove, T: float, corridor: float | None, warm: Solved
     ) -> tuple[Any, Any]:
         """The fine-knot problem at ``T`` and the warm path in its coefficients (time-scaled, lstsq)."""
-        g = self.settings.gradient
+        g = self.gradient
         robot = self._robot(m)
         basis = SplineBasis(T, knot_spacing=g.knot_spacing, degree=g.degree, dt=STEP)
         problem = SplineProblem(
@@ -873,7 +987,14 @@ class CycleOptimizer:
         return problem, c
 
     def _solve_once(
-        self, m: PlannedMove, T: float, units: int, corridor: float | None, warm: Solved | None = None
+        self,
+        m: PlannedMove,
+        T: float,
+        units: int,
+        corridor: float | None,
+        warm: Solved | None = None,
+        way: tuple[tuple[float, FloatArray], ...] | None = None,
+        gradient: GradientSettings | None = None,
     ) -> Solved:
         robot = self._robot(m)
         amax = self._amax(robot)
@@ -882,16 +1003,17 @@ class CycleOptimizer:
         if m.index in self.linear:
             return self._retime_once(m, T)
         inner = m.index in self.within
+        way = self.waypoints(m.index, T) if way is None else way
         base = self.base(m.index) if inner else None
         q0 = m.path.q0 if base is None else base.q[0]
         q1 = self.by_index[self.chains[m.index][-1]].path.q1 if base is None else base.q[-1]
         if warm is not None and not inner:  # from the nearest solved duration: the last stages only
             problem, start = self._warm_problem(m, T, corridor, warm)
-            g = self.settings.gradient
+            g = self.gradient
             refine = replace(g, n_starts=1, continuation=g.continuation[-g.refine_stages :])
             res = optimize_spline(problem, refine, rng=rng, initial=start)
         else:
-            g = self.settings.gradient
+            g = self.gradient if gradient is None else gradient
             res, problem = solve_move(
                 robot,
                 q0,
@@ -900,11 +1022,16 @@ class CycleOptimizer:
                 friction=NOMINAL_FRICTION,
                 settings=g
                 if base is None
-                else replace(g, knot_spacing=max(g.knot_spacing, ON_TAUGHT_KNOTS), coarse_factor=1),
+                else replace(
+                    g,
+                    knot_spacing=max(g.knot_spacing, ON_TAUGHT_KNOTS),
+                    coarse_factor=1,
+                    energy_every=self.settings.gradient.energy_every,
+                ),
                 rng=rng,
                 acceleration_limit=amax,
                 max_deviation_m=None if corridor is None else corridor / 1000,
-                waypoints=self.waypoints(m.index, T),
+                waypoints=way,
                 jerk_limit=self._jmax(robot),
                 waypoint_radius=self.zone_radius(m.index),
                 base=base,
@@ -931,6 +1058,7 @@ class CycleOptimizer:
             tcp_deviation_mm(robot, samples, taught),
             None if self.settings.cell is None else self._clearance_mm(m, fine.q),
             corridor,
+            passes=tuple(t for t, _ in way) if way else None,
         )
 
     def _retime_once(self, m: PlannedMove, T: float) -> Solved:
@@ -983,7 +1111,7 @@ class CycleOptimizer:
             return self.cache[key]
         win = self.segment_of[i]
         fine = self.base(i)
-        every = self.settings.gradient.check_factor
+        every = self.gradient.check_factor
         samples = Trajectory(t=fine.t[::every], q=fine.q[::every], qd=fine.qd[::every], qdd=fine.qdd[::every])
         robot = self._robot(self.by_index[i])
         e, e_lab = _energy(robot, self.plant(robot), fine, self.settings.energy, half_open=True)
@@ -1040,6 +1168,7 @@ class CycleOptimizer:
             self.progress(f"unit {n_move}/{len(self.optimizable)}: solving at up to {k + 1} durations")
             if i in self.within:  # its ends are the taught motion's: at its own duration only
                 try:
+                    self.tune_passes(i, round(self.span[i] / STEP) * STEP)
                     out[i].append(self.solve(i, round(self.span[i] / STEP) * STEP))
                 except TimeBudgetSpent:
                     return out
@@ -1050,6 +1179,10 @@ class CycleOptimizer:
                 units.add(own)
             lo_u = int(np.ceil(self.t_lo[i] / STEP - 1e-9))
             units = {max(u, lo_u) for u in units if u * STEP <= hi + 1e-9} or {lo_u}
+            try:  # when the chain passes its targets: searched at its own duration (or the middle one)
+                self.tune_passes(i, (own if own in units else sorted(units)[len(units) // 2]) * STEP)
+            except TimeBudgetSpent:
+                return out
             for u in sorted(units):
                 try:
                     out[i].append(self.solve(i, u * STEP))
