@@ -254,9 +254,10 @@ def check_motion_time(plan: PlannedCycle, source: str, *, optimized: bool = Fals
 
     Tiny speeds (``\\V:=0.0001``, a speeddata of 1e-9 mm/s) or a long ``\\T`` imply hours
     of motion, and arrays of every sample of it: the ``motion_s`` limit bounds the moves
-    of the cycle together. ``optimized``: the moves are to be optimized, whose cost
-    grows with the cube of a move's duration (one dense solve over its spline
-    coefficients), so the ``move_s`` limit bounds each move too; see :mod:`joulepath._work`.
+    of the cycle together. ``optimized``: the moves are to be optimized, each in dense
+    solves over spline coefficients as many as its duration holds knots (a 6 s move
+    took about twice as long as a 3 s one, minutes on a busy 2-core machine), so the
+    ``move_s`` limit bounds each move too; see :mod:`joulepath._work`.
 
     Raises
     ------
