@@ -147,7 +147,12 @@ CASES = [
     C("twin-efficiency-true", SHOW_TWIN, 2, "gear_efficiency", _friction('"gear_efficiency": 0.9', '"gear_efficiency": true')),
     C("twin-stribeck-speed-true", SHOW_TWIN, 2, "stribeck_speed", _friction('"stribeck_speed": 0.05', '"stribeck_speed": true')),
     C("twin-friction-not-utf8", SHOW_TWIN, 2, "not UTF-8", {TWIN: "", "tw/friction.json": "\udcff{}"}),
-    C("rapid-position-1e999", CYC, 2, "outside its range", {"p.mod": mod(*AB, decl=DECL.replace("[[30, 10", "[[1E999, 10"))}),
+    C("rapid-joint-1e999", CYC, 2, "1E999 is not a finite number", {"p.mod": mod(*AB, decl=DECL.replace("[[30, 10", "[[1E999, 10"))}),
+    C("rapid-robtarget-1e999", CYC, 2, "1E999 is not a finite number", {"p.mod": mod(*AB, "MoveJ pX, v1000, fine, tool0;", decl=DECL + "    CONST robtarget pX := [[1E999, 0, 630], [0.5, 0, 0.866025, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];\n")}),
+    C("rapid-wait-overflow", CYC, 2, "not a finite number", {"p.mod": mod(*AB, "WaitTime 1E300 * 1E300;")}),
+    C("rapid-div-overflow", CYC, 2, "not a finite number", {"p.mod": mod(*AB, "WaitTime 1E300 * 1E300 DIV 2;")}),
+    C("rapid-div-fraction", CYC, 2, "DIV needs whole numbers", {"p.mod": mod(*AB, "WaitTime 0.1 DIV 0.5;")}),
+    C("rapid-speed-v-1e999", CYC, 2, "not a finite number", {"p.mod": mod(AB[0], "MoveAbsJ jB, v1000\\V:=1E999, fine, tool0;")}),
     # ---- nesting
     C("cycle-toml-nested-3000", CYT, 2, "nested more than 32 deep", {"c.toml": "start_deg = " + "[" * 3000 + "]" * 3000 + "\n" + CYCLE_TOML}),
     C("cycle-toml-nested-40", CYT, 2, "nested more than 32 deep", {"c.toml": "start_deg = " + "[" * 40 + "]" * 40 + "\n" + CYCLE_TOML}),

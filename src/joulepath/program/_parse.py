@@ -35,6 +35,7 @@ Reading never executes anything.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -318,7 +319,10 @@ def _aggregate(path: str, line: int, text: str) -> object:
         m = _NUMBER.match(text, pos)
         if m:
             pos = m.end()
-            return float(m.group())
+            number = float(m.group())
+            if not math.isfinite(number):
+                raise fail(f"{m.group()[:20]} is not a finite number (RAPID holds at most 3.4E38)")
+            return number
         for word, v in (("TRUE", True), ("FALSE", False)):
             if text[pos : pos + len(word)].upper() == word:
                 pos += len(word)
@@ -687,6 +691,8 @@ def _array_element(path: str, line: int, text: str, names: Names) -> tuple[str, 
 def _number(path: str, line: int, text: str, names: Names, what: str) -> float:
     text = text.strip()
     if _NUMBER.fullmatch(text):
+        if not math.isfinite(float(text)):
+            raise RapidError(f"{path}:{line}: {what} {text[:20]} is not a finite number (at most 3.4E38)")
         return float(text)
     if _IDENT.match(text) and text.lower() in names.loop:
         return float(names.loop[text.lower()])
@@ -829,6 +835,10 @@ def _evaluate(
             op = take()[1].upper()
             r = num(primary())
             a = num(v)
+            if not (math.isfinite(a) and math.isfinite(r)):
+                raise fail("a value is not a finite number; write numbers RAPID can hold (at most 3.4E38)")
+            if op in ("DIV", "MOD") and (a != round(a) or r != round(r)):
+                raise fail(f"{op} needs whole numbers, got {a:g} {op} {r:g}")
             if op != "*" and r == 0:
                 raise fail("division by zero")
             v = (
@@ -889,6 +899,8 @@ def _evaluate(
     out = disjunction()
     if k != len(tokens):
         raise fail(f"unexpected {tokens[k][1]!r}")
+    if not isinstance(out, bool) and not math.isfinite(out):
+        raise fail("its value is not a finite number; write numbers RAPID can hold (at most 3.4E38)")
     return out
 
 
