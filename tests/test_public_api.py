@@ -81,7 +81,7 @@ ALLOWED = {
     "experiment": None,  # orchestrates every stage, like the CLI
     "cli": None,  # may import anything
 }
-FOUNDATION = {"_typing", "_rng", "_io", "_runfolder", "errors", "units", "abb", "__version__"}
+FOUNDATION = {"_typing", "_rng", "_io", "_runfolder", "_work", "errors", "units", "abb", "__version__"}
 
 
 def _imports(path: Path) -> set[str]:

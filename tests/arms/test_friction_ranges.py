@@ -63,7 +63,7 @@ def test_friction_file_beside_the_description_is_the_robots_friction(tmp_path):
             "coulomb = [1, 1, 1, 1, 1, 1]\nviscous = [0, 0, 0, 0, 0, 0]\nstribeck = 1\n",
             "unknown key 'stribeck'",
         ),
-        ("coulomb = [", "not a TOML friction file"),
+        ("coulomb = [", "not valid TOML"),
     ],
 )
 def test_bad_friction_file_is_one_line_and_exit_2(tmp_path, capsys, text, needle):

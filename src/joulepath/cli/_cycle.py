@@ -137,7 +137,7 @@ def cycle(
     if export not in ("auto", "rapid", "egm"):
         raise typer.BadParameter(f"{export!r}: give auto, rapid or egm", param_hint="--export")
     check_out_folder(out, files=CYCLE_FILES, inputs=[program, *([cell] if cell else [])])
-    if not program.is_file():
+    if not program.exists():  # anything else but a regular file is refused by name when read
         raise typer.BadParameter(f"{program}: no such file", param_hint="PROGRAM")
     r = load_robot_for_cli(robot, unchecked=unchecked)
     check_measure(energy, r.drivetrain)  # one line saying what to provide

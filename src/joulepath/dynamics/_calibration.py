@@ -14,7 +14,6 @@ Loading a twin never executes code: the friction file is plain JSON checked fiel
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from joulepath._io import load_json
 from joulepath._typing import FloatArray
 from joulepath.energy import motor_side_torque
 from joulepath.errors import InvalidRobotDescription
@@ -127,19 +127,29 @@ class Calibration:
         }
 
 
+MAX_FRICTION_JSON_BYTES = 1 << 20
+"""Largest ``friction.json`` read (the file is a few hundred bytes)."""
+
+
+def _is_number(value: Any) -> bool:
+    """A JSON number (never ``true``/``false``) that is a finite float of sane size."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and abs(value) <= 1e12
+
+
 def _floats(value: Any, where: str, n: int) -> tuple[float, ...]:
-    if not isinstance(value, list) or len(value) != n or not all(isinstance(v, int | float) for v in value):
-        raise InvalidRobotDescription(f"{where}: expected a list of {n} numbers (one per joint)")
+    if not isinstance(value, list) or len(value) != n or not all(_is_number(v) for v in value):
+        raise InvalidRobotDescription(
+            f"{where}: expected a list of {n} finite numbers (one per joint, not true/false)"
+        )
     return tuple(float(v) for v in value)
 
 
 def read_calibration(path: str | os.PathLike[str], n_joints: int) -> Calibration:
     """Read and check a twin's friction file (plain JSON; nothing is executed)."""
     p = Path(path)
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise InvalidRobotDescription(f"{p}: not a readable JSON friction file ({err})") from err
+    data = load_json(
+        p, max_bytes=MAX_FRICTION_JSON_BYTES, what="a JSON friction file", error=InvalidRobotDescription
+    )
     if not isinstance(data, dict) or data.get("format") != FRICTION_FORMAT:
         raise InvalidRobotDescription(
             f'{p}: not a joulepath friction file (expected "format": "{FRICTION_FORMAT}"); '
@@ -149,15 +159,15 @@ def read_calibration(path: str | os.PathLike[str], n_joints: int) -> Calibration
     if not isinstance(fr, dict):
         raise InvalidRobotDescription(f'{p}: no "friction" object')
     eta = data.get("gear_efficiency", 1.0)
-    if not isinstance(eta, int | float) or not 0.0 < float(eta) <= 1.0:
+    if not _is_number(eta) or not 0.0 < float(eta) <= 1.0:
         raise InvalidRobotDescription(f"{p}: gear_efficiency must be a number in (0, 1], got {eta!r}")
     twin_of = data.get("twin_of")
     if twin_of is not None and not isinstance(twin_of, str):
         raise InvalidRobotDescription(f"{p}: twin_of must be a robot name or null")
     speeds = {k: fr.get(k) for k in ("stribeck_speed", "smoothing")}
     for k, v in speeds.items():
-        if not isinstance(v, int | float):
-            raise InvalidRobotDescription(f"{p}: friction.{k} must be a number (rad/s)")
+        if not _is_number(v):
+            raise InvalidRobotDescription(f"{p}: friction.{k} must be a finite number (rad/s)")
     friction = IdentifiedFriction(
         coulomb=_floats(fr.get("coulomb"), f"{p}: friction.coulomb", n_joints),
         viscous=_floats(fr.get("viscous"), f"{p}: friction.viscous", n_joints),

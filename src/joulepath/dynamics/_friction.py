@@ -18,6 +18,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from joulepath._io import load_toml
 from joulepath._typing import FloatArray
 from joulepath.errors import InvalidInput
 
@@ -204,17 +205,8 @@ def read_friction_file(path: str | os.PathLike[str], n_joints: int) -> CoulombVi
     InvalidInput
         Unreadable file, unknown key, not one non-negative finite value per joint.
     """
-    import tomllib
-
     p = Path(path)
-    try:
-        if p.stat().st_size > MAX_FRICTION_BYTES:
-            raise InvalidInput(f"{p}: is larger than {MAX_FRICTION_BYTES >> 10} KiB; is it a friction file?")
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise InvalidInput(f"{p}: cannot be read ({err.strerror})") from err
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
-        raise InvalidInput(f"{p}: not a TOML friction file ({err})") from err
+    data = load_toml(p, max_bytes=MAX_FRICTION_BYTES, what="a TOML friction file")
     unknown = sorted(set(data) - _FRICTION_KEYS)
     if unknown:
         raise InvalidInput(f"{p}: unknown key {unknown[0]!r}; a friction file holds {sorted(_FRICTION_KEYS)}")

@@ -51,7 +51,6 @@ obstacles.
 
 from __future__ import annotations
 
-import tomllib
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -61,7 +60,9 @@ import defusedxml
 import defusedxml.ElementTree as DET
 import numpy as np
 
+from joulepath._io import finite_number, load_toml, read_capped
 from joulepath._typing import FloatArray
+from joulepath._work import check_work
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.kinematics import link_frames
@@ -74,6 +75,9 @@ MAX_MESH_TRIANGLES = 1_000_000
 """Most triangles in one mesh."""
 MAX_URDF_BYTES = 16 << 20
 """Largest URDF cell read (16 MiB); meshes live in other files."""
+MAX_CELL_FILE_BYTES = 4 << 20
+"""Largest TOML cell file read."""
+_FEWER_TRIANGLES = "simplify the meshes (a cell needs coarse hulls: a few thousand triangles each)"
 _MESH_SUFFIXES = (".stl", ".obj")
 _IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 Rotation = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
@@ -114,20 +118,25 @@ class Cell:
         return tuple(dict.fromkeys(ob.file for ob in self.obstacles if ob.file))
 
 
+MAX_CELL_MM = 1e6
+"""Largest coordinate or size in a cell file, mm (a kilometre: anything beyond is a typo)."""
+
+
+def _is_number(value: object, bound: float = MAX_CELL_MM) -> bool:
+    """A TOML number (never ``true``/``false``), finite and within ``±bound``."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and abs(value) <= bound
+
+
 def _vec(value: object, where: str, n: int = 3) -> tuple[float, float, float]:
-    if (
-        not isinstance(value, list)
-        or len(value) != n
-        or not all(isinstance(v, int | float) and np.isfinite(v) for v in value)
-    ):
-        raise InvalidInput(f"{where}: needs a list of {n} numbers (mm)")
+    if not isinstance(value, list) or len(value) != n or not all(_is_number(v) for v in value):
+        raise InvalidInput(f"{where}: needs a list of {n} numbers (mm, within ±{MAX_CELL_MM:g})")
     return (float(value[0]) / 1000, float(value[1]) / 1000, float(value[2]) / 1000)
 
 
 def _positive(value: object, where: str) -> float:
-    if not isinstance(value, int | float) or not (np.isfinite(value) and value > 0):
-        raise InvalidInput(f"{where}: needs a positive number of mm")
-    return float(value) / 1000
+    if not _is_number(value) or not value > 0:  # type: ignore[operator]
+        raise InvalidInput(f"{where}: needs a positive number of mm (at most {MAX_CELL_MM:g})")
+    return float(value) / 1000  # type: ignore[arg-type]
 
 
 def rpy_matrix(rpy: tuple[float, float, float] | FloatArray) -> FloatArray:
@@ -149,12 +158,8 @@ def _rotation(matrix: FloatArray) -> Rotation:
 
 
 def _scale(value: object, where: str) -> tuple[float, float, float]:
-    values = [value] * 3 if isinstance(value, int | float) else value
-    if (
-        not isinstance(values, list)
-        or len(values) != 3
-        or not all(isinstance(v, int | float) and np.isfinite(v) and v > 0 for v in values)
-    ):
+    values: list[Any] = [value] * 3 if not isinstance(value, list) else value
+    if len(values) != 3 or not all(_is_number(v, 1e6) and v > 0 for v in values):
         raise InvalidInput(f"{where}: scale must be a positive number or a list of 3 positive numbers")
     return (float(values[0]), float(values[1]), float(values[2]))
 
@@ -177,8 +182,8 @@ def load_mesh(path: Path, scale: tuple[float, float, float], where: str) -> Any:
         raise InvalidInput(f"{where}: mesh {path} is not a regular file")
     try:
         n_bytes = path.stat().st_size
-        with path.open("rb"):
-            pass
+        with path.open("rb") as fh:
+            head = fh.read(84)
     except OSError as err:
         raise InvalidInput(f"{where}: mesh {path} cannot be read ({err.strerror})") from err
     if n_bytes == 0:
@@ -188,6 +193,9 @@ def load_mesh(path: Path, scale: tuple[float, float, float], where: str) -> Any:
             f"{where}: mesh {path} has {n_bytes / 2**20:.1f} MiB, over {MAX_MESH_BYTES / 2**20:g} MiB; "
             "simplify it (a cell needs a coarse hull)"
         )
+    n_binary = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
+    if path.suffix.lower() == ".stl" and n_bytes == 84 + 50 * n_binary:  # a binary STL: counted unread
+        check_work("triangles", n_binary, f"{where}: mesh {path}", _FEWER_TRIANGLES)
     coal = _coal()
     try:
         model = coal.MeshLoader().load(str(path), np.asarray(scale, dtype=float))
@@ -196,6 +204,7 @@ def load_mesh(path: Path, scale: tuple[float, float, float], where: str) -> Any:
     n_tris = int(model.num_tris)
     if n_tris == 0:
         raise InvalidInput(f"{where}: mesh {path} has no triangles")
+    check_work("triangles", n_tris, f"{where}: mesh {path}", _FEWER_TRIANGLES)
     if n_tris > MAX_MESH_TRIANGLES:
         raise InvalidInput(
             f"{where}: mesh {path} has {n_tris} triangles, over {MAX_MESH_TRIANGLES}; simplify it"
@@ -222,11 +231,7 @@ def _toml_obstacle(kind: str, item: dict[str, Any], where: str, base: Path) -> O
     rotation = _IDENTITY
     if "rpy_deg" in item:
         rpy = item["rpy_deg"]
-        if (
-            not isinstance(rpy, list)
-            or len(rpy) != 3
-            or not all(isinstance(v, int | float) and np.isfinite(v) for v in rpy)
-        ):
+        if not isinstance(rpy, list) or len(rpy) != 3 or not all(_is_number(v) for v in rpy):
             raise InvalidInput(f"{where} rpy_deg: needs a list of 3 numbers (degrees)")
         rotation = _rotation(rpy_matrix(np.radians(rpy)))
     if kind == "box":
@@ -258,12 +263,7 @@ def read_cell(path: str | Path) -> Cell:
     p = Path(path)
     if p.suffix.lower() == ".urdf":
         return read_urdf_cell(p)
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as err:
-        raise InvalidInput(f"{p}: cannot be read ({err}); give a TOML cell file") from err
-    except tomllib.TOMLDecodeError as err:
-        raise InvalidInput(f"{p}: not valid TOML ({err})") from err
+    data = load_toml(p, max_bytes=MAX_CELL_FILE_BYTES, what="a TOML cell file")
     allowed = {"margin_mm", "robot", *_KINDS}
     unknown = set(data) - allowed
     if unknown:
@@ -271,9 +271,9 @@ def read_cell(path: str | Path) -> Cell:
             f"{p}: unknown key(s) {sorted(unknown)}; use margin_mm, [robot], "
             + ", ".join(f"[[{k}]]" for k in _KINDS)
         )
-    margin = data.get("margin_mm", DEFAULT_MARGIN_MM)
-    if not isinstance(margin, int | float) or not 0 <= margin <= 1000:
-        raise InvalidInput(f"{p}: margin_mm must be a number of mm in [0, 1000]")
+    margin = finite_number(
+        data.get("margin_mm", DEFAULT_MARGIN_MM), f"{p}: margin_mm", lo=0, hi=1000, unit="mm"
+    )
     radii = {"arm_radius_mm": 0.055, "wrist_radius_mm": 0.04, "tool_radius_mm": 0.025}
     robot = data.get("robot", {})
     if not isinstance(robot, dict) or set(robot) - set(radii):
@@ -285,6 +285,12 @@ def read_cell(path: str | Path) -> Cell:
         items = data.get(kind, [])
         if not isinstance(items, list):
             raise InvalidInput(f"{p}: {kind} must be an array of tables ([[{kind}]])")
+        check_work(
+            "obstacles",
+            len(obstacles) + len(items),
+            str(p),
+            "merge neighbouring obstacles into one box, or cover the area with one coarse mesh",
+        )
         for k, item in enumerate(items, start=1):
             where = f"{p}: {kind} {k}"
             if not isinstance(item, dict) or not required <= set(item) <= required | optional:
@@ -293,6 +299,12 @@ def read_cell(path: str | Path) -> Cell:
             obstacles.append(_toml_obstacle(kind, item, where, p.parent))
     if not obstacles:
         raise InvalidInput(f"{p}: no obstacle; add " + ", ".join(f"[[{k}]]" for k in _KINDS) + " tables")
+    check_work(
+        "triangles",
+        sum(int(o.mesh.num_tris) for o in obstacles if o.mesh is not None),
+        str(p),
+        _FEWER_TRIANGLES,
+    )
     return Cell(
         tuple(obstacles),
         float(margin) / 1000,
@@ -381,12 +393,7 @@ def read_urdf_cell(path: str | Path) -> Cell:
     The root link's frame is the robot's base frame; the margin is ``DEFAULT_MARGIN_MM``.
     """
     p = Path(path)
-    try:
-        if p.stat().st_size > MAX_URDF_BYTES:
-            raise InvalidInput(f"{p}: over {MAX_URDF_BYTES >> 20} MiB; a cell URDF is small")
-        data = p.read_bytes()
-    except OSError as err:
-        raise InvalidInput(f"{p}: cannot be read ({err.strerror}); give a URDF or TOML cell file") from err
+    data = read_capped(p, max_bytes=MAX_URDF_BYTES, what="a URDF or TOML cell file")
     try:
         root = DET.fromstring(data, forbid_dtd=True)
     except defusedxml.DefusedXmlException as err:
@@ -441,6 +448,12 @@ def read_urdf_cell(path: str | Path) -> Cell:
         lost = next(name for name in links if name not in pose)
         raise InvalidInput(f"{p}: link {lost!r} is not connected to the root {roots[0]!r}")
     obstacles: list[Obstacle] = []
+    check_work(
+        "obstacles",
+        sum(len(el.findall("collision")) for el in links.values()),
+        str(p),
+        "merge neighbouring collision shapes into one box, or cover the area with one coarse mesh",
+    )
     for name, el in links.items():
         cols = el.findall("collision")
         for n, collision in enumerate(cols, start=1):
@@ -450,6 +463,12 @@ def read_urdf_cell(path: str | Path) -> Cell:
             obstacles.append(_urdf_geometry(collision, label, T, at, p.parent))
     if not obstacles:
         raise InvalidInput(f"{p}: no <collision> geometry in any link; a cell needs obstacles")
+    check_work(
+        "triangles",
+        sum(int(o.mesh.num_tris) for o in obstacles if o.mesh is not None),
+        str(p),
+        _FEWER_TRIANGLES,
+    )
     return Cell(tuple(obstacles), DEFAULT_MARGIN_MM / 1000, source=str(p))
 
 

@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from joulepath._typing import FloatArray
+from joulepath._work import check_work
 from joulepath.dynamics import NOMINAL_FRICTION, Robot
 from joulepath.energy import DEFAULT_MEASURE, MEASURES, energy_measure, measure_energy, measure_power
 from joulepath.errors import InvalidInput, LimitViolation
@@ -53,13 +54,14 @@ from joulepath.optimize._gradient import SplineProblem, optimize_spline, solve_m
 from joulepath.optimize._retime import retime_on_path, shortest_on_path
 from joulepath.optimize._verify import shortest_feasible_duration, tcp_deviation_mm
 from joulepath.program._cell import Cell, clearance
-from joulepath.program._resolve import CycleSpec, Step
+from joulepath.program._resolve import CycleSpec, Step, check_moves_arm
 from joulepath.sim import ControllerConfig, Plant, make_plant
 from joulepath.sim._timing import (
     FINE_DT,
     PlannedCycle,
     PlannedMove,
     _tcp,
+    check_motion_time,
     evaluate_cycle,
     plan_cycle,
 )
@@ -395,6 +397,7 @@ class CycleOptimizer:
         self.timed_out = False
         self.plan: PlannedCycle = plan_cycle(spec, settings.controller)
         self.gradient = replace(settings.gradient, energy_every=settings.energy_every)
+        check_motion_time(self.plan, spec.source, optimized=True)
         self._plants: dict[int, Plant] = {}
         self._default_motion: CycleMotion | None = None
         self._default_energies: dict[int, tuple[float, float, float]] | None = None
@@ -1497,11 +1500,18 @@ def optimize_cycle(
     Never refused at the taught cycle time: each unit's taught motion is a candidate, so
     in the worst case the taught cycle itself is returned, 0 % saved.
     """
+    check_moves_arm(spec)
     t_start = time.perf_counter()
     deadline = None if settings.max_time_s is None else t_start + settings.max_time_s
     opt = CycleOptimizer(spec, settings, progress=progress, deadline=deadline)
     plan = opt.plan
     target = plan.cycle_time if settings.cycle_time is None else settings.cycle_time
+    check_work(  # the time the moves may take at this cycle time, before any of them is solved
+        "motion_s",
+        target - opt.waits_kept(settings.use_waits),
+        f"{spec.source}: at a cycle time of {target:g} s",
+        "give a shorter cycle time, or declare fewer waits idle for --use-waits",
+    )
     shortest = opt.shortest_cycle + opt.waits_kept(settings.use_waits)
     if target < shortest - 1e-9:
         raise LimitViolation(

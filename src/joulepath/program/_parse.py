@@ -35,11 +35,13 @@ Reading never executes anything.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from joulepath._io import read_capped
 from joulepath.program._model import (
     Branch,
     Call,
@@ -99,6 +101,10 @@ MAX_RUNS = 10_000
 """Most runs of one FOR loop with moves inside that are unrolled."""
 MAX_UNROLLED = 100_000
 """Most runs of all such FOR loops of a module together (nested runs count each)."""
+MAX_NESTING = 32
+"""Deepest nesting of blocks (IF, FOR, TEST, WHILE), calls and aggregate or expression brackets."""
+MAX_MODULE_BYTES = 8 << 20
+"""Largest RAPID module read (a controller's program memory holds a few MB)."""
 _FOR = re.compile(
     r"FOR\s+([A-Za-z]\w*)\s+FROM\s+(.+?)\s+TO\s+(.+?)(?:\s+STEP\s+(.+?))?\s+DO", re.IGNORECASE | re.DOTALL
 )
@@ -170,10 +176,28 @@ def _opens_block_line(text: str) -> bool:
     return head == "CASE" and up.endswith(":")
 
 
+def _statement_text(buf: list[str], first: int) -> str:
+    """Enough of the statement in ``buf`` (content from ``first``) for :func:`_opens_block_line`.
+
+    Its first words and its last characters, so the test at each line end costs the
+    same however long the statement already is (the splitter stays linear in the text).
+    """
+    if len(buf) - first <= 512:
+        return "".join(buf[first:]).strip()
+    last = len(buf)
+    while last > first and buf[last - 1].isspace():
+        last -= 1
+    return "".join(buf[first : first + 256]) + " " + "".join(buf[max(first, last - 16) : last])
+
+
 def split_units(path: str, text: str) -> list[Unit]:
-    """Statements of a RAPID source: comments removed, strings kept, line numbers kept."""
+    """Statements of a RAPID source: comments removed, strings kept, line numbers kept.
+
+    One pass, linear in the text (a statement of a megabyte costs what its characters cost).
+    """
     units: list[Unit] = []
     buf: list[str] = []
+    first: int | None = None  # index in buf of the statement's first non-space character
     start = 0
     line = 1
     depth = 0
@@ -199,20 +223,18 @@ def split_units(path: str, text: str) -> list[Unit]:
                 i += 1
             continue
         if ch == "\n":
-            current = "".join(buf).strip()
-            if current and depth == 0 and _opens_block_line(current):
-                units.append(Unit(start, line, current))
-                buf = []
+            if first is not None and depth == 0 and _opens_block_line(_statement_text(buf, first)):
+                units.append(Unit(start, line, "".join(buf[first:]).strip()))
+                buf, first = [], None
             line += 1
             i += 1
-            if buf and not "".join(buf).strip():
+            if first is None:
                 buf = []
-            if not buf:
                 start = line
-            else:
+            elif not buf[-1].isspace():
                 buf.append(" ")
             continue
-        if not "".join(buf).strip():
+        if first is None:
             start = line
         if ch == '"':
             in_string = True
@@ -225,11 +247,13 @@ def split_units(path: str, text: str) -> list[Unit]:
         elif ch == ";" and depth == 0:
             buf.append(ch)
             units.append(Unit(start, line, "".join(buf).strip()))
-            buf = []
+            buf, first = [], None
             i += 1
             continue
         elif ch == ";":
             raise RapidError(f"{path}:{line}: ';' inside brackets; close the brackets before the ';'")
+        if first is None and not ch.isspace():
+            first = len(buf)
         buf.append(ch)
         i += 1
     rest = "".join(buf).strip()
@@ -254,12 +278,14 @@ def _aggregate(path: str, line: int, text: str) -> object:
         while pos < len(text) and text[pos].isspace():
             pos += 1
 
-    def value() -> object:
+    def value(depth: int = 0) -> object:
         nonlocal pos
         skip()
         if pos >= len(text):
             raise fail("a value is missing")
         if text[pos] == "[":
+            if depth >= MAX_NESTING:
+                raise fail(f"brackets nested more than {MAX_NESTING} deep")
             pos += 1
             items: list[object] = []
             skip()
@@ -267,7 +293,7 @@ def _aggregate(path: str, line: int, text: str) -> object:
                 pos += 1
                 return items
             while True:
-                items.append(value())
+                items.append(value(depth + 1))
                 skip()
                 if pos < len(text) and text[pos] == ",":
                     pos += 1
@@ -293,7 +319,10 @@ def _aggregate(path: str, line: int, text: str) -> object:
         m = _NUMBER.match(text, pos)
         if m:
             pos = m.end()
-            return float(m.group())
+            number = float(m.group())
+            if not math.isfinite(number):
+                raise fail(f"{m.group()[:20]} is not a finite number (RAPID holds at most 3.4E38)")
+            return number
         for word, v in (("TRUE", True), ("FALSE", False)):
             if text[pos : pos + len(word)].upper() == word:
                 pos += len(word)
@@ -662,6 +691,8 @@ def _array_element(path: str, line: int, text: str, names: Names) -> tuple[str, 
 def _number(path: str, line: int, text: str, names: Names, what: str) -> float:
     text = text.strip()
     if _NUMBER.fullmatch(text):
+        if not math.isfinite(float(text)):
+            raise RapidError(f"{path}:{line}: {what} {text[:20]} is not a finite number (at most 3.4E38)")
         return float(text)
     if _IDENT.match(text) and text.lower() in names.loop:
         return float(names.loop[text.lower()])
@@ -714,7 +745,8 @@ def _evaluate(
     k = 0
 
     def fail(msg: str) -> RapidError:
-        return RapidError(f"{path}:{line}: {what} {text.strip()!r}: {msg}")
+        shown = text.strip() if len(text.strip()) <= 60 else text.strip()[:57] + "..."
+        return RapidError(f"{path}:{line}: {what} {shown!r}: {msg}")
 
     def peek() -> str:
         return tokens[k][1].upper() if k < len(tokens) else ""
@@ -759,7 +791,19 @@ def _evaluate(
             "declare it CONST"
         )
 
+    level = 0
+
     def primary() -> float | bool:
+        nonlocal level
+        level += 1
+        try:
+            return unary()
+        finally:
+            level -= 1
+
+    def unary() -> float | bool:
+        if level > MAX_NESTING:
+            raise fail(f"brackets or signs nested more than {MAX_NESTING} deep")
         kind, tok = take()
         if kind == "num":
             return float(tok)
@@ -791,6 +835,10 @@ def _evaluate(
             op = take()[1].upper()
             r = num(primary())
             a = num(v)
+            if not (math.isfinite(a) and math.isfinite(r)):
+                raise fail("a value is not a finite number; write numbers RAPID can hold (at most 3.4E38)")
+            if op in ("DIV", "MOD") and (a != round(a) or r != round(r)):
+                raise fail(f"{op} needs whole numbers, got {a:g} {op} {r:g}")
             if op != "*" and r == 0:
                 raise fail("division by zero")
             v = (
@@ -851,6 +899,8 @@ def _evaluate(
     out = disjunction()
     if k != len(tokens):
         raise fail(f"unexpected {tokens[k][1]!r}")
+    if not isinstance(out, bool) and not math.isfinite(out):
+        raise fail("its value is not a finite number; write numbers RAPID can hold (at most 3.4E38)")
     return out
 
 
@@ -1082,6 +1132,7 @@ class _Reader:
     unrolled: int = 0
     expanded: int = 0
     stack: tuple[str, ...] = ()
+    level: int = 0  # how deep the statement being read is nested in blocks and calls
 
     def peek(self) -> Unit | None:
         return self.units[self.pos] if self.pos < len(self.units) else None
@@ -1099,6 +1150,13 @@ class _Reader:
         return bool(head.lower() in _MOVES_LOWER or OTHER_MOTION.match(head) or head.lower() in self.procs)
 
     def block(self, close: str, opener: Unit, *, inside: str) -> tuple[list[Statement], Unit]:
+        self.level += 1
+        try:
+            return self._block(close, opener, inside=inside)
+        finally:
+            self.level -= 1
+
+    def _block(self, close: str, opener: Unit, *, inside: str) -> tuple[list[Statement], Unit]:
         body: list[Statement] = []
         while True:
             u = self.peek()
@@ -1327,8 +1385,12 @@ class _Reader:
             if head != "IF" and (head != "ELSE" or up == "TEST"):
                 where += f" (line {part.line})"
             self.pos = first
-            while self.pos < last:
-                body.append(self.statement(f"{up} (line {u.line})"))
+            self.level += 1
+            try:
+                while self.pos < last:
+                    body.append(self.statement(f"{up} (line {u.line})"))
+            finally:
+                self.level -= 1
         self.pos = parts[-1][2] + 1
         note = f"line {u.line}: {', '.join(said)} -> {where}"
         return Branch(u.line, end.end_line, note, tuple(body))
@@ -1391,6 +1453,7 @@ class _Reader:
             self.unrolled,
             self.expanded,
             (*self.stack, head.lower()),
+            self.level,
         )
         body, _ = sub.block("ENDPROC", routine.unit, inside=f"PROC {name}")
         self.unrolled, self.expanded = sub.unrolled, sub.expanded
@@ -1398,6 +1461,12 @@ class _Reader:
 
     def statement(self, inside: str) -> Statement:
         u = self.take()
+        if self.level > MAX_NESTING:
+            raise self.fail(
+                u.line,
+                f"blocks and calls nest more than {MAX_NESTING} deep here; "
+                "flatten the nested blocks, or call the procedures one after another",
+            )
         head = u.head
         up = head.upper()
         if up == "FOR" and u.text.rstrip().upper().endswith("DO") and self.has_motion():
@@ -1647,42 +1716,85 @@ def _statements(body: tuple[Statement, ...]) -> Iterator[Statement]:
             yield from _statements(s.body)
 
 
+def _call_sites(body: tuple[Statement, ...]) -> tuple[list[tuple[Call, int]], int]:
+    """The calls of procedures read as they are (no arguments) in ``body``, each with how deep
+    in blocks it stands, and the deepest block level of ``body``; an explicit stack, no recursion."""
+    sites: list[tuple[Call, int]] = []
+    deepest = 0
+    todo: list[tuple[tuple[Statement, ...], int]] = [(body, 0)]
+    while todo:
+        stmts, level = todo.pop()
+        deepest = max(deepest, level)
+        for s in stmts:
+            if isinstance(s, Call) and s.body is None:
+                sites.append((s, level))
+            elif isinstance(s, WhileTrue | Branch):
+                todo.append((s.body, level + 1))
+            elif isinstance(s, ForLoop):
+                todo.extend((run, level + 1) for run in s.runs)
+            elif isinstance(s, Call) and s.body is not None:
+                todo.append((s.body, level + 1))
+    sites.sort(key=lambda site: site[0].line)
+    return sites, deepest
+
+
 def _check_calls(module: Module) -> None:
-    """No recursion; at most one WHILE TRUE in main."""
+    """No recursion; calls and blocks nested at most :data:`MAX_NESTING` deep; one WHILE TRUE in main.
+
+    A depth-first walk of the call graph with an explicit stack: each procedure is
+    visited once, so the check is linear in the program (30 procedures that each call
+    the next twice cost 30 visits, not 2**30), and no chain of calls, however long,
+    reaches Python's recursion limit.
+    """
     main = module.procedure("main")
     assert main is not None
     loops = [s for s in main.body if isinstance(s, WhileTrue)]
     if len(loops) > 1:
         raise module.error(loops[1].line, "a second WHILE TRUE in main; the cycle is one loop")
-    done: set[str] = set()
-
-    def visit(body: tuple[Statement, ...], stack: tuple[str, ...]) -> None:
-        calls: dict[str, Call] = {}  # each callee once (a FOR loop repeats its calls)
-        for s in _statements(body):
-            if isinstance(s, Call) and s.body is None:
-                calls.setdefault(s.name.lower(), s)
-        for s in calls.values():
-            if s.name.lower() in stack:
+    depth: dict[str, int] = {}  # a finished procedure: how deep blocks and calls nest below its start
+    sites_of: dict[str, tuple[list[tuple[Call, int]], int]] = {"main": _call_sites(main.body)}
+    path: list[tuple[str, int]] = [("main", 0)]  # the procedures being walked, each with its next site
+    while path:
+        name, k = path[-1]
+        sites, deepest = sites_of[name]
+        if k == len(sites):
+            path.pop()
+            depth[name] = max([deepest, *(lv + 1 + depth[c.name.lower()] for c, lv in sites)])
+            if depth[name] > MAX_NESTING:
+                proc = module.procedure(name)
+                assert proc is not None
                 raise module.error(
-                    s.line, f"{s.name} calls itself (through {' -> '.join(stack)}); not supported"
+                    proc.line,
+                    f"blocks and calls nest {depth[name]} deep below {proc.name} (at most {MAX_NESTING}); "
+                    "call the procedures one after another instead of each from the previous",
                 )
-            if s.name.lower() in done:
-                continue
-            callee = module.procedure(s.name)
-            assert callee is not None
-            visit(callee.body, (*stack, callee.name.lower()))
-            done.add(s.name.lower())
-
-    visit(main.body, ("main",))
+            continue
+        path[-1] = (name, k + 1)
+        call, _ = sites[k]
+        key = call.name.lower()
+        if key in depth:
+            continue
+        on_path = [n for n, _ in path]
+        if key in on_path:
+            raise module.error(
+                call.line, f"{call.name} calls itself (through {' -> '.join(on_path)}); not supported"
+            )
+        if len(path) > MAX_NESTING:
+            raise module.error(
+                call.line,
+                f"calls nest more than {MAX_NESTING} deep ({' -> '.join(on_path[:3])} -> ... -> "
+                f"{call.name}); call the procedures one after another instead of each from the previous",
+            )
+        callee = module.procedure(call.name)
+        assert callee is not None
+        sites_of[key] = _call_sites(callee.body)
+        path.append((key, 0))
 
 
 def read_module(path: str | Path) -> Module:
     """Read a RAPID module file (UTF-8 or Latin-1)."""
     p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except OSError as err:
-        raise RapidError(f"{p}: cannot be read ({err.strerror}); give a RAPID .mod file") from err
+    raw = read_capped(p, max_bytes=MAX_MODULE_BYTES, what="a RAPID .mod file", error=RapidError)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:

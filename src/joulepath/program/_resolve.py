@@ -12,14 +12,15 @@ are taken into account (targets are TCP poses, the load is carried in the dynami
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Collection
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from joulepath._io import finite_number, load_toml
 from joulepath._typing import FloatArray
+from joulepath._work import check_work
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
 from joulepath.kinematics import quaternion_to_rotation
@@ -79,6 +80,10 @@ def target_pose(target: RobTarget) -> FloatArray:
     return out
 
 
+RAPID_AXES = 6
+"""Robot axes of a RAPID ``jointtarget`` (``robax``): RAPID programs drive six-axis arms."""
+MAX_CYCLE_FILE_BYTES = 4 << 20
+"""Largest plain cycle file (TOML) read."""
 MAX_STEPS = 200_000
 """Most statements a program's run may unroll into (calls and FOR loops followed)."""
 
@@ -170,6 +175,12 @@ def resolve_module(module: Module, robot: Robot, *, idle_waits: Collection[int] 
     when it is marked ``! joulepath: idle`` or its line is in ``idle_waits``; every run
     of it is (a procedure called twice, a FOR loop).
     """
+    if robot.n_joints != RAPID_AXES:
+        raise RapidError(
+            f"{module.path}: a RAPID module drives a {RAPID_AXES}-axis ABB arm (its jointtargets hold "
+            f"{RAPID_AXES} robot axes), but this robot has {robot.n_joints} joints; give a "
+            f"{RAPID_AXES}-joint robot, or write the cycle as a plain cycle file (.toml)"
+        )
     main = module.procedure("main")
     assert main is not None
     loop = next((s for s in main.body if isinstance(s, WhileTrue)), None)
@@ -183,6 +194,12 @@ def resolve_module(module: Module, robot: Robot, *, idle_waits: Collection[int] 
         )
     notes: list[str] = []
     flat = _flatten(module, body, notes)
+    check_work(
+        "moves",
+        sum(isinstance(s, Move) for s in flat),
+        f"{module.path}:{main.line}",
+        "the cycle (calls and FOR loops unrolled) has that many moves; split it into shorter programs",
+    )
     wait_lines = {s.line for s in flat if isinstance(s, WaitTime)}
     for line in sorted(set(idle_waits)):
         if line not in wait_lines:
@@ -409,18 +426,19 @@ def read_cycle_toml(path: str | Path, robot: Robot) -> CycleSpec:
     controller's jerk-limited profile stretched to ``duration_s``.
     """
     p = Path(path)
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as err:
-        raise InvalidInput(f"{p}: cannot be read ({err}); give a TOML cycle file") from err
-    except tomllib.TOMLDecodeError as err:
-        raise InvalidInput(f"{p}: not valid TOML ({err})") from err
+    data = load_toml(p, max_bytes=MAX_CYCLE_FILE_BYTES, what="a TOML cycle file")
     unknown = set(data) - {"start_deg", "step"}
     if unknown:
         raise InvalidInput(f"{p}: unknown key(s) {sorted(unknown)}; use start_deg and [[step]]")
     raw = data.get("step")
     if not isinstance(raw, list) or not raw:
         raise InvalidInput(f"{p}: no [[step]] tables; add moves (joints_deg, duration_s) and waits (wait_s)")
+    check_work(
+        "moves",
+        sum(isinstance(st, dict) and "joints_deg" in st for st in raw),
+        str(p),
+        "split the cycle into shorter files",
+    )
     n = robot.n_joints
     lo, hi = robot.joint_ranges()
     steps: list[Step] = []
@@ -429,19 +447,17 @@ def read_cycle_toml(path: str | Path, robot: Robot) -> CycleSpec:
         if not isinstance(st, dict):
             raise InvalidInput(f"{where}: must be a table")
         if set(st) == {"wait_s"}:
-            w = st["wait_s"]
-            if not isinstance(w, int | float) or not 0 <= w <= 3600:
-                raise InvalidInput(f"{where}: wait_s must be a number of seconds in [0, 3600]")
-            steps.append(Step("wait", k, f"wait {w:g}", None, seconds=float(w)))
+            w = finite_number(st["wait_s"], f"{where}: wait_s", lo=0.0, hi=3600.0, unit="seconds")
+            steps.append(Step("wait", k, f"wait {w:g}", None, seconds=w))
             continue
         if set(st) != {"joints_deg", "duration_s"}:
             raise InvalidInput(
                 f"{where}: a step is either wait_s or joints_deg + duration_s, got {sorted(st)}"
             )
         q = _joints(st["joints_deg"], n, where)
-        T = st["duration_s"]
-        if not isinstance(T, int | float) or not 0 < T <= 60:
-            raise InvalidInput(f"{where}: duration_s must be a number of seconds in (0, 60]")
+        T = finite_number(st["duration_s"], f"{where}: duration_s", lo=0.0, hi=60.0, unit="seconds")
+        if T == 0:
+            raise InvalidInput(f"{where}: duration_s must be a number of seconds in (0, 60], got 0")
         bad = np.nonzero((q < lo - 1e-9) | (q > hi + 1e-9))[0]
         if bad.size:
             j = int(bad[0])
@@ -472,14 +488,36 @@ def _joints(value: object, n: int, where: str) -> FloatArray:
     if (
         not isinstance(value, list)
         or len(value) != n
-        or not all(isinstance(v, int | float) and np.isfinite(v) for v in value)
+        or not all(isinstance(v, int | float) and not isinstance(v, bool) and abs(v) <= 1e6 for v in value)
     ):
-        raise InvalidInput(f"{where}: needs a list of {n} joint values in degrees")
+        raise InvalidInput(f"{where}: needs a list of {n} joint values in degrees (numbers, not true/false)")
     out: FloatArray = np.radians(np.asarray(value, dtype=float))
     return out
 
 
 __all__ = ["CycleSpec", "RapidError", "Step", "read_cycle_toml", "resolve_module"]
+
+
+def check_moves_arm(spec: CycleSpec) -> None:
+    """Refuse a cycle in which no move goes anywhere: every target is where the arm already is.
+
+    A zero-length move among others is fine (it takes no time and no energy).
+
+    Raises
+    ------
+    InvalidInput
+        Every move of ``spec`` ends where the arm is when it starts.
+    """
+    q = spec.start
+    for step in spec.steps:
+        if step.kind == "move" and step.q is not None:
+            if np.abs(step.q - q).max() > 1e-9:
+                return
+            q = step.q
+    raise InvalidInput(
+        f"{spec.source}: the cycle does not move the arm (every move goes where the arm already is); "
+        "nothing to optimize: give targets that differ"
+    )
 
 
 def read_cycle_program(

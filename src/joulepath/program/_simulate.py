@@ -29,7 +29,7 @@ from joulepath.errors import InvalidInput
 from joulepath.program._parse import read_module
 from joulepath.program._resolve import CycleSpec, resolve_module
 from joulepath.sim import ControllerConfig, log_text, log_times, make_plant, run_plant
-from joulepath.sim._timing import PlannedCycle, evaluate_cycle, plan_cycle
+from joulepath.sim._timing import PlannedCycle, check_motion_time, evaluate_cycle, plan_cycle
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -145,6 +145,7 @@ def simulate_program(
     q0 = None if start is None else _check_start(r, start)
     spec = resolve_module(read_module(Path(program)), r)
     motion = program_motion(spec, config, start=q0)
+    check_motion_time(motion.plan, spec.source)
     the_plant = make_plant(plant, r, instance_seed=instance_seed)
     rng = np.random.default_rng(seed)
     t = log_times(motion.end_time + config.idle, config, rng=rng)

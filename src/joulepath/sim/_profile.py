@@ -48,8 +48,15 @@ def plan_profile(v_max: float, a_max: float, j_max: float = np.inf) -> Profile:
 
 
 def evaluate_profile(p: Profile, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """``s, ds/dt, d²s/dt²`` at times ``tau`` (clipped to [0, T])."""
+    """``s, ds/dt, d²s/dt²`` at times ``tau`` (clipped to [0, T]).
+
+    A profile of no duration (a move to where the arm already is) is done at once:
+    ``s = 1`` and no speed or acceleration at every time.
+    """
     T = p.duration
+    if not p.ta > 0.0:
+        none = np.zeros_like(tau, dtype=float)
+        return none + 1.0, none, none.copy()
     tau = np.clip(tau, 0.0, T)
     s = np.empty_like(tau)
     sd = np.empty_like(tau)

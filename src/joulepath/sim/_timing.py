@@ -41,6 +41,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from joulepath._typing import FloatArray
+from joulepath._work import check_work
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
 from joulepath.kinematics._ik import solve_ik
@@ -246,6 +247,33 @@ class PlannedCycle:
     waits: tuple[tuple[int, float, float], ...]  # (step index, start, seconds)
     cycle_time: float
     start: FloatArray
+
+
+def check_motion_time(plan: PlannedCycle, source: str, *, optimized: bool = False) -> None:
+    """Refuse a cycle whose moves take longer than the work limits allow, before any work.
+
+    Tiny speeds (``\\V:=0.0001``, a speeddata of 1e-9 mm/s) or a long ``\\T`` imply hours
+    of motion, and arrays of every sample of it: the ``motion_s`` limit bounds the moves
+    of the cycle together. ``optimized``: the moves are to be optimized, each in dense
+    solves over spline coefficients as many as its duration holds knots (a 6 s move
+    took about twice as long as a 3 s one, minutes on a busy 2-core machine), so the
+    ``move_s`` limit bounds each move too; see :mod:`joulepath._work`.
+
+    Raises
+    ------
+    InvalidInput
+        The moves of ``plan`` take longer than a limit.
+    """
+    fix = (
+        "the moves take that long at their programmed speeds and times (a tiny \\V or speeddata, a long "
+        "\\T); give them faster speeds or shorter times"
+    )
+    motion = plan.cycle_time - sum(seconds for _, _, seconds in plan.waits)
+    check_work("motion_s", motion, source, fix + ", or split the cycle")
+    if optimized and plan.moves:
+        longest = max(plan.moves, key=lambda m: m.profile.duration)
+        where = f"{source}: the move {longest.step.label!r}"
+        check_work("move_s", longest.profile.duration, where, fix + ", or split the move in two")
 
 
 def moves_of(spec: StepSequence) -> list[int]:
