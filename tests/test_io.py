@@ -11,6 +11,7 @@ import joulepath._io as io_
 from joulepath._io import (
     OutputJournal,
     atomic_write_text,
+    expect_outputs,
     make_folder,
     output_journal,
     outside_journal,
@@ -118,3 +119,15 @@ def test_make_folder_refuses_a_dangling_link(tmp_path):
     (tmp_path / "out").symlink_to(tmp_path / "nowhere")
     with pytest.raises(InvalidInput, match="which does not exist"):
         make_folder(tmp_path / "out")
+
+
+def test_files_other_processes_write_are_undone_too(tmp_path):
+    (tmp_path / "old.csv").write_text("earlier run")
+    before = _tree(tmp_path)
+    with pytest.raises(RuntimeError), output_journal():
+        expect_outputs([tmp_path / "old.csv", tmp_path / "logs" / "new.csv"])
+        (tmp_path / "logs").mkdir()  # as a worker process does, outside the journal
+        (tmp_path / "logs" / "new.csv").write_text("x")
+        (tmp_path / "old.csv").write_text("overwritten")
+        raise RuntimeError
+    assert _tree(tmp_path) == before

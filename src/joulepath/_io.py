@@ -24,7 +24,7 @@ import os
 import shutil
 import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -108,8 +108,12 @@ class OutputJournal:
         """How many paths this command has written or removed so far."""
         return len(self.changed)
 
-    def _keep(self, p: Path, *, move: bool) -> None:
-        """Record ``p`` before its first change, keeping what is there under a hidden name beside it."""
+    def _keep(self, p: Path, *, move: bool, link: bool = True) -> None:
+        """Record ``p`` before its first change, keeping what is there under a hidden name beside it.
+
+        ``move``: what is there goes aside (a removal); else it is kept as a second name
+        (``link``: a hard link, right for writers that rename a new file into place) or a copy.
+        """
         if p in self.changed:
             return
         if not os.path.lexists(p):
@@ -127,6 +131,8 @@ class OutputJournal:
             else:
                 kept.unlink()
                 try:
+                    if not link:
+                        raise OSError
                     os.link(p, kept, follow_symlinks=False)  # a second name: no copy, no disk space
                 except OSError:
                     shutil.copy2(p, kept, follow_symlinks=False)
@@ -210,6 +216,27 @@ def _remove_path(p: Path) -> None:
         shutil.rmtree(p)
     else:
         p.unlink(missing_ok=True)
+
+
+def expect_outputs(paths: Iterable[str | os.PathLike[str]]) -> None:
+    """Record, before other processes write them, the files they will write for this command.
+
+    Worker processes do not share the command's journal: what each path holds now is kept
+    (and its folders noted), so that a failure of the command undoes their writes too.
+    """
+    journal = _JOURNAL.get()
+    if journal is None:
+        return
+    for path in paths:
+        p = Path(path)
+        journal.folders(p.parent)
+        if os.path.lexists(p.parent):
+            try:
+                journal._keep(p, move=False, link=False)  # a worker may write in place
+            except OSError as err:
+                raise InvalidInput(f"{p}: cannot be written ({err.strerror or err})") from err
+        else:
+            journal.changed.setdefault(p, None)
 
 
 def make_folder(path: str | os.PathLike[str]) -> Path:

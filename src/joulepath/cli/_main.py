@@ -74,10 +74,10 @@ def _root(
 SELF_RECOVERING = frozenset({"run", "demo"})
 """Commands whose stages keep or drop their own folders (``experiment``), not undone as a whole."""
 
-_ENVIRONMENT_ERRNOS = frozenset(
-    {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EACCES, errno.EPERM}
-)
-"""OSErrors that say something about the machine (a full disk, a read-only folder), not about joulepath."""
+_FULL = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
+_DENIED = frozenset({errno.EROFS, errno.EACCES, errno.EPERM})
+"""OSErrors that say something about the machine (a full disk, a read-only folder), not about joulepath:
+one line, wherever they are raised."""
 
 
 def _command(args: Sequence[str]) -> str:
@@ -107,14 +107,17 @@ def _one_line(err: BaseException, debug: bool) -> tuple[str, int] | None:
         ctx = getattr(err, "ctx", None)
         where = ctx.command_path if ctx is not None else "joulepath"
         return f"error: {message().rstrip('.')}; see '{where} --help'", 2
-    if isinstance(err, OSError) and err.errno in _ENVIRONMENT_ERRNOS and not debug:
+    if isinstance(err, OSError) and err.errno in _FULL | _DENIED and not debug:
         where = f"{err.filename}: " if err.filename else ""
-        return f"error: {where}{err.strerror or err}; free some space or choose a place you can write to", 2
+        fix = "free some space and run it again" if err.errno in _FULL else "check its permissions"
+        return f"error: {where}{err.strerror or err}; {fix}", 2
     return None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI with ``argv`` (default: ``sys.argv[1:]``); return the exit code."""
+    from contextlib import AbstractContextManager, nullcontext
+
     from joulepath._io import OutputJournal, output_journal
 
     args = list(sys.argv[1:] if argv is None else argv)
@@ -125,9 +128,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if debug:  # accepted anywhere on the line, handled as a root option
         args = ["--debug", *(a for a in args if a != "--debug")]
     journal = None if _command(args) in SELF_RECOVERING else OutputJournal()
+    journaled: AbstractContextManager[object] = nullcontext() if journal is None else output_journal(journal)
     caught: list[warnings.WarningMessage] = []
     try:
-        with warnings.catch_warnings(record=True) as caught, output_journal(journal):
+        with warnings.catch_warnings(record=True) as caught, journaled:
             warnings.simplefilter("default")  # once per place: bounded
             try:
                 result = app(args=args, prog_name="joulepath", standalone_mode=False)
