@@ -349,3 +349,15 @@ def test_optimize_tasks_zero_runs(tiny_run, tiny_demo_toml, tmp_path):
         "q_end_deg",
     ]
     assert (run / "report.html").is_file()
+
+
+def test_a_missing_extra_is_refused_before_running(tmp_path, tiny_demo_toml, monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util, "find_spec", lambda name, *a: None if name == "casadi" else real(name, *a)
+    )
+    toml = tiny_demo_toml(tmp_path, **{"optimize.reference": "true", "optimize.fitness": '"physics"'})
+    with pytest.raises(InvalidInput, match=r"optimize\.reference needs the optional package 'casadi'"):
+        load_experiment(toml)

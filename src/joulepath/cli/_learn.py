@@ -66,7 +66,9 @@ def train(
     from joulepath.learn import FAMILIES, TrainConfig
     from joulepath.learn import train as run
 
-    check_out_folder(out)
+    check_out_folder(  # the names every training writes, before any work
+        out, files=("results.csv", "report.json", "importance_E.csv", "importance_E.png", "joints.json")
+    )
     config = TrainConfig(
         families=_split(family, "--family", FAMILIES, FAMILIES),
         targets=_split(target, "--target", target_columns(MAX_JOINTS), target_columns(MAX_JOINTS)),
@@ -135,7 +137,7 @@ def importance(
     from joulepath.data import load_table
     from joulepath.learn import feature_importance, plot_importance, rank_joints
 
-    check_out_folder(out)
+    check_out_folder(out, files=(f"importance_{target}.csv", f"importance_{target}.png"), inputs=[data])
     table = load_table(data)
     imp = feature_importance(table, target, seed=seed)
     make_folder(out)

@@ -228,7 +228,7 @@ def bench_optimizers(
     from joulepath._io import atomic_write_text, make_folder
     from joulepath.optimize import bench_optimizers as run
 
-    check_out_folder(out)
+    check_out_folder(out, files=["optimizers_single.csv", *(["optimizers_multi.csv"] if model else [])])
     if quick:
         tasks, generations, population = 10, 30, 30
     variants = (

@@ -496,6 +496,7 @@ def _check_stages(exp: Experiment, robot: Any, source: str) -> None:
     from joulepath.errors import JoulepathError
     from joulepath.export import select_exporter
 
+    _check_extras(exp, source)
     o = exp.optimize
     if o.tasks:
         try:
@@ -539,6 +540,36 @@ def _check_stages(exp: Experiment, robot: Any, source: str) -> None:
             check_cycle(spec, settings)
         except JoulepathError as err:
             raise InvalidInput(f"{source}: [cycle] {err}") from err
+
+
+_EXTRAS: tuple[tuple[str, str, str], ...] = (
+    ("synth.methods", "sdv", "synth"),
+    ("train.families", "skops", "ml"),
+    ("xgb", "xgboost", "ml"),
+    ("optimize.reference", "casadi", "reference"),
+    ("scheduler", "distributed", "dask"),
+)
+"""(setting, the module it needs, the extra that installs it), checked before the first stage."""
+
+
+def _check_extras(exp: Experiment, source: str) -> None:
+    """Refuse, before any stage runs, settings whose optional packages are not installed."""
+    import importlib.util
+
+    used = {
+        "synth.methods": bool(exp.synth.methods),
+        "train.families": bool(exp.train.families),
+        "xgb": "xgb" in exp.train.families,
+        "optimize.reference": exp.optimize.reference and exp.optimize.tasks > 0,
+        "scheduler": bool(exp.scheduler),
+    }
+    for setting, module, extra in _EXTRAS:
+        if used[setting] and importlib.util.find_spec(module) is None:
+            what = "[train] families = 'xgb'" if setting == "xgb" else setting
+            raise InvalidInput(
+                f"{source}: {what} needs the optional package {module!r}, which is not installed; "
+                f"pip install 'joulepath[{extra}]', or change the setting"
+            )
 
 
 def _check_robot(exp: Experiment, source: str) -> Any:
