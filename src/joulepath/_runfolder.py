@@ -39,6 +39,12 @@ CYCLE_JSON = "cycle.json"
 CYCLE_PARETO_PNG = "pareto.png"
 """Energy against cycle time (only when ``[cycle] pareto_points`` ≥ 3)."""
 
+RUN_FILES = ("summary.json", "report.html", "run.log")
+"""The files at the top of a run folder: the summary, the report and the log of every run."""
+
+STAGE_FOLDERS = ("data", "synth", "models", "importance", "optimize", "bench", IDENTIFY_STAGE, CYCLE_STAGE)
+"""Every stage's folder in a run folder (a stage runs in a hidden ``.NAME.partial`` sibling first)."""
+
 __all__ = [
     "CYCLE_JSON",
     "CYCLE_PARETO_PNG",
@@ -48,4 +54,6 @@ __all__ = [
     "IDENTIFY_SCORE_COLUMNS",
     "IDENTIFY_STAGE",
     "IDENTIFY_TWIN",
+    "RUN_FILES",
+    "STAGE_FOLDERS",
 ]

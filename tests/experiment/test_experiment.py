@@ -2,6 +2,7 @@
 
 import json
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -11,6 +12,7 @@ from joulepath.cli import main
 from joulepath.errors import InvalidInput
 from joulepath.experiment import load_experiment, run_experiment
 
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 STAGES = ("data", "synth", "train", "importance", "optimize", "bench")
 
 TINY = """
@@ -330,5 +332,57 @@ def test_cycle_section_is_checked_before_running(tmp_path, tiny_demo_toml):
         toml.write_text(base + "\n" + extra)
         with pytest.raises(InvalidInput, match=words):
             load_experiment(toml)
-    toml.write_text(base + '\n[cycle]\nprogram = "p.mod"\ncycle_time = 5\n')
+    # the program, the cell and the default cycle are read and checked now, not when the stage starts
+    (tmp_path / "fast.toml").write_text(
+        "start_deg = [0, 0, 0, 0, 30, 0]\n[[step]]\njoints_deg = [60, 20, 10, 0, 40, 0]\nduration_s = 0.05\n"
+    )
+    (tmp_path / "cell.toml").write_text('[[box]]\nname = "b"\ncenter_mm = [0, 0, 0]\n')
+    late = {
+        '[cycle]\nprogram = "p.mod"\n': r"\[cycle\] .*p\.mod",
+        '[cycle]\nprogram = "fast.toml"\n': r"\[cycle\] .*duration_s = 0\.05 s is shorter",
+        '[cycle]\nprogram = "good.mod"\ncell = "cell.toml"\n': r"\[cycle\] .*cell\.toml",
+    }
+    shutil.copy(EXAMPLES / "pick_and_place.mod", tmp_path / "good.mod")
+    for extra, words in late.items():
+        toml.write_text(base + "\n" + extra)
+        with pytest.raises(InvalidInput, match=words):
+            load_experiment(toml)
+    toml.write_text(base + '\n[cycle]\nprogram = "good.mod"\ncycle_time = 5\n')
     assert load_experiment(toml).cycle.cycle_time == 5.0
+
+
+def test_identify_section_needs_an_irml_robot_before_running(tmp_path, tiny_demo_toml):
+    from joulepath.description import preset_path
+
+    urdf = tmp_path / "arm.urdf"
+    shutil.copy(preset_path("irb120", fmt="urdf"), urdf)
+    toml = tiny_demo_toml(tmp_path, robot=f'"{urdf}"', **{"optimize.range_set": '"nominal"'})
+    assert "enabled = true" in toml.read_text()  # the demo identifies a twin
+    with pytest.raises(InvalidInput, match=r"\[identify\] needs a robot described in IRML"):
+        load_experiment(toml)
+
+
+def test_optimize_tasks_zero_runs(tiny_run, tiny_demo_toml, tmp_path):
+    run = tmp_path / "run"
+    shutil.copytree(tiny_run, run)
+    toml = tiny_demo_toml(tmp_path, **{"train.targets": '["E", "E1"]', "optimize.tasks": "0"})
+    summary = run_experiment(load_experiment(toml), run, say=lambda _t: None)
+    assert summary["tasks"] == 0 and summary["mean_saved_pct"] is None
+    assert list(pd.read_csv(run / "optimize" / "tasks.csv").columns)[:3] == [
+        "task",
+        "q_start_deg",
+        "q_end_deg",
+    ]
+    assert (run / "report.html").is_file()
+
+
+def test_a_missing_extra_is_refused_before_running(tmp_path, tiny_demo_toml, monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util, "find_spec", lambda name, *a: None if name == "casadi" else real(name, *a)
+    )
+    toml = tiny_demo_toml(tmp_path, **{"optimize.reference": "true", "optimize.fitness": '"physics"'})
+    with pytest.raises(InvalidInput, match=r"optimize\.reference needs the optional package 'casadi'"):
+        load_experiment(toml)

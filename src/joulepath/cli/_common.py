@@ -8,6 +8,7 @@ Output checks run before any work, so a refused ``--out`` writes nothing:
   exist, by resolved path otherwise);
 * an output folder must be a folder or not exist yet; the files a command writes in
   it are checked like output files;
+* no output, and no folder above it, may be a symbolic link to nothing (a dangling link);
 * the nearest existing folder above the output must be writable.
 """
 
@@ -51,8 +52,17 @@ def parse_joints(text: str, *, option: str, degrees: bool, n: int = 6) -> list[f
     return [math.radians(v) for v in values] if degrees else values
 
 
+def _not_dangling(path: Path, option: str) -> None:
+    if path.is_symlink() and not path.exists():
+        raise InvalidInput(
+            f"{path}: is a symbolic link to {os.readlink(path)}, which does not exist; "
+            f"remove the link or choose another {option}"
+        )
+
+
 def _no_file_above(path: Path, option: str) -> None:
     for parent in path.parents:
+        _not_dangling(parent, option)
         if parent.exists():
             if not parent.is_dir():
                 raise InvalidInput(f"{path}: {parent} is a file, not a folder; choose another {option}")
@@ -95,6 +105,7 @@ def check_out_file(
     """
     if path.is_dir():
         raise InvalidInput(f"{path}: is a folder, but {option} needs a file name; give e.g. {path / example}")
+    _not_dangling(path, option)
     _no_file_above(path, option)
     try:
         check_replaceable(path)
@@ -117,11 +128,13 @@ def check_out_folder(
     """
     if path.exists() and not path.is_dir():
         raise InvalidInput(f"{path}: is a file, but {option} needs a folder; give a new or existing folder")
+    _not_dangling(path, option)
     _no_file_above(path / "x", option)
     inputs = list(inputs)
     _not_an_input(path, inputs, option)
     for name in files:
         target = path / name
+        _not_dangling(target, option)
         if target.is_dir():
             raise InvalidInput(
                 f"{target}: is a folder where a file must be written; move it or choose another {option}"
@@ -134,5 +147,12 @@ def check_out_folder(
 
 
 def robot_inputs(robot: str) -> list[str]:
-    """The robot argument as an input path when it names an existing file (else nothing)."""
-    return [robot] if robot and Path(robot).is_file() else []
+    """The robot argument as input paths: the file it names, or a twin folder and its files (else nothing)."""
+    from joulepath.dynamics._calibration import TWIN_FILES
+
+    if not robot:
+        return []
+    path = Path(robot)
+    if path.is_dir():
+        return [robot, *(str(path / name) for name in TWIN_FILES)]
+    return [robot] if path.is_file() else []

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -9,6 +10,7 @@ from pathlib import Path
 import typer
 
 from joulepath.cli._common import check_out_folder, console
+from joulepath.errors import InvalidInput
 
 BUNDLED = ("demo", "thesis")
 RUNS = Path("runs")
@@ -59,7 +61,16 @@ def _run(experiment: str, out: Path | None, quiet: bool, scheduler: str | None) 
 
     exp = load_experiment(_experiment_path(experiment))
     folder = out or default_folder(exp.name)
-    check_out_folder(folder)
+    from joulepath._runfolder import RUN_FILES, STAGE_FOLDERS
+
+    check_out_folder(folder, files=RUN_FILES, inputs=[str(_experiment_path(experiment))])
+    for name in STAGE_FOLDERS:
+        stage = folder / name
+        if os.path.lexists(stage) and (stage.is_symlink() or not stage.is_dir()):
+            raise InvalidInput(
+                f"{stage}: is not a folder, but the run keeps its {name} stage there; "
+                "move it or choose another --out"
+            )
     say = (lambda _t: None) if quiet else (lambda t: console.print(t, markup=False))
     with _bars(not quiet and console.is_terminal) as progress:
         summary = run_experiment(exp, folder, say=say, progress=progress, scheduler=scheduler)  # type: ignore[arg-type]

@@ -67,7 +67,9 @@ def train(
     from joulepath.learn import FAMILIES, TrainConfig
     from joulepath.learn import train as run
 
-    check_out_folder(out)
+    check_out_folder(  # the names every training writes, before any work
+        out, files=("results.csv", "report.json", "importance_E.csv", "importance_E.png", "joints.json")
+    )
     config = TrainConfig(
         families=_split(family, "--family", FAMILIES, FAMILIES),
         targets=_split(target, "--target", target_columns(MAX_JOINTS), target_columns(MAX_JOINTS)),
@@ -133,14 +135,14 @@ def importance(
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
 ) -> int:
     """Rank the inputs (and joints) by their influence on the energy (thesis Figs 4.1-4.2)."""
-    from joulepath._io import atomic_write_text
+    from joulepath._io import atomic_write_text, make_folder
     from joulepath.data import load_table
     from joulepath.learn import feature_importance, plot_importance, rank_joints
 
-    check_out_folder(out)
+    check_out_folder(out, files=(f"importance_{target}.csv", f"importance_{target}.png"), inputs=[data])
     table = load_table(data)
     imp = feature_importance(table, target, seed=seed)
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     atomic_write_text(out / f"importance_{target}.csv", imp.to_csv())
     plot_importance(imp, out / f"importance_{target}.png", title=f"Feature importance for {target}")
     console.print(imp.head(12).to_string(float_format=lambda v: f"{v:.3f}"), markup=False)

@@ -1,8 +1,17 @@
-"""Entry point: parse, dispatch, and turn user errors into one line and exit code 2."""
+"""Entry point: parse, dispatch, and turn user errors into one line and exit code 2.
+
+A command either finishes or leaves nothing of its own behind: it runs inside an
+:class:`~joulepath._io.OutputJournal`, undone when it fails (``run`` keeps its own
+stage-by-stage recovery). Warnings that libraries raise while it runs (NumPy's
+RuntimeWarnings, ...) are held back: after an error only the error line is printed,
+after success they are shown as usual.
+"""
 
 from __future__ import annotations
 
+import errno
 import sys
+import warnings
 from collections.abc import Sequence
 
 import typer
@@ -64,8 +73,55 @@ def _root(
     """Energy-optimal point-to-point moves for six-axis industrial robot arms."""
 
 
+SELF_RECOVERING = frozenset({"run", "demo"})
+"""Commands whose stages keep or drop their own folders (``experiment``), not undone as a whole."""
+
+_FULL = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
+_DENIED = frozenset({errno.EROFS, errno.EACCES, errno.EPERM})
+"""OSErrors that say something about the machine (a full disk, a read-only folder), not about joulepath:
+one line, wherever they are raised."""
+
+
+def _command(args: Sequence[str]) -> str:
+    return next((a for a in args if not a.startswith("-")), "")
+
+
+def _replay(caught: list[warnings.WarningMessage]) -> None:
+    """Show the held-back warnings as the filters outside ``main`` say (once per message)."""
+    seen: set[tuple[type[Warning], str]] = set()
+    for w in caught:
+        key = (w.category, str(w.message))
+        if key not in seen:
+            seen.add(key)
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
+
+
+def _one_line(err: BaseException, debug: bool) -> tuple[str, int] | None:
+    """The error line and exit code of an error the user can fix; None for a bug (traceback)."""
+    if isinstance(err, JoulepathError):
+        return None if debug else (f"error: {err}", 2)
+    if isinstance(err, typer.Abort):
+        return "aborted", 130
+    if isinstance(err, typer.TyperException):  # usage errors: bad option values, missing arguments
+        message = getattr(err, "format_message", None)
+        if message is None or debug:
+            return None
+        ctx = getattr(err, "ctx", None)
+        where = ctx.command_path if ctx is not None else "joulepath"
+        return f"error: {message().rstrip('.')}; see '{where} --help'", 2
+    if isinstance(err, OSError) and err.errno in _FULL | _DENIED and not debug:
+        where = f"{err.filename}: " if err.filename else ""
+        fix = "free some space and run it again" if err.errno in _FULL else "check its permissions"
+        return f"error: {where}{err.strerror or err}; {fix}", 2
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI with ``argv`` (default: ``sys.argv[1:]``); return the exit code."""
+    from contextlib import AbstractContextManager, nullcontext
+
+    from joulepath._io import OutputJournal, output_journal
+
     args = list(sys.argv[1:] if argv is None else argv)
     if not args:
         print("error: no command given; see 'joulepath --help' for the commands", file=sys.stderr)
@@ -73,24 +129,28 @@ def main(argv: Sequence[str] | None = None) -> int:
     debug = "--debug" in args
     if debug:  # accepted anywhere on the line, handled as a root option
         args = ["--debug", *(a for a in args if a != "--debug")]
+    journal = None if _command(args) in SELF_RECOVERING else OutputJournal()
+    journaled: AbstractContextManager[object] = nullcontext() if journal is None else output_journal(journal)
+    caught: list[warnings.WarningMessage] = []
     try:
-        result = app(args=args, prog_name="joulepath", standalone_mode=False)
-    except JoulepathError as err:
-        if debug:
+        with warnings.catch_warnings(record=True) as caught, journaled:
+            warnings.simplefilter("default")  # once per place: bounded
+            try:
+                result = app(args=args, prog_name="joulepath", standalone_mode=False)
+            except typer.Exit as err:  # a command that chose its exit code: its files stay
+                result = int(err.exit_code)
+    except BaseException as err:  # the journal is undone already
+        line = _one_line(err, debug)
+        if line is None:
+            _replay(caught)
             raise
-        print(f"error: {err}", file=sys.stderr)
-        return 2
-    except typer.Exit as err:
-        return int(err.exit_code)
-    except typer.Abort:
-        print("aborted", file=sys.stderr)
-        return 130
-    except typer.TyperException as err:  # usage errors: bad option values, missing arguments
-        message = getattr(err, "format_message", None)
-        if message is None or debug:
-            raise
-        ctx = getattr(err, "ctx", None)
-        where = ctx.command_path if ctx is not None else "joulepath"
-        print(f"error: {message().rstrip('.')}; see '{where} --help'", file=sys.stderr)
-        return 2
+        text, code = line
+        if journal is not None and journal.undone:
+            text += (
+                f"; nothing of this run was kept (the {journal.undone} file(s) it had written were "
+                "removed, and any it had replaced put back)"
+            )
+        print(text, file=sys.stderr)
+        return code
+    _replay(caught)
     return int(result) if isinstance(result, int) else 0

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from joulepath.cli._common import check_out_folder, console, parse_joints
+from joulepath.cli._common import check_out_folder, console, parse_joints, robot_inputs
 from joulepath.cli._robot import load_robot_for_cli, lock_option, unchecked_option
 from joulepath.description import DEFAULT_ROBOT
 
@@ -131,13 +131,19 @@ def optimize(
     written; 2: bad input (an infeasible task included).
     """
     from joulepath.energy import check_measure
-    from joulepath.export import select_exporter
-    from joulepath.optimize import MAX_DURATION, OptimizeConfig, optimize_move, write_run
+    from joulepath.export import EXPORTERS, select_exporter
+    from joulepath.optimize import MAX_DURATION, RUN_FILES, OptimizeConfig, optimize_move, write_run
     from joulepath.trajectory import sample_times
 
     check_out_folder(out)
     r = load_robot_for_cli(robot, unchecked=unchecked, lock=lock)
     exporter, warning = select_exporter(r, export or None)
+    programs = {f for e in EXPORTERS.values() for f in e.files}
+    check_out_folder(  # every name written inside --out, before any work
+        out,
+        files=sorted({*(f for f in RUN_FILES if f not in programs), *exporter.files}),
+        inputs=robot_inputs(robot),
+    )
     if warning is not None:
         print(f"warning: {warning}", file=sys.stderr)
     q0 = parse_joints(start, option="--start", degrees=degrees, n=r.n_joints)
@@ -242,10 +248,10 @@ def bench_optimizers(
     out: Path = typer.Option(..., "--out", help="Folder for the results CSV."),
 ) -> int:
     """The thesis' optimizer benchmark (§4.5.1): every GA/DE/MA configuration on random tasks."""
-    from joulepath._io import atomic_write_text
+    from joulepath._io import atomic_write_text, make_folder
     from joulepath.optimize import bench_optimizers as run
 
-    check_out_folder(out)
+    check_out_folder(out, files=["optimizers_single.csv", *(["optimizers_multi.csv"] if model else [])])
     if quick:
         tasks, generations, population = 10, 30, 30
     variants = (
@@ -268,7 +274,7 @@ def bench_optimizers(
                 scheduler=scheduler or None,
                 progress=_status(status, f"{kind}-objective ({fitness})"),
             )
-        out.mkdir(parents=True, exist_ok=True)
+        make_folder(out)
         atomic_write_text(out / f"optimizers_{kind}.csv", frame.to_csv(index=False))
         console.print(f"{kind}-objective, fitness {fitness}:")
         console.print(frame.to_string(index=False, float_format=lambda v: f"{v:.2f}"), markup=False)

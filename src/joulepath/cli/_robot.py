@@ -52,6 +52,12 @@ def parse_locks(items: list[str] | None) -> dict[str, float]:
                 f"{item!r} is not JOINT=VALUE (a joint name and a finite number, e.g. finger_joint=0)",
                 param_hint="--lock",
             )
+        joint = name.strip()
+        if joint in out:
+            raise typer.BadParameter(
+                f"joint {joint!r} is locked twice ({out[joint]:g} and {number:g}); lock it once",
+                param_hint="--lock",
+            )
         out[name.strip()] = number
     return out
 

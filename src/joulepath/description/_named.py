@@ -24,16 +24,26 @@ class NamedArm:
     urdf: str
     lock: dict[str, float] = field(default_factory=dict)
     about: str = ""
+    payload_kg: float | None = None  # rated payload of the maker's data sheet (None: not recorded here)
 
 
 NAMED_ARMS: dict[str, NamedArm] = {
-    "ur3": NamedArm("ur_description/urdf/ur3_robot.urdf", about="Universal Robots UR3 (CB3 limits ±360°)"),
-    "ur5": NamedArm("ur_description/urdf/ur5_robot.urdf", about="Universal Robots UR5 (CB3 limits ±360°)"),
-    "ur10": NamedArm("ur_description/urdf/ur10_robot.urdf", about="Universal Robots UR10 (CB3 limits ±360°)"),
+    "ur3": NamedArm(
+        "ur_description/urdf/ur3_robot.urdf", about="Universal Robots UR3 (CB3 limits ±360°)", payload_kg=3.0
+    ),
+    "ur5": NamedArm(
+        "ur_description/urdf/ur5_robot.urdf", about="Universal Robots UR5 (CB3 limits ±360°)", payload_kg=5.0
+    ),
+    "ur10": NamedArm(
+        "ur_description/urdf/ur10_robot.urdf",
+        about="Universal Robots UR10 (CB3 limits ±360°)",
+        payload_kg=10.0,
+    ),
     "panda": NamedArm(
         "panda_description/urdf/panda.urdf",
         lock={"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0},
         about="Franka Emika Panda, 7 joints; the hand's two finger joints locked closed",
+        payload_kg=3.0,
     ),
     "xarm7": NamedArm("xarm_description/urdf/xarm7.urdf", about="UFactory xArm7, 7 joints"),
     "z1": NamedArm(

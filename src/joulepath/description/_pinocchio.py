@@ -234,6 +234,37 @@ def _vec(el: ET.Element | None, attr: str, default: str) -> np.ndarray:
     return np.array([float(v) for v in (raw or default).split()])
 
 
+MAX_LOCK_ANGLE = 2 * np.pi
+"""rad: the largest lock value of a joint without a range (a continuous one): one turn either way."""
+MAX_LOCK_TRAVEL = 10.0
+"""m: the largest lock value of a prismatic joint without a range."""
+
+
+def _check_lock_value(el: Any, name: str, value: float, p: Path) -> None:
+    """Refuse a lock value outside the joint's ``<limit>`` range (or one turn, 10 m without one)."""
+    unit = "m" if el.get("type") == "prismatic" else "rad"
+    limit = el.find("limit")
+    lo = hi = None
+    if el.get("type") != "continuous" and limit is not None:
+        try:
+            lo, hi = float(limit.get("lower", "nan")), float(limit.get("upper", "nan"))
+        except ValueError:
+            lo = hi = None
+    if lo is not None and hi is not None and np.isfinite(lo) and np.isfinite(hi) and lo <= hi:
+        if not lo - 1e-9 <= value <= hi + 1e-9:
+            raise InvalidRobotDescription(
+                f"{p}: the lock value {value:g} {unit} of joint {name!r} is outside its range "
+                f"[{lo:g}, {hi:g}] {unit}; lock it within the range"
+            )
+        return
+    bound = MAX_LOCK_TRAVEL if unit == "m" else MAX_LOCK_ANGLE
+    if not abs(value) <= bound:
+        raise InvalidRobotDescription(
+            f"{p}: the lock value {value:g} {unit} of joint {name!r} is beyond ±{bound:g} {unit}; "
+            "give a value within one turn (or 10 m)"
+        )
+
+
 def _lock_in_urdf(data: bytes, lock: dict[str, float], p: Path) -> str:
     """The URDF text with the joints of ``lock`` made fixed at the given values (rad, or m).
 
@@ -255,6 +286,7 @@ def _lock_in_urdf(data: bytes, lock: dict[str, float], p: Path) -> str:
         kind = el.get("type")
         if kind not in ("revolute", "continuous", "prismatic"):
             raise InvalidRobotDescription(f"{p}: joint {name!r} is {kind}; only a 1-axis joint can be locked")
+        _check_lock_value(el, name, value, p)
         origin = el.find("origin")
         xyz, rpy = _vec(origin, "xyz", "0 0 0"), _vec(origin, "rpy", "0 0 0")
         axis = _vec(el.find("axis"), "xyz", "1 0 0")

@@ -39,6 +39,11 @@ from joulepath.errors import InvalidInput, InvalidRobotDescription
 from joulepath.kinematics import Pose, check_q, forward_kinematics, geometric_jacobian
 
 METHODS = ("pinocchio", "lagrange-euler")
+FRICTION_BOUND = 10.0
+"""A joint friction torque (N·m) is refused above this many times the torque of the arm's whole moving
+weight held at its reach (the IRB 120: about 840 N·m, some 500 times its identified friction)."""
+TWIN_KINEMATICS_TOLERANCE_MM = 1.0
+"""How far tool0 of a twin and of the robot its ``twin_of`` names may lie apart at the same configuration."""
 _IRB120 = re.compile(r"irb[ _-]?120", re.I)
 _FROM_FILES = object()
 FALLBACK_RANGE_SETS = ("lab", "collection")
@@ -157,7 +162,15 @@ class Robot:
             src = Path(self.source)
             beside = src.with_name(src.stem + FRICTION_SUFFIX)
             if beside.is_file():
-                return read_friction_file(beside, self.n_joints), f"friction file {beside}"
+                from_file = read_friction_file(beside, self.n_joints)
+                n = self.n_joints
+                check_friction(
+                    self,
+                    str(beside),
+                    coulomb=np.broadcast_to(np.asarray(from_file.coulomb, dtype=float), (n,)),
+                    viscous=np.broadcast_to(np.asarray(from_file.viscous, dtype=float), (n,)),
+                )
+                return from_file, f"friction file {beside}"
         if _IRB120.search(self.name) and self.n_joints == 6:
             return (
                 NOMINAL_FRICTION,
@@ -359,11 +372,54 @@ class Robot:
         return _energy.path_energy(tau, np.asarray(qd, float), dt, mode=mode, copper_loss=copper_loss)
 
     # ---------------------------------------------------------------- payload
+    @property
+    def rated_payload_kg(self) -> float | None:
+        """The heaviest load the maker rates the arm for (kg), if known.
+
+        From the IRML ``<carrying-capacity>``, else a named arm's data sheet
+        (:data:`~joulepath.description.NAMED_ARMS`); None when neither says.
+        """
+        if self.description is not None:
+            rated = self.description.info_float("carrying-capacity")
+            if rated is not None and rated > 0:
+                return float(rated)
+        arm = NAMED_ARMS.get(self.name)
+        if arm is not None and arm.payload_kg is not None and (self.source or "").endswith(arm.urdf):
+            return arm.payload_kg
+        return None
+
+    def check_payload(self, mass: float, *, what: str = "payload") -> None:
+        """Refuse a load the arm cannot carry: above its :attr:`rated_payload_kg`, or, when no rating
+        is known, heavier than the arm's own moving links.
+
+        Raises
+        ------
+        InvalidInput
+            ``mass`` is not a finite number ≥ 0, or is above the bound; the message names it.
+        """
+        if not (np.isfinite(mass) and mass >= 0):
+            raise InvalidInput(f"{what}: mass {mass!r} kg is not a finite number ≥ 0")
+        rated = self.rated_payload_kg
+        if rated is not None and mass > rated:
+            raise InvalidInput(
+                f"{what}: {mass:g} kg is more than the {self.name}'s rated payload of {rated:g} kg; "
+                "check the mass (kg), or use an arm rated for it"
+            )
+        own = float(np.sum(self.chain.masses))
+        if rated is None and mass > own:
+            raise InvalidInput(
+                f"{what}: {mass:g} kg is heavier than the {self.name}'s own moving links ({own:.3g} kg) and "
+                "no rated payload is known for it; check the mass (kg), or give the robot's "
+                "<carrying-capacity> in its IRML"
+            )
+
     def with_payload(
         self,
         mass: float,
         com: ArrayLike = (0.0, 0.0, 0.0),
         inertia: ArrayLike | None = None,
+        *,
+        what: str = "payload",
     ) -> Robot:
         """A copy of this robot carrying a payload at tool0.
 
@@ -376,7 +432,16 @@ class Robot:
         inertia : array_like of shape (3, 3) or (3,), optional
             About the centre of mass, tool0 axes, kg·m²; a 3-vector is the diagonal
             (ABB ``ix, iy, iz``). Default: a point mass.
+        what : str
+            How a refusal names the load (e.g. ``"tool tGripper"``).
+
+        Raises
+        ------
+        InvalidInput
+            A negative or non-finite mass, a mass above the arm's rating (:meth:`check_payload`),
+            or an inertia that is not physical.
         """
+        self.check_payload(float(mass), what=what)
         inertia_arr = np.zeros((3, 3)) if inertia is None else np.asarray(inertia, dtype=float)
         if inertia_arr.shape == (3,):
             inertia_arr = np.diag(inertia_arr)
@@ -433,6 +498,8 @@ class Robot:
         lines.append(f"moving mass {self.chain.masses.sum():.3f} kg")
         if self.payload is not None:
             lines.append(f"payload {self.payload.mass:.3f} kg at {self.payload.com} m (tool0)")
+        if self.rated_payload_kg is not None:
+            lines.append(f"rated payload {self.rated_payload_kg:g} kg")
         if len(self.range_set_names) > 1:
             lines.append("range sets: " + ", ".join(self.range_set_names))
         return "\n".join(lines)
@@ -519,6 +586,7 @@ def load_robot(
         raise InvalidRobotDescription(f"{path}: unknown robot file type {suffix!r}; use .irml or .urdf")
     if checked:
         _refuse_unphysical(robot, text)
+        _ = robot.friction  # a friction file beside the description is read (and checked) now
     return robot
 
 
@@ -526,8 +594,122 @@ def _load_twin(folder: Path, *, checked: bool) -> Robot:
     """A twin folder (``joulepath identify --out``): its IRML robot with its identified friction."""
     robot_file, friction_file = twin_paths(folder)
     robot = load_robot(robot_file, checked=checked)
-    robot.calibration = read_calibration(friction_file, robot.n_joints)
+    calibration = read_calibration(friction_file, robot.n_joints)
+    f = calibration.friction
+    check_friction(
+        robot,
+        str(friction_file),
+        coulomb=np.array(f.coulomb),
+        viscous=np.array(f.viscous),
+        offset=np.array(f.offset),
+        stribeck=np.array(f.stribeck),
+    )
+    _check_twin_of(robot, calibration.twin_of, str(friction_file))
+    robot.calibration = calibration
     return robot
+
+
+def friction_bound(robot: Robot) -> float:
+    """The largest plausible friction torque of a joint of ``robot`` (N·m), see :data:`FRICTION_BOUND`.
+
+    The reach is the IRML ``<reach>`` or tool0's distance from the base at home,
+    whichever is larger (at least 0.1 m).
+    """
+    reach = float(np.linalg.norm(robot.fk(robot.home).position_m))
+    if robot.description is not None:
+        reach = max(reach, robot.description.info_float("reach") or 0.0)
+    weight = float(np.sum(robot.chain.masses)) * float(np.linalg.norm(robot.chain.gravity))
+    return FRICTION_BOUND * max(weight, 1.0) * max(reach, 0.1)
+
+
+def check_friction(
+    robot: Robot,
+    where: str,
+    *,
+    coulomb: FloatArray,
+    viscous: FloatArray,
+    offset: FloatArray | None = None,
+    stribeck: FloatArray | None = None,
+) -> None:
+    """Refuse friction that no drive has: a negative Coulomb, viscous or Stribeck level (friction
+    opposes motion), or a torque over :func:`friction_bound` (the break-away level, or the viscous
+    torque at the joint's speed limit, 10 rad/s where none is given). ``offset`` may be negative
+    (a direction asymmetry) but counts in the break-away level.
+
+    Raises
+    ------
+    InvalidRobotDescription
+        The first joint and term that fail, and the bound.
+    """
+    n = robot.n_joints
+    zero = np.zeros(n)
+    terms = {"coulomb": coulomb, "viscous": viscous, "stribeck": zero if stribeck is None else stribeck}
+    for name, values in terms.items():
+        bad = np.nonzero(~(np.asarray(values, dtype=float) >= 0))[0]
+        if bad.size:
+            j = int(bad[0])
+            raise InvalidRobotDescription(
+                f"{where}: {name} friction of joint {j + 1} is {float(values[j]):g}; friction opposes "
+                "motion, so it must be ≥ 0: identify the friction again"
+            )
+    bound = friction_bound(robot)
+    offsets = zero if offset is None else np.abs(np.asarray(offset, dtype=float))
+    breakaway = np.asarray(coulomb, float) + offsets + np.asarray(terms["stribeck"], float)
+    speed = np.where(np.isfinite(robot.velocity_limit), robot.velocity_limit, 10.0)
+    viscous_torque = np.asarray(viscous, float) * speed
+    for label, torque in (
+        ("break-away (coulomb + |offset| + stribeck)", breakaway),
+        ("viscous", viscous_torque),
+    ):
+        over = np.nonzero(~(torque <= bound))[0]
+        if over.size:
+            j = int(over[0])
+            raise InvalidRobotDescription(
+                f"{where}: the {label} friction torque of joint {j + 1} is {float(torque[j]):.3g} N·m, over "
+                f"{bound:.3g} N·m ({FRICTION_BOUND:g} times the arm's whole weight at its reach): not a "
+                "plausible friction; identify the friction again"
+            )
+
+
+def _probe_configurations(robot: Robot) -> FloatArray:
+    """Home and three spread configurations within the joint ranges (±1 rad where a range is open)."""
+    lo = np.where(np.isfinite(robot.lower), robot.lower, -1.0)
+    hi = np.where(np.isfinite(robot.upper), robot.upper, 1.0)
+    j = np.arange(robot.n_joints)
+    fractions = [0.2 + 0.6 * (((3 * j + 7 * k) % 10) / 9.0) for k in range(3)]
+    return np.vstack([robot.home, *(lo + (hi - lo) * f for f in fractions)])
+
+
+def _check_twin_of(robot: Robot, twin_of: str | None, where: str) -> None:
+    """Refuse a twin whose ``twin_of`` names a robot of other kinematics (or one that cannot be loaded)."""
+    if twin_of is None:
+        return
+    fix = "set twin_of to the robot the twin was identified on, or identify the twin again"
+    if twin_of not in PRESETS and twin_of not in NAMED_ARMS and Path(twin_of).is_dir():
+        raise InvalidRobotDescription(
+            f"{where}: twin_of = {twin_of!r} is a folder; a twin is the twin of a robot (a bundled name or "
+            f"a robot file), never of another twin folder: {fix}"
+        )
+    from joulepath.errors import JoulepathError
+
+    try:
+        nominal = load_robot(twin_of, checked=False)
+    except JoulepathError as err:
+        raise InvalidRobotDescription(
+            f"{where}: twin_of = {twin_of!r} cannot be loaded ({err}); {fix}"
+        ) from err
+    if nominal.n_joints != robot.n_joints:
+        raise InvalidRobotDescription(
+            f"{where}: twin_of = {twin_of!r} has {nominal.n_joints} joints, the twin {robot.n_joints}: {fix}"
+        )
+    qs = _probe_configurations(robot)
+    gap_mm = 1000.0 * np.linalg.norm(nominal.fk(qs).position_m - robot.fk(qs).position_m, axis=-1)
+    if not np.all(gap_mm <= TWIN_KINEMATICS_TOLERANCE_MM):
+        k = int(np.argmax(np.where(np.isfinite(gap_mm), gap_mm, np.inf)))
+        raise InvalidRobotDescription(
+            f"{where}: twin_of = {twin_of!r}, but the twin's kinematics are not that robot's: tool0 lies "
+            f"{gap_mm[k]:.0f} mm apart at q = [{', '.join(f'{v:.2f}' for v in qs[k])}] rad: {fix}"
+        )
 
 
 def _refuse_unphysical(robot: Robot, given: str) -> None:

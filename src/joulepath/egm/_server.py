@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from joulepath._io import atomic_write_text, finite_json
+from joulepath._io import atomic_write_text, finite_json, output_journal
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.egm._plan import Plan, check_plan, plan_file, read_plan, read_run_result, run_robot
@@ -444,10 +444,11 @@ def stream_run(
     with UdpEndpoint(config.host, config.port) as endpoint:
         session = serve(plan, endpoint, config, on_listening=on_listening)
     summary = finite_json(summarize(session, plan, r, result, config))
-    files = {
-        STREAM_CSV: atomic_write_text(out / STREAM_CSV, stream_csv(session)),
-        STREAM_JSON: atomic_write_text(out / STREAM_JSON, json.dumps(summary, indent=2, allow_nan=False)),
-    }
+    with output_journal():  # both files or neither, kept even when the session faulted (its record)
+        files = {
+            STREAM_CSV: atomic_write_text(out / STREAM_CSV, stream_csv(session)),
+            STREAM_JSON: atomic_write_text(out / STREAM_JSON, json.dumps(summary, indent=2, allow_nan=False)),
+        }
     if session.fault is not None:
         raise StreamAborted(f"{session.fault} (log: {out / STREAM_JSON})")
     return StreamOutcome(summary=summary, files=files)

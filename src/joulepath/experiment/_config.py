@@ -491,11 +491,98 @@ def load_experiment(path: str | os.PathLike[str]) -> Experiment:
                     f"(paths are relative to the experiment file's folder)"
                 )
     _check_together(exp, source)
-    _check_robot(exp, source)
+    robot = _check_robot(exp, source)
+    _check_stages(exp, robot, source)
     return exp
 
 
-def _check_robot(exp: Experiment, source: str) -> None:
+def _check_stages(exp: Experiment, robot: Any, source: str) -> None:
+    """Every stage's settings and files that can be checked before the first stage starts.
+
+    The ``[optimize]`` program exporter for the robot; ``[identify]``: an IRML robot (a twin
+    is written as IRML) and its range set; ``[cycle]``: the program read and resolved for the
+    robot, the cell file with its meshes read, the settings built and the default cycle planned.
+    """
+    from joulepath.errors import JoulepathError
+    from joulepath.export import select_exporter
+
+    _check_extras(exp, source)
+    o = exp.optimize
+    if o.tasks:
+        try:
+            select_exporter(robot, o.export or None)
+        except JoulepathError as err:
+            raise InvalidInput(f"{source}: [optimize] export = {o.export!r}: {err}") from err
+    st = exp.identify
+    if st.enabled:
+        if robot.description is None:
+            raise InvalidInput(
+                f"{source}: [identify] needs a robot described in IRML (the twin is written as IRML); "
+                f"robot = {exp.robot!r} comes from a URDF: use an .irml robot, or drop [identify]"
+            )
+        from joulepath.dynamics._robot import FALLBACK_RANGE_SETS
+
+        if st.range_set not in (*robot.range_set_names, *FALLBACK_RANGE_SETS):
+            raise InvalidInput(
+                f"{source}: [identify] range_set = {st.range_set!r} is not a range set of {robot.name}; "
+                f"use one of {', '.join(robot.range_set_names)}"
+            )
+    c = exp.cycle
+    if c.program:
+        from joulepath.program import CycleSettings, read_cycle_program
+        from joulepath.program._cell import read_cell
+        from joulepath.program._cycle import check_cycle
+
+        program, cell = (
+            resolve_logs(exp, (c.program,))[0],
+            (resolve_logs(exp, (c.cell,))[0] if c.cell else None),
+        )
+        try:
+            spec, _ = read_cycle_program(program, robot)
+            settings = CycleSettings(
+                cell=read_cell(cell) if cell is not None else None,
+                cycle_time=c.cycle_time or None,
+                use_waits=c.use_waits,
+                fly_by=c.fly_by,
+                corridor_mm=c.corridor_mm or None,
+                seed=exp.seed,
+            )
+            check_cycle(spec, settings)
+        except JoulepathError as err:
+            raise InvalidInput(f"{source}: [cycle] {err}") from err
+
+
+_EXTRAS: tuple[tuple[str, str, str], ...] = (
+    ("synth.methods", "sdv", "synth"),
+    ("train.families", "skops", "ml"),
+    ("xgb", "xgboost", "ml"),
+    ("optimize.reference", "casadi", "reference"),
+    ("scheduler", "distributed", "dask"),
+)
+"""(setting, the module it needs, the extra that installs it), checked before the first stage."""
+
+
+def _check_extras(exp: Experiment, source: str) -> None:
+    """Refuse, before any stage runs, settings whose optional packages are not installed."""
+    import importlib.util
+
+    used = {
+        "synth.methods": bool(exp.synth.methods),
+        "train.families": bool(exp.train.families),
+        "xgb": "xgb" in exp.train.families,
+        "optimize.reference": exp.optimize.reference and exp.optimize.tasks > 0,
+        "scheduler": bool(exp.scheduler),
+    }
+    for setting, module, extra in _EXTRAS:
+        if used[setting] and importlib.util.find_spec(module) is None:
+            what = "[train] families = 'xgb'" if setting == "xgb" else setting
+            raise InvalidInput(
+                f"{source}: {what} needs the optional package {module!r}, which is not installed; "
+                f"pip install 'joulepath[{extra}]', or change the setting"
+            )
+
+
+def _check_robot(exp: Experiment, source: str) -> Any:
     from joulepath.dynamics import load_robot
     from joulepath.dynamics._robot import FALLBACK_RANGE_SETS
     from joulepath.errors import JoulepathError
@@ -513,6 +600,7 @@ def _check_robot(exp: Experiment, source: str) -> None:
             f"{source}: [optimize] range_set = {exp.optimize.range_set!r} is not a range set of "
             f"{robot.name}; use one of {', '.join(names)}"
         )
+    return robot
 
 
 def resolve_logs(exp: Experiment, logs: tuple[str, ...]) -> list[str]:

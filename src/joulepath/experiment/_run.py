@@ -762,13 +762,33 @@ def _optimize_stage(ctx: _Context, model_key: str, importance_key: str) -> dict[
             )
             ctx.tell(f"optimize: task {k} ({T:g} s, {s.algorithm}): {verdict}")
         ctx.progress("optimize", len(tasks), len(tasks))
-        frame = pd.DataFrame(rows)
+        frame = pd.DataFrame(rows) if rows else pd.DataFrame(columns=list(TASK_COLUMNS))
         atomic_write_text(folder / "tasks.csv", frame.to_csv(index=False))
         if len(frame):
             _plot_tasks(frame, folder / "tasks.png")
         return {}
 
     return _stage(ctx, "optimize", "optimize", key, body)
+
+
+TASK_COLUMNS = (
+    "task",
+    "q_start_deg",
+    "q_end_deg",
+    "duration_s",
+    "algorithm",
+    "default_J",
+    "optimized_J",
+    "saved_pct",
+    "saved_lab_pct",
+    "saved_vs_initial_pct",
+    "limits_ok",
+    "max_tcp_deviation_mm",
+    "iterations",
+    "wall_s",
+)
+"""The columns of ``optimize/tasks.csv`` (with ``reference``, also those of the optimum); a header
+only when ``[optimize] tasks = 0``."""
 
 
 def _optimum(robot: Any, res: Any) -> dict[str, Any]:

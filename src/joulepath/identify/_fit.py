@@ -50,6 +50,8 @@ from joulepath.identify._regressor import (
 )
 
 REST_SPEED = np.radians(1.0)
+MIN_TORQUE_SPREAD = 1e-6
+"""N·m: a joint whose logged torque varies less (standard deviation) holds no torque information."""
 """A joint whose logged speed never exceeds this (rad/s) never moved: its friction cannot be identified."""
 
 MAX_CONDITION = 1e4
@@ -96,10 +98,14 @@ class IdentifyOptions:
     holdout: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.stribeck_speed is not None and not self.stribeck_speed > 0:
-            raise InvalidInput(f"stribeck_speed must be a positive speed in rad/s, got {self.stribeck_speed}")
         if not self.smoothing > 0:
             raise InvalidInput(f"smoothing must be a positive speed in rad/s, got {self.smoothing}")
+        if self.stribeck_speed is not None and not self.smoothing <= self.stribeck_speed <= 100.0:
+            raise InvalidInput(
+                f"the Stribeck speed must be {self.smoothing:g} to 100 rad/s, got {self.stribeck_speed:g}: "
+                f"below the smoothing width ({self.smoothing:g} rad/s) the term acts only at rest and cannot "
+                "be identified; give e.g. 0.05"
+            )
         if self.gear_efficiency is not None and not 0.0 < self.gear_efficiency <= 1.0:
             raise InvalidInput(f"gear efficiency must be in (0, 1], got {self.gear_efficiency}")
         if not 0.0 <= self.holdout < 0.9:
@@ -219,6 +225,15 @@ def _check_motion(data: IdentificationData, n_params: int) -> None:
             f"{data.n_samples} samples give {data.n_samples * data.n_joints} torque equations for "
             f"{n_params} parameters; log at least {2 * n_params // data.n_joints + 1} samples "
             "(more moves)"
+        )
+    spread = np.std(data.tau, axis=0)
+    flat = [j + 1 for j in range(data.n_joints) if not spread[j] > MIN_TORQUE_SPREAD]
+    if flat:
+        j = flat[0] - 1
+        raise InvalidInput(
+            f"the logged torque of joint(s) {', '.join(map(str, flat))} never varies (joint {j + 1}: "
+            f"{float(data.tau[0, j]):g} N·m in every sample): such logs hold no torque information, "
+            "whatever the motion; log the drives' torque (or current) and identify again"
         )
     still = [j + 1 for j in range(data.n_joints) if np.abs(data.qd[:, j]).max() <= REST_SPEED]
     if still:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import os
 from pathlib import Path
 
@@ -9,6 +10,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from joulepath._io import atomic_write_bytes
 from joulepath.data import EnergyTable
 from joulepath.errors import InvalidInput
 
@@ -112,9 +114,7 @@ def plot_importance(importance: pd.DataFrame, path: str | os.PathLike[str], *, t
     ax.set_title(title)
     ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout()
-    out = Path(path)
-    tmp = out.with_name(f".{out.name}.tmp.png")
-    fig.savefig(tmp, dpi=110)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)
-    os.replace(tmp, out)
-    return out
+    return atomic_write_bytes(Path(path), buf.getvalue())

@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import os
 import platform
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,7 +30,7 @@ import pandas as pd
 from sklearn.pipeline import Pipeline
 from sklearn.svm import LinearSVR
 
-from joulepath._io import atomic_write_text
+from joulepath._io import atomic_write_bytes, atomic_write_text, make_folder
 from joulepath._typing import FloatArray
 from joulepath.data._schema import card_joints
 from joulepath.errors import InvalidModel, MissingDependency
@@ -216,26 +217,25 @@ class EnergyModel:
     # ---------------------------------------------------------- persistence
     def save(self, folder: str | os.PathLike[str]) -> Path:
         """Write the model and its card into ``folder`` (created if needed)."""
-        out = Path(folder)
-        out.mkdir(parents=True, exist_ok=True)
+        out = make_folder(folder)
         card = dict(self.card)
         card["card_version"] = CARD_VERSION
         card["input_columns_sha256"] = input_columns_sha256(self.input_columns)
         if self.family == "xgb":
             steps = dict(self.pipeline.steps)
-            tmp = out / ".tmp.model.json"
             steps["model"].get_booster().set_attr(**{_XGB_COLUMNS_ATTR: json.dumps(list(self.input_columns))})
-            steps["model"].save_model(tmp)
-            os.replace(tmp, out / "model.json")
+            with tempfile.TemporaryDirectory(prefix=".model.", dir=out) as scratch:
+                tmp = Path(scratch) / "model.json"
+                steps["model"].save_model(tmp)
+                data = tmp.read_bytes()
+            atomic_write_bytes(out / "model.json", data)
             card["file"] = "model.json"
         else:
             try:
                 import skops.io as sio
             except ImportError as err:
                 raise MissingDependency("skops is not installed: pip install 'joulepath[ml]'") from err
-            tmp = out / ".model.skops.tmp"
-            sio.dump(self.pipeline, tmp)
-            os.replace(tmp, out / "model.skops")
+            atomic_write_bytes(out / "model.skops", sio.dumps(self.pipeline))
             card["file"] = "model.skops"
         atomic_write_text(out / "card.json", json.dumps(card, indent=2, default=str))
         return out

@@ -31,7 +31,7 @@ from sklearn.metrics import mean_absolute_error, r2_score
 from sklearn.model_selection import GroupKFold, KFold, ParameterGrid
 from sklearn.pipeline import Pipeline
 
-from joulepath._io import atomic_write_text
+from joulepath._io import atomic_write_text, outside_journal
 from joulepath._typing import FloatArray
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.learn._svr import SubsampleWarning
@@ -350,17 +350,18 @@ def grid_search(
         r2, mae, seconds = out
         results[i] = CandidateResult(points[i], tuple(r2), tuple(mae), seconds)
         if cache is not None:
-            atomic_write_text(
-                cache / f"{keys[i]}.json",
-                json.dumps(
-                    {
-                        "params": {k: repr(v) for k, v in points[i].items()},
-                        "r2": r2,
-                        "mae": mae,
-                        "fit_s": seconds,
-                    }
-                ),
-            )
+            with outside_journal():  # a content-keyed cache: kept for the next run even if this one fails
+                atomic_write_text(
+                    cache / f"{keys[i]}.json",
+                    json.dumps(
+                        {
+                            "params": {k: repr(v) for k, v in points[i].items()},
+                            "r2": r2,
+                            "mae": mae,
+                            "fit_s": seconds,
+                        }
+                    ),
+                )
         if progress:
             progress(len(results), total)
 

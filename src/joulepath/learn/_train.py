@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import time
@@ -16,7 +17,7 @@ import pandas as pd
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.model_selection import ParameterGrid
 
-from joulepath._io import atomic_write_text
+from joulepath._io import atomic_write_bytes, atomic_write_text, make_folder, remove_output
 from joulepath.data import EnergyTable, target_columns
 from joulepath.data._schema import MAX_JOINTS
 from joulepath.errors import InvalidInput, InvalidModel
@@ -278,7 +279,7 @@ def train(
     if config.scheduler is not None:  # an unreachable scheduler fails before anything is written
         connect_scheduler(config.scheduler).close()
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     cols = input_columns(train_table.feature_set, config.inputs, train_table.n_joints)
     X = train_table.frame[list(cols)].to_numpy(dtype=np.float64)
     groups = train_table.frame["move_id"].to_numpy()
@@ -432,12 +433,10 @@ def _remove_stale_models(out: Path, kept: set[str]) -> None:
     ``results.csv`` and ``report.json`` describe this run only, so a model left from an
     earlier one would otherwise still be found by :func:`best_model`.
     """
-    import shutil
-
     for card in out.glob("*/card.json"):
         folder = card.parent
         if folder.name not in kept and folder.is_dir() and not folder.is_symlink():
-            shutil.rmtree(folder)
+            remove_output(folder)
 
 
 def plot_test_scores(results: pd.DataFrame, baselines: Sequence[dict[str, Any]], out: Path) -> list[Path]:
@@ -461,11 +460,10 @@ def plot_test_scores(results: pd.DataFrame, baselines: Sequence[dict[str, Any]],
         fig.suptitle(f"Test scores for {target}")
         fig.tight_layout()
         path = out / f"test_scores_{target}.png"
-        tmp = out / f".test_scores_{target}.tmp.png"
-        fig.savefig(tmp, dpi=110)
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=110)
         plt.close(fig)
-        os.replace(tmp, path)
-        paths.append(path)
+        paths.append(atomic_write_bytes(path, buf.getvalue()))
     return paths
 
 

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from joulepath._io import atomic_write_text, finite_json
+from joulepath._io import atomic_write_text, finite_json, make_folder, remove_output, save_figure
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.energy import (
@@ -605,10 +605,7 @@ def plot_run(result: MoveResult, robot: Robot, out: Path) -> list[Path]:
 
 
 def _save(fig: Any, path: Path) -> Path:
-    tmp = path.with_name(f".{path.name}.tmp.png")
-    fig.savefig(tmp, dpi=100)
-    os.replace(tmp, path)
-    return path
+    return save_figure(fig, path, dpi=100)
 
 
 RUN_FILES = (
@@ -644,8 +641,7 @@ def write_run(
     from joulepath.export import EXPORTERS, select_exporter
 
     exporter, warning = select_exporter(robot, export)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = make_folder(out_dir)
     files = {}
     s = result.summary
     summary = s.to_json()
@@ -679,7 +675,7 @@ def write_run(
         for name in sorted({f for e in EXPORTERS.values() for f in e.files}):
             stale = out / name
             if stale.is_file() and not stale.is_symlink():
-                stale.unlink()
+                remove_output(stale)
     summary["program"] = sorted(programs) if refused is None else None
     summary["rapid"] = "path.mod" if "path.mod" in files else None
     if refused is not None:

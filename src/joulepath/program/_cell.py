@@ -51,6 +51,7 @@ obstacles.
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -172,6 +173,32 @@ def _coal_message(err: Exception) -> str:
     return " ".join(text.split())[:200]
 
 
+_STL_RECORD = np.dtype([("normal", "<f4", 3), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")])
+_TEXT_VERTEX = re.compile(rb"^[ \t]*(?:vertex|v)[ \t]+(\S+)[ \t]+(\S+)[ \t]+(\S+)", re.MULTILINE)
+
+
+def _refuse_nonfinite_vertices(path: Path, where: str) -> None:
+    """Refuse a mesh with a NaN or infinite vertex coordinate (binary STL, ASCII STL or OBJ).
+
+    Coordinates that are not numbers at all are left to coal's loader, which refuses them.
+    """
+    data = path.read_bytes()  # size checked by the caller
+    n = int(np.frombuffer(data[80:84], "<u4")[0]) if len(data) >= 84 else -1
+    if n >= 0 and len(data) == 84 + 50 * n:  # binary STL
+        coords = np.frombuffer(data, _STL_RECORD, count=n, offset=84)["vertices"].astype(float)
+    else:
+        rows = _TEXT_VERTEX.findall(data)
+        try:
+            coords = np.asarray(rows, dtype=bytes).astype(float)
+        except ValueError:  # a coordinate that is no number: coal refuses the file
+            coords = np.empty(0)
+    if coords.size and not np.isfinite(coords).all():
+        raise InvalidInput(
+            f"{where}: mesh {path} has vertices that are not finite numbers (NaN or infinity); "
+            "export the mesh again"
+        )
+
+
 def load_mesh(path: Path, scale: tuple[float, float, float], where: str) -> Any:
     """A mesh file (STL or OBJ) as a coal ``BVHModel``, scaled; ``InvalidInput`` if it cannot be used."""
     if path.suffix.lower() not in _MESH_SUFFIXES:
@@ -196,6 +223,7 @@ def load_mesh(path: Path, scale: tuple[float, float, float], where: str) -> Any:
     n_binary = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
     if path.suffix.lower() == ".stl" and n_bytes == 84 + 50 * n_binary:  # a binary STL: counted unread
         check_work("triangles", n_binary, f"{where}: mesh {path}", _FEWER_TRIANGLES)
+    _refuse_nonfinite_vertices(path, where)  # before coal: its OBB fit chokes (and prints) on NaN
     coal = _coal()
     try:
         model = coal.MeshLoader().load(str(path), np.asarray(scale, dtype=float))

@@ -398,6 +398,8 @@ class CycleOptimizer:
         self.plan: PlannedCycle = plan_cycle(spec, settings.controller)
         self.gradient = replace(settings.gradient, energy_every=settings.energy_every)
         check_motion_time(self.plan, spec.source, optimized=True)
+        if spec.module is None:
+            _refuse_short_durations(spec, self.plan)
         self._plants: dict[int, Plant] = {}
         self._default_motion: CycleMotion | None = None
         self._default_energies: dict[int, tuple[float, float, float]] | None = None
@@ -1487,6 +1489,31 @@ class CycleMotion:
     trajectory: Trajectory
     starts: dict[int, float]
     cycle_time: float
+
+
+def check_cycle(spec: CycleSpec, settings: CycleSettings) -> None:
+    """What :func:`optimize_cycle` refuses before it solves anything, without solving (the default
+    cycle is planned; a cycle file's ``duration_s`` the arm cannot keep is refused)."""
+    plan = plan_cycle(spec, settings.controller)
+    if spec.module is None:
+        _refuse_short_durations(spec, plan)
+
+
+def _refuse_short_durations(spec: CycleSpec, plan: PlannedCycle) -> None:
+    """A cycle file's ``duration_s`` is the move's time as the arm runs it: refuse one it cannot keep.
+
+    (A RAPID ``\\T`` shorter than the fastest motion is run at full speed by the controller, as
+    the emulation does; a cycle file has no controller that could stand in for it.)
+    """
+    for m in plan.moves:
+        asked = m.step.time_s
+        if asked is not None and m.profile.duration > asked * (1 + 1e-9) + 1e-9:
+            least = np.ceil(m.profile.duration * 1000) / 1000
+            raise InvalidInput(
+                f"{spec.source}: step {m.step.line}: duration_s = {asked:g} s is shorter than the fastest "
+                f"the arm makes this move within its speed, acceleration and jerk limits "
+                f"({m.profile.duration:.3f} s); give duration_s ≥ {least:g}"
+            )
 
 
 def optimize_cycle(

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -11,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from joulepath import __version__
-from joulepath._io import atomic_write_text, finite_json
+from joulepath._io import atomic_write_text, finite_json, make_folder, remove_output, save_figure
 from joulepath.errors import LimitViolation
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._cycle import LAB_MEASURE, CycleResult, ParetoPoint
@@ -362,10 +361,7 @@ def pareto_plot(points: list[ParetoPoint], default: tuple[float, float, float], 
     ax.set_ylabel("energy per cycle [J]")
     ax.legend()
     fig.tight_layout()
-    tmp = path.with_name(f".{path.name}.tmp.png")
-    fig.savefig(tmp, dpi=100)
-    os.replace(tmp, path)
-    return path
+    return save_figure(fig, path, dpi=100)
 
 
 def reads_back(result: CycleResult, text: str) -> str | None:
@@ -453,13 +449,12 @@ def write_cycle_run(
             if text is not None:
                 follows = name
                 break
-    out.mkdir(parents=True, exist_ok=True)
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     stale = out / "optimized.mod"
     if text is not None:
         files["optimized.mod"] = atomic_write_text(stale, text)
     elif stale.is_file() and not stale.is_symlink():
-        stale.unlink()
+        remove_output(stale)
     files["optimized_cycle.csv"] = atomic_write_text(out / "optimized_cycle.csv", optimized_cycle_csv(result))
     files["cycle_path.csv"] = atomic_write_text(out / "cycle_path.csv", cycle_path_csv(result))
     stream = egm == "always" or (egm == "fallback" and text is None)
@@ -467,7 +462,7 @@ def write_cycle_run(
     for name in ("egm.mod", "EGM_SETUP.md"):
         old = out / name
         if name not in egm_files and old.is_file() and not old.is_symlink():
-            old.unlink()
+            remove_output(old)
     for name, body in egm_files.items():
         files[name] = atomic_write_text(out / name, body)
     if pareto is not None:

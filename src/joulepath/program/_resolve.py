@@ -256,11 +256,14 @@ def _move_step(
     tcp = tool_transform(tool)
     key = s.tool.lower()
     if key not in robots:
-        robots[key] = (
-            robot.with_payload(tool.mass_kg, com=np.asarray(tool.cog_mm) / 1000.0)
-            if tool.mass_kg > 0
-            else robot
-        )
+        try:
+            robots[key] = (
+                robot.with_payload(tool.mass_kg, com=np.asarray(tool.cog_mm) / 1000.0, what=f"tool {s.tool}")
+                if tool.mass_kg > 0
+                else robot
+            )
+        except InvalidInput as err:
+            raise module.error(s.line, str(err)) from err
     if s.instruction == "MoveAbsJ":
         if s.target_ref is not None:
             raise module.error(

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from joulepath._io import atomic_write_text, check_replaceable, make_folder
+from joulepath._io import atomic_write_text, check_replaceable, expect_outputs, make_folder
 from joulepath.data import (
     controller_log_text,
     generic_log_text,
@@ -165,6 +165,12 @@ def simulate_plan(
             if progress:
                 progress(results[-1])
         return results
+    expect_outputs(  # the workers write outside this command's journal
+        path
+        for name, _, _ in plan
+        for log in [Path(out) / "logs" / f"{name}.csv"]
+        for path in (log, moves_sidecar_path(log), Path(out) / f"{name}.parquet")
+    )
     with ProcessPoolExecutor(max_workers=workers) as pool:
         futures = [
             pool.submit(_plan_job, name, plant, n, child, str(out), robot)

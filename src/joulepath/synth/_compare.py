@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from joulepath._io import atomic_write_bytes
+from joulepath._io import atomic_write_bytes, make_folder
 from joulepath._typing import FloatArray
 from joulepath.data import EnergyTable
 from joulepath.errors import InvalidInput
@@ -209,7 +209,7 @@ def plot_distributions(
     if not isinstance(bins, int) or bins < 2:
         raise InvalidInput(f"bins must be an integer >= 2, got {bins!r}")
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     written = []
     for group, wanted in (groups or FEATURE_GROUPS).items():
         cols = [c for c in wanted if c in shared]
