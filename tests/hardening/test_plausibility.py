@@ -81,7 +81,7 @@ def _set(path: str, value):
         (lambda d: d["friction"]["stribeck"].__setitem__(5, -1.0), "stribeck friction of joint 6 is -1"),
         (
             lambda d: d["friction"]["coulomb"].__setitem__(1, 1e300),
-            "friction torque of joint 2 is 1e+300 N·m",
+            "friction.coulomb: expected a list of 6 finite numbers of magnitude at most 1e12",
         ),
         (lambda d: d["friction"]["offset"].__setitem__(2, -1e6), "friction torque of joint 3 is 1e+06 N·m"),
         (lambda d: d["friction"]["viscous"].__setitem__(3, 1e5), "viscous friction torque of joint 4"),

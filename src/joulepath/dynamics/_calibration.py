@@ -139,7 +139,8 @@ def _is_number(value: Any) -> bool:
 def _floats(value: Any, where: str, n: int) -> tuple[float, ...]:
     if not isinstance(value, list) or len(value) != n or not all(_is_number(v) for v in value):
         raise InvalidRobotDescription(
-            f"{where}: expected a list of {n} finite numbers (one per joint, not true/false)"
+            f"{where}: expected a list of {n} finite numbers of magnitude at most 1e12 "
+            "(one per joint, not true/false)"
         )
     return tuple(float(v) for v in value)
 
