@@ -32,6 +32,7 @@ from joulepath.energy._drives import (
     DriveModel,
     drives_toml,
     read_drives_file,
+    read_drives_toml,
 )
 from joulepath.energy._joint import MODES, PathEnergy, joint_energy, joint_power, path_energy, total_energy
 from joulepath.energy._measures import (
@@ -77,6 +78,7 @@ __all__ = [
     "motor_side_torque",
     "path_energy",
     "read_drives_file",
+    "read_drives_toml",
     "register_measure",
     "thesis_power",
     "total_energy",

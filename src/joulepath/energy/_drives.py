@@ -167,6 +167,27 @@ def _per_joint(raw: Any, where: str, n: int) -> tuple[float, ...]:
     return (_number(raw, where),) * n
 
 
+def read_drives_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The TOML table of a drives file, unchecked beyond being one (a regular file of at most 64 KiB).
+
+    Raises
+    ------
+    InvalidInput
+        Not a regular readable file, larger than 64 KiB, or not TOML; one line naming the file.
+    """
+    p = Path(path)
+    try:
+        if not p.is_file():
+            raise InvalidInput(f"{p}: not a regular file; a drives file is a TOML file")
+        if p.stat().st_size > MAX_DRIVES_BYTES:
+            raise InvalidInput(f"{p}: is larger than {MAX_DRIVES_BYTES >> 10} KiB; is it a drives file?")
+        return tomllib.loads(p.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise InvalidInput(f"{p}: cannot be read ({err.strerror})") from err
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        raise InvalidInput(f"{p}: not a TOML drives file ({err})") from err
+
+
 def read_drives_file(path: str | os.PathLike[str], n_joints: int) -> DriveModel:
     """Read a drives file (TOML, data only; see the module docstring for the format).
 
@@ -179,16 +200,7 @@ def read_drives_file(path: str | os.PathLike[str], n_joints: int) -> DriveModel:
         the file and the key.
     """
     p = Path(path)
-    try:
-        if not p.is_file():
-            raise InvalidInput(f"{p}: not a regular file; a drives file is a TOML file")
-        if p.stat().st_size > MAX_DRIVES_BYTES:
-            raise InvalidInput(f"{p}: is larger than {MAX_DRIVES_BYTES >> 10} KiB; is it a drives file?")
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise InvalidInput(f"{p}: cannot be read ({err.strerror})") from err
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
-        raise InvalidInput(f"{p}: not a TOML drives file ({err})") from err
+    data = read_drives_toml(p)
     unknown = sorted(set(data) - _KEYS)
     if unknown:
         raise InvalidInput(f"{p}: unknown key {unknown[0]!r}; a drives file holds {sorted(_KEYS)}")

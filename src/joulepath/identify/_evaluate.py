@@ -45,7 +45,6 @@ import io
 import json
 import math
 import os
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -57,17 +56,10 @@ from joulepath._typing import FloatArray
 from joulepath.data import find_gaps, read_log, segment_moves
 from joulepath.data._features import REST_SPEED
 from joulepath.dynamics import Robot
-from joulepath.energy import joint_energy
+from joulepath.energy import DRIVES_SUFFIX, TWIN_DRIVES_FILE, joint_energy, read_drives_toml
 from joulepath.errors import InvalidInput
 from joulepath.identify._data import _central
 from joulepath.identify._fit import r2_per_joint
-
-DRIVES_SUFFIX = ".drives.toml"
-"""A robot's drive data sit beside its description: ``ur5.urdf`` -> ``ur5.drives.toml``."""
-TWIN_DRIVES_FILE = "drives.toml"
-"""A twin folder's drive data."""
-MAX_DRIVES_BYTES = 64 << 10
-"""Largest drives file read (a drives file is a few lines)."""
 
 MOVE_COLUMNS = ("move", "t_start", "t_end", "energy_measured_J", "energy_predicted_J", "error_pct")
 """Columns of ``moves.csv``."""
@@ -132,14 +124,7 @@ def read_drive_gains(path: str | os.PathLike[str], n_joints: int) -> DriveGains:
         is not ``n_joints`` positive finite numbers.
     """
     p = Path(path)
-    try:
-        if p.stat().st_size > MAX_DRIVES_BYTES:
-            raise InvalidInput(f"{p}: {p.stat().st_size} bytes; a drives file is at most {MAX_DRIVES_BYTES}")
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as err:
-        raise InvalidInput(f"{p}: cannot be read as a drives file ({err})") from err
-    except tomllib.TOMLDecodeError as err:
-        raise InvalidInput(f"{p}: not a TOML drives file ({err})") from err
+    data = read_drives_toml(p)
     k = data.get("torque_constant")
     fix = f"give torque_constant = [...] with {n_joints} numbers > 0 (N·m/A, joint side)"
     if k is None:
