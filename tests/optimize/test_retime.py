@@ -211,7 +211,8 @@ def test_shortest_on_path_with_a_jerk_limit_is_feasible_and_tight(irb120, lines,
         assert not retime_on_path(irb120, line.path, 0.98 * fastest, **kwargs).feasible
 
 
-def test_search_gradients_match_finite_differences(irb120, lines, limits):
+@pytest.mark.parametrize("measure", ["thesis", "electrical"])
+def test_search_gradients_match_finite_differences(irb120, lines, limits, measure):
     line = lines["fast"]
     duration = 0.8
     timing = _timing(duration, True, True)
@@ -232,6 +233,8 @@ def test_search_gradients_match_finite_differences(irb120, lines, limits):
         amax=limits[0],
         jmax=limits[1],
         tcp_speed=line.v_tcp,
+        measure=measure,
+        drivetrain=irb120.drivetrain,
     )
     x = np.sort(np.random.default_rng(3).uniform(0.05, 0.95, timing.n_free))
     h = 1e-6
@@ -276,3 +279,44 @@ def test_retime_on_path_free_end_keeps_the_path_and_its_start_at_rest(irb120, li
     assert r.s[-1] == pytest.approx(1.0, abs=1e-12)
     np.testing.assert_allclose(r.fine.qd[0], 0.0, atol=1e-9)
     assert r.energy_J <= r.start_energy_J
+
+
+def test_retime_on_path_minimizes_the_measure_it_is_given(irb120, lines, limits):
+    """Re-timed on the electrical measure, a MoveL spends no more at the cabinet than the same line
+    re-timed on the thesis' metric, measured electrically (and the reverse on the thesis' metric)."""
+    line = lines["slow"]
+    kwargs = dict(acceleration_limit=limits[0], tcp_speed_limit=line.v_tcp, tcp=TOOL)
+    duration = 1.3 * shortest_on_path(irb120, line.path, **kwargs) if _has_toppra() else 2.0
+    by = {
+        m: retime_on_path(irb120, line.path, duration, energy_measure=m, **kwargs)
+        for m in ("thesis", "electrical")
+    }
+    assert all(r.feasible for r in by.values())
+    on = {
+        (m, k): energy_on_samples(irb120, r.fine, friction=NOMINAL_FRICTION, measure=k)
+        for m, r in by.items()
+        for k in ("thesis", "electrical")
+    }
+    assert by["electrical"].energy_J == pytest.approx(on[("electrical", "electrical")])
+    assert on[("electrical", "electrical")] <= on[("thesis", "electrical")] * 1.002
+    assert on[("thesis", "thesis")] <= on[("electrical", "thesis")] * 1.002
+    assert by["electrical"].energy_J <= by["electrical"].start_energy_J * (1 + 1e-9)
+
+
+def test_retime_on_path_refuses_a_measure_without_its_data(tmp_path, lines, limits):
+    import shutil
+
+    import joulepath
+    from joulepath.description import preset_path
+
+    urdf = tmp_path / "arm.urdf"  # the IRB 120 without its drives file beside it
+    shutil.copy(preset_path("irb120", fmt="urdf"), urdf)
+    bare = joulepath.load_robot(str(urdf))
+    with pytest.raises(InvalidInput, match="electrical energy needs drive data"):
+        retime_on_path(
+            bare, lines["slow"].path, 2.0, acceleration_limit=limits[0], energy_measure="electrical"
+        )
+
+
+def _has_toppra() -> bool:
+    return importlib.util.find_spec("toppra") is not None

@@ -42,7 +42,7 @@ a bound on ``ṡ``.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 import numpy as np
@@ -51,7 +51,7 @@ from scipy.optimize import minimize
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Friction, Robot, friction_derivative
-from joulepath.energy import thesis_power
+from joulepath.energy import DEFAULT_MEASURE, Drivetrain, SmoothPower, check_measure, measure_power
 from joulepath.errors import InvalidInput
 from joulepath.optimize._verify import check_limits, energy_on_samples
 from joulepath.sim._profile import Profile, evaluate_profile, plan_profile
@@ -96,7 +96,8 @@ class Retimed:
     duration : float
         s, exactly the one asked for.
     energy_J : float
-        ``Σ |tau · qd| dt`` on :attr:`fine` (J).
+        The motion energy on the measure asked for (``thesis``: ``Σ |tau · qd| dt``) on
+        :attr:`fine` (J).
     fine : Trajectory
         The motion on a grid of at most 2.5 ms, its last sample at the end.
     samples : Trajectory
@@ -197,6 +198,8 @@ class _Limits:
     jmax: FloatArray | None
     tcp_speed: float | None
     tcp: FloatArray | None
+    measure: str = DEFAULT_MEASURE
+    drivetrain: Drivetrain = field(default_factory=Drivetrain)
 
 
 def _motion(
@@ -332,6 +335,8 @@ class _Search:
     amax: FloatArray
     jmax: FloatArray | None
     tcp_speed: float | None
+    measure: str = DEFAULT_MEASURE
+    drivetrain: Drivetrain = field(default_factory=Drivetrain)
 
     def state(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         return self.b0 @ x + self.off0, self.b1 @ x + self.off1, self.b2 @ x + self.off2
@@ -366,7 +371,8 @@ class _Search:
         if self.friction is not None:
             tau = tau + self.friction.torque(qd)
             fd = friction_derivative(self.friction, qd)
-        power = thesis_power(tau, qd, _EPS_POWER)  # Σ |tau qd| smoothed, and its derivatives
+        # the measure's power (thesis: Σ |tau qd|), smoothed, and its derivatives
+        power: SmoothPower = measure_power(self.measure, tau, qd, self.drivetrain, eps=_EPS_POWER)
         dqd_ds = p["dq1"] * sd
         dtau_ds = p["dm"] * sdd + p["dc"] * sd * sd + p["dg"] + fd * dqd_ds
         dtau_dsd = 2.0 * p["c"] * sd + fd * p["q1"]
@@ -434,6 +440,8 @@ def _search(
         amax=limits.amax,
         jmax=limits.jmax,
         tcp_speed=limits.tcp_speed,
+        measure=limits.measure,
+        drivetrain=limits.drivetrain,
     )
     n = x0.size
     order = np.zeros((n + 1, n))  # x_0 >= 0, x_{i+1} - x_i >= 0, 1 - x_{n-1} >= 0
@@ -481,7 +489,7 @@ def _measure(
     t = _grid(duration, FINE_DT)
     s, sd, sdd = law(t)
     fine = _motion(at, np.clip(s, 0.0, 1.0), sd, sdd, t)
-    energy = energy_on_samples(robot, fine, friction=limits.friction)
+    energy = energy_on_samples(robot, fine, friction=limits.friction, measure=limits.measure)
     report = check_limits(
         robot, fine, friction=limits.friction, acceleration_limit=limits.amax, jerk_limit=limits.jmax
     )
@@ -512,6 +520,7 @@ def retime_on_path(
     friction: Friction | None = NOMINAL_FRICTION,
     start_at_rest: bool = True,
     end_at_rest: bool = True,
+    energy_measure: str = DEFAULT_MEASURE,
 ) -> Retimed:
     """The least-energy timing ``s(t)`` of a fixed joint path in exactly ``duration`` s.
 
@@ -535,6 +544,9 @@ def retime_on_path(
         Added to the rigid-body torque in the energy (default: the nominal friction).
     start_at_rest, end_at_rest : bool
         Zero ``ṡ`` and ``s̈`` at that end (else both are free there).
+    energy_measure : str
+        The energy minimized and reported (:data:`joulepath.energy.MEASURES`; its motion energy,
+        standby excluded: at a fixed duration the standby is the same for every timing).
 
     Returns
     -------
@@ -571,7 +583,8 @@ def retime_on_path(
         robot, path, acceleration_limit=amax, jerk_limit=jmax, tcp_speed_limit=tcp_speed_limit, tcp=tcp
     )
     start = _stretched(fastest, duration)
-    limits = _Limits(friction, amax, jmax, tcp_speed_limit, tcp)
+    check_measure(energy_measure, robot.drivetrain)
+    limits = _Limits(friction, amax, jmax, tcp_speed_limit, tcp, energy_measure, robot.drivetrain)
     timing = _timing(duration, start_at_rest, end_at_rest)
     t = _grid(duration, FINE_DT)
     x = _search(robot, at, timing, t, _fit_start(timing, t, evaluate_profile(start, t)[0]), limits)

@@ -1078,6 +1078,7 @@ class CycleOptimizer:
             jerk_limit=self._jmax(robot),
             tcp_speed_limit=m.step.speed.v_tcp / 1000.0,
             tcp=m.step.tcp,
+            energy_measure=self.settings.energy,
         )
         self.n_solves += 1
         e, e_lab = _energy(robot, self.plant(robot), r.fine, self.settings.energy)
