@@ -309,3 +309,52 @@ ENDMODULE
     taught = opt.taught(i).energy_J
     assert best.energy_J < taught
     assert (taught - plan.energy_J) >= 0.9 * (taught - best.energy_J)
+
+
+KINDS = """MODULE Kinds
+    CONST jointtarget jHome := [[0, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST jointtarget jSide := [[-40, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pA := [[400, -150, 250], [0, 0, 1, 0], [-1, 0, -1, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pAUp := [[400, -150, 350], [0, 0, 1, 0], [-1, 0, -1, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pB := [[350, 200, 250], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST robtarget pBUp := [[350, 200, 350], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    PROC main()
+        MoveAbsJ jHome, v1000, fine, tool0;
+        MoveAbsJ jSide, v1000, z50, tool0;
+        MoveJ pBUp, v1000, fine, tool0;
+        MoveL pB, v300, fine, tool0;
+        WaitTime 0.2;
+        MoveL pBUp, v300, z20, tool0;
+        MoveJ pAUp, v1000, z20, tool0;
+        MoveL pA, v300, fine, tool0;
+        MoveAbsJ jHome, v1000, fine, tool0;
+    ENDPROC
+ENDMODULE
+"""
+
+
+def test_for_every_move_kind_the_optimizer_moves_as_fast_as_the_controller(robot):
+    """One model of the motion: for every kind of unit (a chain of joint moves through a zone from
+    rest to rest, a single joint move from rest to rest, a MoveL from rest to rest, a MoveJ blended
+    between MoveL), the optimizer's own motion, not the taught candidate, is within every limit at
+    the controller's duration or shorter, so the taught cycle time never needs the taught motion."""
+    pytest.importorskip("toppra")
+    spec = resolve_module(parse_module(KINDS, path="kinds.mod"), robot)
+    opt = CycleOptimizer(spec, CycleSettings(gradient=FAST))
+    kinds = {"chain": 0, "single": 0, "linear": 0, "within": 0}
+    for i, members in opt.chains.items():
+        span = opt.span[i]
+        if i in opt.linear:
+            kinds["linear"] += 1
+            assert opt.t_lo[i] <= span + 0.025  # TOPP-RA's shortest, whole samples, within the speeddata
+            assert opt.solve(i, float(np.ceil(span / 0.025 - 1e-9) * 0.025)).usable
+        elif i in opt.within:
+            kinds["within"] += 1
+            assert opt.solve(i, round(span / 0.025) * 0.025).usable  # its window is whole samples
+        else:
+            kinds["chain" if len(members) > 1 else "single"] += 1
+            own = opt.solve_on_taught(i)  # the optimizer's shape at the taught duration
+            assert own is not None and own.usable, own.limit_excess if own else "under 0.15 s"
+            assert own.duration == pytest.approx(span)
+    assert all(kinds.values()), kinds
+    assert opt.shortest_cycle <= opt.plan.cycle_time + 1e-9
