@@ -18,13 +18,18 @@ from joulepath.sim._timing import _tcp
 FAST = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), max_iter=60, coarse_factor=1)
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "pick_and_place.mod"
 
-BLENDED = """MODULE Blended
-    CONST jointtarget jHome := [[0, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+TARGETS = """    CONST jointtarget jHome := [[0, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
     CONST robtarget pA := [[400, -150, 250], [0, 0, 1, 0], [-1, 0, -1, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
     CONST robtarget pAUp := [[400, -150, 350], [0, 0, 1, 0], [-1, 0, -1, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
     CONST robtarget pB := [[350, 200, 250], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
     CONST robtarget pBUp := [[350, 200, 350], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-    PROC main()
+"""
+
+BLENDED = (
+    """MODULE Blended
+"""
+    + TARGETS
+    + """    PROC main()
         MoveAbsJ jHome, v1000, fine, tool0;
         MoveJ pAUp, v1000, z50, tool0;
         MoveL pA, v300, fine, tool0;
@@ -38,6 +43,7 @@ BLENDED = """MODULE Blended
     ENDPROC
 ENDMODULE
 """
+)
 
 
 @pytest.fixture(scope="module")
@@ -311,14 +317,12 @@ ENDMODULE
     assert (taught - plan.energy_J) >= 0.9 * (taught - best.energy_J)
 
 
-KINDS = """MODULE Kinds
-    CONST jointtarget jHome := [[0, 0, 0, 0, 30, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+KINDS = (
+    """MODULE Kinds
     CONST jointtarget jSide := [[-40, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-    CONST robtarget pA := [[400, -150, 250], [0, 0, 1, 0], [-1, 0, -1, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-    CONST robtarget pAUp := [[400, -150, 350], [0, 0, 1, 0], [-1, 0, -1, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-    CONST robtarget pB := [[350, 200, 250], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-    CONST robtarget pBUp := [[350, 200, 350], [0, 0, 1, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-    PROC main()
+"""
+    + TARGETS
+    + """    PROC main()
         MoveAbsJ jHome, v1000, fine, tool0;
         MoveAbsJ jSide, v1000, z50, tool0;
         MoveJ pBUp, v1000, fine, tool0;
@@ -331,6 +335,7 @@ KINDS = """MODULE Kinds
     ENDPROC
 ENDMODULE
 """
+)
 
 
 def test_for_every_move_kind_the_optimizer_moves_as_fast_as_the_controller(robot):
