@@ -10,9 +10,10 @@
   lab data (train: 100 lab moves, test: 50 other lab moves), both input kinds.
 
 Usage: python benchmarks/learn.py
-       python benchmarks/learn.py --tour DATA TEST   (README tour: time ``joulepath train
-       --family all --grid quick`` on DATA/TEST, e.g. the tables of ``simulate --plan
-       thesis``; prints the timed progress lines, wall and CPU time; writes nothing)
+       python benchmarks/learn.py --tour DATA TEST   (the full-size train command of
+       docs/tutorials/thesis-method.md: time ``joulepath train --family all --grid quick``
+       on DATA/TEST, e.g. the tables of ``simulate --plan thesis``; prints the timed
+       progress lines, wall and CPU time; writes nothing)
 """
 
 from __future__ import annotations
@@ -142,7 +143,7 @@ def main() -> None:
 
 
 def tour(data: str, test: str) -> None:
-    """Time the README tour's train command as a user runs it (a real process, no terminal)."""
+    """Time the full-size train command (docs/tutorials/thesis-method.md) as a user runs it."""
     import os
     import resource
     import subprocess

@@ -1,6 +1,6 @@
 """Speed and physics-verified saving of ``--fitness surrogate`` (issue 11: learned model, <= 5 s per move).
 
-Trains learned energy models the way a user would (README, "Python API"): simulated
+Trains learned energy models the way a user would (docs/how-to/python.md): simulated
 lab-plant logs (``--train-moves`` training moves, ``--test-moves`` test moves on another
 seed), ``ingest``, ``train(..., TrainConfig(targets=("E",), cv=3, inputs="physics"))`` once
 per family (MLP, and the linear ``par`` family), ``best_model(dir, "E")``. Then, on the
@@ -63,7 +63,7 @@ CSV_PATH = ROOT / "benchmarks" / "results" / "optimizer_surrogate.csv"
 
 
 def train_models(families: list[str], n_train: int, n_test: int, robot: joulepath.Robot, tmp: Path):
-    """One best model for E per family, trained as the README shows; with its card's scores."""
+    """One best model for E per family, trained as docs/how-to/python.md shows; with its card's scores."""
     t0 = time.perf_counter()
     tr = ingest([simulate(tmp / "tr.csv", plant="lab", n_moves=n_train, seed=SEED).log], robot=robot)
     te = ingest([simulate(tmp / "te.csv", plant="lab", n_moves=n_test, seed=SEED + 1).log], robot=robot)
@@ -187,7 +187,7 @@ def main() -> None:
         f"Machine: {machine()}; one BLAS thread; run {time.strftime('%Y-%m-%d')}. "
         "The machine was shared with other jobs: CPU time per call (process_time) is given beside the wall.",
         "",
-        f'Learned models (trained as in the README\'s Python API, `inputs="physics"`, target E, cv=3, quick grid): '
+        f'Learned models (trained as in docs/how-to/python.md, `inputs="physics"`, target E, cv=3, quick grid): '
         f"simulated lab-plant logs, {n_tr_moves} training moves ({n_tr_rows:,} rows, seed {SEED}), "
         f"{n_te_moves} test moves ({n_te_rows:,} rows, seed {SEED + 1}); simulating and ingesting took {data_s:.0f} s.",
         "",

@@ -64,7 +64,7 @@ def test_panda_physics_optimization_stays_within_limits_and_exports_ros2(panda, 
     q0 = np.array([0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0])
     qf = np.array([1.0, 0.5, 0.5, -1.0, 0.5, 2.0, 0.5])
     # CMA-ES keeps this test short; the default gradient search needs minutes on this frictionless
-    # 7-joint move (README, "Other arms and controllers")
+    # 7-joint move (docs/tutorials/urdf-ros2.md)
     result = optimize_move(panda, q0, qf, 2.0, OptimizeConfig(algorithm="cmaes", evaluations=400, seed=3))
     s = result.summary
     assert s.limits_ok and s.algorithm == "cmaes" and s.energy_optimized_J <= s.energy_default_J

@@ -394,7 +394,7 @@ def test_cli_gap_is_noted_and_no_row_spans_it(tmp_path, signals, capsys):
 
 
 def test_simulated_lab_log_ingests_with_its_robot(tmp_path, irb120):
-    """The README tour: a log that `simulate` writes is accepted by `ingest --robot irb120`.
+    """The tutorials' step: a log that `simulate` writes is accepted by `ingest --robot irb120`.
 
     The emulated controller's zone blends pass joint 6's nominal speed limit by up to about
     1.7 times (seed 0, 1000 moves); the unit check must not take that for degrees.

@@ -216,18 +216,20 @@ def test_api_reference_has_a_page_per_public_module():
 
 
 def _documented_command_lines() -> list[tuple[str, str]]:
-    """``(page, line)`` of every ``joulepath ...`` line in docs/ bash blocks (continued lines joined)."""
+    """``(page, line)`` of every ``joulepath ...`` line in the bash blocks of docs/ and of the
+    README (continued lines joined)."""
     found = []
-    for page in sorted(DOCS.rglob("*.md")):
+    for page in [*sorted(DOCS.rglob("*.md")), ROOT / "README.md"]:
         for block in re.findall(r"```bash\n(.*?)```", page.read_text(encoding="utf-8"), flags=re.S):
             for line in block.replace("\\\n", " ").splitlines():
                 if line.strip().startswith("joulepath "):
-                    found.append((str(page.relative_to(DOCS)), line.strip()))
+                    found.append((str(page.relative_to(ROOT)), line.strip()))
     return found
 
 
 def test_documented_commands_and_options_exist():
-    """Every ``joulepath`` command line in the docs names a real command and only its real options."""
+    """Every ``joulepath`` command line in the docs and the README names a real command and only its
+    real options."""
     import typer.main
 
     from joulepath.cli._main import app
@@ -236,6 +238,7 @@ def test_documented_commands_and_options_exist():
     root = group.context_class(group, info_name="joulepath")
     lines = _documented_command_lines()
     assert len(lines) > 30
+    assert sum(page == "README.md" for page, _ in lines) >= 8, "the README's quick starts"
     for page, line in lines:
         argv = shlex.split(line.replace("<PC address>", "HOST"), comments=True)[1:]
         cmd, ctx = group, root
@@ -248,3 +251,14 @@ def test_documented_commands_and_options_exist():
         for token in argv:
             if token.startswith("--"):
                 assert token.split("=")[0] in known, f"{page}: `{line}` has no option {token}"
+
+
+def test_exit_codes_page_lists_every_work_limit():
+    """docs/reference/exit-codes.md states each work limit with its variable and its default."""
+    from joulepath._work import WORK_LIMITS
+
+    page = (DOCS / "reference" / "exit-codes.md").read_text(encoding="utf-8")
+    for name, limit in WORK_LIMITS.items():
+        row = re.search(rf"^\| `{name.upper()}` \| ([\d.]+) \|", page, flags=re.M)
+        assert row, f"exit-codes.md has no row for JOULEPATH_MAX_{name.upper()}"
+        assert float(row.group(1)) == limit.default, (name, row.group(1), limit.default)
