@@ -54,7 +54,7 @@ class EnergyMeasure:
                 f"the {self.name} energy needs drive data (torque constants, winding resistances, drive "
                 f"efficiencies, bus kind, standby power): {drivetrain.drives_source}; provide a "
                 "<robot>.drives.toml beside the robot description, or drives.toml in a twin folder "
-                "(format: README, 'Energy measures')"
+                "(format: docs/reference/formats.md, 'Drives files')"
             )
         if "gear" in self.needs and drivetrain.gear_efficiency is None:
             return (

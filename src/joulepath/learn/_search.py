@@ -218,7 +218,7 @@ def _mlp_epochs_at(model: Any, m: int, n: int) -> float | None:
 
     More rows per epoch mean fewer epochs until the validation score stalls; we
     assume ``sqrt(m / n)`` times as many (never below ``n_iter_no_change + 1``). On the
-    README tour's table, 2,000 -> 56,236 rows took the quick grid's MLPs from 114 to 16
+    thesis-sized table, 2,000 -> 56,236 rows took the quick grid's MLPs from 114 to 16
     epochs (identity; sqrt predicts 22) and from 500 (max_iter) to 38 (relu; sqrt
     predicts 94), so the estimate errs high. None for other models.
     """

@@ -1,14 +1,14 @@
 """Support-vector regression that scales to the thesis' table sizes.
 
 libsvm's :class:`~sklearn.svm.SVR` costs between O(n²) and O(n³) in the rows: on
-the 70,000 rows of the README tour a single fit takes hours. :class:`ScalableSVR`
+a thesis-sized table (70,000 rows) a single fit takes hours. :class:`ScalableSVR`
 keeps the thesis' grid (Table 2.3: ``kernel``, ``degree``, ``gamma``, ``C``,
 ``epsilon``) and fits
 
 * ``kernel="linear"`` with :class:`~sklearn.svm.LinearSVR` (liblinear, linear in
   the rows). By default it minimises the *squared* epsilon-insensitive loss in the
   primal (``linear_loss="squared_epsilon_insensitive"``): on 56,000 rows of the
-  README tour that fit takes 2 s, where liblinear's dual solver for the thesis'
+  thesis-sized table that fit takes 2 s, where liblinear's dual solver for the thesis'
   plain epsilon-insensitive loss stops at 1,000 iterations unconverged after
   170 s (measured; test R² 0.998 vs 0.996). ``linear_loss="epsilon_insensitive"``
   keeps the thesis' loss;
