@@ -281,7 +281,10 @@ def test_refusals(plant, tmp_path, capsys):
             ["--payload-log", str(plant["payload"]), "--payload-mass", "5", "--payload-com", "0.05,0"],
             "--payload-com '0.05,0': give three numbers",
         ),
-        ([], "does not fix the torque constant of joint(s) 6"),  # nominal: the bare wrist holds no torque
+        (
+            [],
+            "too small against the logged current (friction) to scale it; give a payload log",
+        ),  # bare wrist 3
         (  # 20 g: the payload's effect is below the noise
             ["--payload-log", str(plant["payload"]), "--payload-mass", "0.02", "--payload-com", "0,0,0.01"],
             "below the noise",

@@ -42,13 +42,12 @@ model; :func:`identified_drives` turns the gains into the twin's drives file
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares, minimize_scalar
+from scipy.optimize import least_squares
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot, motor_torque
@@ -57,13 +56,13 @@ from joulepath.energy._drives import ASSUMED
 from joulepath.errors import InvalidInput
 from joulepath.identify._data import IdentificationData
 from joulepath.identify._fit import (
-    ETA_BOUNDS,
     Identification,
     IdentifyOptions,
     _check_motion,
     gear_side_speed,
     identify,
     joint_side,
+    search_eta,
 )
 from joulepath.identify._regressor import base_parameters, friction_regressor, inertial_regressor
 
@@ -139,6 +138,10 @@ class DriveGainFit:
     reference_note: str
     sources: tuple[str, ...]
 
+    def __post_init__(self) -> None:
+        if self.reference not in REFERENCES:
+            raise InvalidInput(f"reference must be one of {', '.join(REFERENCES)}, got {self.reference!r}")
+
     def source_text(self) -> str:
         """Where the gains come from: the drives file's ``[sources]`` entry."""
         names = ", ".join(Path(s).name for s in self.sources)
@@ -184,13 +187,6 @@ def _diagonal(values: FloatArray) -> FloatArray:
     idx = np.arange(n)
     out[:, idx, idx] = values
     return out
-
-
-def _search_eta(cost: Callable[[float], float], fixed: float | None) -> float:
-    if fixed is not None:
-        return fixed
-    best = minimize_scalar(cost, bounds=ETA_BOUNDS, method="bounded", options={"xatol": 1e-5})
-    return float(best.x)
 
 
 def _standard_errors(Mw: FloatArray, rw: FloatArray) -> FloatArray:
@@ -342,7 +338,7 @@ def _fit_sets(
         def cost(e: float, w: FloatArray = w) -> float:
             return float((_solve_linear(sets, prior, w, e)[2] ** 2).sum())
 
-        eta = _search_eta(cost, options.gear_efficiency)
+        eta = search_eta(cost, options.gear_efficiency)
         x, k, res = _solve_linear(sets, prior, w, eta)
         if not np.all(k > 0):
             break

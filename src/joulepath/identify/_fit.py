@@ -29,6 +29,7 @@ Steps (:func:`identify`):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -334,6 +335,14 @@ def score_prediction(pred: FloatArray, data: IdentificationData) -> FitScores:
     )
 
 
+def search_eta(cost: Callable[[float], float], fixed: float | None) -> float:
+    """The gear efficiency in :data:`ETA_BOUNDS` of least ``cost`` (a bounded scalar search), or ``fixed``."""
+    if fixed is not None:
+        return fixed
+    best = minimize_scalar(cost, bounds=ETA_BOUNDS, method="bounded", options={"xatol": 1e-5})
+    return float(best.x)
+
+
 class _Problem:
     """The stacked weighted least-squares problem of one data set."""
 
@@ -352,12 +361,7 @@ class _Problem:
             pred = motor_torque(self.A @ x, self.qd, e)
             return float((((pred - self.tau) * w) ** 2).sum()), x
 
-        if eta is not None:
-            return eta, fit(eta)[1]
-        best = minimize_scalar(
-            lambda e: fit(e)[0], bounds=ETA_BOUNDS, method="bounded", options={"xatol": 1e-5}
-        )
-        e = float(best.x)
+        e = search_eta(lambda e: fit(e)[0], eta)
         return e, fit(e)[1]
 
 
@@ -550,4 +554,5 @@ __all__ = [
     "joint_side",
     "r2_per_joint",
     "score_prediction",
+    "search_eta",
 ]
