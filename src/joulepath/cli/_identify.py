@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import typer
@@ -36,6 +37,20 @@ def identify(
     max_condition: float = typer.Option(
         1e4, "--max-condition", min=1.0, help="Refuse logs whose stacked regressor is worse conditioned."
     ),
+    payload_log: Path = typer.Option(
+        None,
+        "--payload-log",
+        help="A log of currents (i1..in, A) of the robot carrying a known payload: the scale between "
+        "current and torque (default: the description's nominal masses).",
+    ),
+    payload_mass: float = typer.Option(
+        0.0, "--payload-mass", min=0.0, help="kg: the mass of the payload in --payload-log."
+    ),
+    payload_com: str = typer.Option(
+        "",
+        "--payload-com",
+        help="X,Y,Z: the payload's centre of mass in the flange (tool0) frame, m (e.g. 0.05,0,0.08).",
+    ),
     force: bool = typer.Option(False, "--force", help="Replace a twin already in --out."),
     unchecked: bool = unchecked_option(),
 ) -> int:
@@ -44,14 +59,33 @@ def identify(
     Writes a twin folder that every command takes as --robot FOLDER. Logs that cannot
     identify the model (too short, a joint that never moves, a badly conditioned
     regressor) are refused with the reason; nothing is written then.
+
+    Logs of motor currents (i1..in, no torques) also give the drives' joint-side torque
+    constants (N·m/A), written to the twin's drives.toml. The scale between current and
+    torque comes from --payload-log with --payload-mass and --payload-com (a payload of
+    known mass), else from the description's nominal masses; the output says which.
     """
     from joulepath.dynamics import TWIN_CARD_FILE, TWIN_FRICTION_FILE, TWIN_ROBOT_FILE
+    from joulepath.energy import TWIN_DRIVES_FILE
     from joulepath.errors import InvalidInput
-    from joulepath.identify import IdentifyOptions, data_from_logs, write_twin
+    from joulepath.identify import (
+        IdentifyOptions,
+        PayloadReference,
+        data_from_logs,
+        identified_drives,
+        identify_from_currents,
+        logged_signal,
+        write_twin,
+    )
     from joulepath.identify import identify as run
 
-    files = (TWIN_ROBOT_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE)
-    check_out_folder(out, files=files, inputs=[*map(str, logs), *robot_inputs(robot)])
+    com = _payload_options(payload_log, payload_mass, payload_com)
+    inputs = [*map(str, logs), *([str(payload_log)] if payload_log else []), *robot_inputs(robot)]
+    signal = "current" if payload_log is not None else logged_signal(logs)
+    files: tuple[str, ...] = (TWIN_ROBOT_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE)
+    if signal == "current":
+        files = (*files, TWIN_DRIVES_FILE)
+    check_out_folder(out, files=files, inputs=inputs)
     existing = [name for name in files if (out / name).exists()]
     if existing and not force:
         raise InvalidInput(
@@ -67,26 +101,70 @@ def identify(
         holdout=holdout,
     )
     with console.status(f"reading {len(logs)} log(s)..."):
-        data = data_from_logs(logs, nominal)
-    with console.status(f"identifying from {data.n_samples:,} samples..."):
-        result = run(data, nominal, options)
-    write_twin(result, nominal, out)
+        data = data_from_logs(logs, nominal, signal=signal)
+        payload = None
+        if payload_log is not None and com is not None:
+            payload = PayloadReference(
+                data=data_from_logs([payload_log], nominal, signal="current"), mass=payload_mass, com=com
+            )
+    if signal == "current":
+        with console.status(f"identifying drive gains and dynamics from {data.n_samples:,} samples..."):
+            both = identify_from_currents(data, nominal, options, payload=payload)
+        result, gains = both.identification, both.gains
+        drives = identified_drives(gains, nominal.drives, nominal.n_joints)
+        write_twin(result, nominal, out, extra=both.card(), drives=drives)
+        pairs = zip(gains.torque_constant, gains.relative_error, strict=True)
+        k = ", ".join(f"{v:.4g} ± {100 * e:.2g} %" for v, e in pairs)
+        console.print(f"drive gains k (N·m/A, joint side): {k}", markup=False)
+        console.print(f"scale reference: {gains.reference} ({gains.reference_note})", markup=False)
+    else:
+        with console.status(f"identifying from {data.n_samples:,} samples..."):
+            result = run(data, nominal, options)
+        write_twin(result, nominal, out)
     f = result.fit
+    what = "current" if signal == "current" else "torque"
     console.print(
         f"identified {result.base.n} base parameters and friction of {nominal.name} from {f.n_samples:,} "
         f"samples; condition number {result.condition_number:.1f} (least excited: {result.weakest}); "
         f"gear efficiency {result.gear_efficiency:.3f}; physically consistent: {result.consistent}"
     )
     console.print(
-        f"fit: torque R² {min(f.torque_r2):.4f} (worst joint), energy R² {f.energy_r2:.4f}",
+        f"fit: {what} R² {min(f.torque_r2):.4f} (worst joint), energy R² {f.energy_r2:.4f}",
         markup=False,
     )
     if result.held_out is not None:
         h = result.held_out
         console.print(
-            f"held out ({h.n_samples:,} samples): torque R² {min(h.torque_r2):.4f} (worst joint), "
+            f"held out ({h.n_samples:,} samples): {what} R² {min(h.torque_r2):.4f} (worst joint), "
             f"energy R² {h.energy_r2:.4f}, energy error {h.energy_error_pct:.2f} %",
             markup=False,
         )
     console.print(f"wrote {out}/: {', '.join(files)} (use it as --robot {out})")
     return 0
+
+
+def _payload_options(log: Path | None, mass: float, com: str) -> tuple[float, float, float] | None:
+    """The payload's centre of mass (m), or None without a payload log; one line for what is missing."""
+    from joulepath.errors import InvalidInput
+
+    if log is None:
+        if mass or com:
+            raise InvalidInput(
+                "--payload-mass and --payload-com describe the payload of --payload-log; give the log "
+                "of currents the robot made carrying it (--payload-log FILE)"
+            )
+        return None
+    if not mass > 0 or not com:
+        raise InvalidInput(
+            f"--payload-log {log} needs the payload's --payload-mass KG and --payload-com X,Y,Z (m, "
+            "flange frame): without them it fixes no scale"
+        )
+    try:
+        values = tuple(float(v) for v in com.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise InvalidInput(
+            f"--payload-com {com!r}: give three numbers X,Y,Z in m (flange frame), e.g. 0.05,0,0.08"
+        )
+    return (values[0], values[1], values[2])

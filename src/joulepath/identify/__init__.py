@@ -3,7 +3,9 @@
 Linear in the parameters (Gautier & Khalil): Pinocchio's joint torque regressor
 reduced to the identifiable base set by a pivoted QR, friction columns per joint,
 weighted least squares, a gear efficiency found by a scalar search, and a physically
-consistent refinement (log-Cholesky). The result writes a calibrated twin folder
+consistent refinement (log-Cholesky). From motor currents, the drives' torque
+constants too, scaled by a payload of known mass or the nominal masses
+(:func:`identify_from_currents`). The result writes a calibrated twin folder
 that :func:`joulepath.load_robot` reads back (``--robot twin/`` on the command line).
 """
 
@@ -14,7 +16,18 @@ from joulepath.identify._consistency import (
     to_log_cholesky,
     triangle_margins,
 )
-from joulepath.identify._data import IdentificationData, data_from_logs
+from joulepath.identify._currents import (
+    MAX_GAIN_ERROR,
+    NOMINAL_PRIOR_WEIGHT,
+    REFERENCES,
+    CurrentIdentification,
+    DriveGainFit,
+    PayloadReference,
+    fit_drive_gains,
+    identified_drives,
+    identify_from_currents,
+)
+from joulepath.identify._data import SIGNALS, IdentificationData, data_from_logs, logged_signal
 from joulepath.identify._evaluate import (
     EVALUATE_FILES,
     DriveGains,
@@ -36,6 +49,7 @@ from joulepath.identify._fit import (
     FitScores,
     Identification,
     IdentifyOptions,
+    gear_side_speed,
     identify,
     joint_side,
     r2_per_joint,
@@ -54,6 +68,8 @@ from joulepath.identify._twin import CARD_FORMAT, link_inertials, twin_descripti
 __all__ = [
     "BaseParameters",
     "CARD_FORMAT",
+    "CurrentIdentification",
+    "DriveGainFit",
     "DriveGains",
     "EVALUATE_FILES",
     "EvaluateConfig",
@@ -65,18 +81,28 @@ __all__ = [
     "IdentificationData",
     "IdentifyOptions",
     "MAX_CONDITION",
+    "MAX_GAIN_ERROR",
+    "NOMINAL_PRIOR_WEIGHT",
+    "PayloadReference",
     "RANK_TOLERANCE",
+    "REFERENCES",
+    "SIGNALS",
     "base_parameters",
     "data_from_logs",
     "design_excitation",
     "drives_path",
     "evaluate_model",
+    "fit_drive_gains",
     "friction_regressor",
     "from_log_cholesky",
+    "gear_side_speed",
+    "identified_drives",
     "identify",
+    "identify_from_currents",
     "inertial_regressor",
     "joint_side",
     "link_inertials",
+    "logged_signal",
     "min_eigenvalues",
     "pseudo_inertia",
     "r2_per_joint",

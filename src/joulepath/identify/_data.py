@@ -1,4 +1,4 @@
-"""Identification data: joint samples ``(q, qd, qdd, tau)`` from controller or generic logs.
+"""Identification data: joint samples ``(q, qd, qdd, tau)`` (or currents) from controller or generic logs.
 
 Accelerations: a log's own ``ddq`` columns when it has them (generic logs);
 otherwise the central difference of the logged joint speed on the log's own
@@ -15,7 +15,7 @@ from __future__ import annotations
 import hashlib
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +25,9 @@ from joulepath.data import find_gaps, is_moves_sidecar, read_log
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, InvalidLog
 
+SIGNALS = {"torque": "N·m", "current": "A"}
+"""What identification data hold per joint, and its unit."""
+
 
 @dataclass(frozen=True, slots=True, eq=False)
 class IdentificationData:
@@ -33,7 +36,8 @@ class IdentificationData:
     Attributes
     ----------
     q, qd, qdd, tau : ndarray of shape (N, n)
-        rad, rad/s, rad/s², N·m (``tau`` as logged: motor side when the drives measure it).
+        rad, rad/s, rad/s², and the logged drive signal: torque in N·m (motor side when the
+        drives measure it), or motor current in A when ``signal == "current"``.
     dt : ndarray of shape (N,)
         Length of each sample, s (for energies).
     stretch : ndarray of int, shape (N,)
@@ -41,6 +45,8 @@ class IdentificationData:
     sources : tuple of str
     data_hash : str
         SHA-256 of the logs' bytes (in the order given), or of the arrays.
+    signal : {"torque", "current"}
+        What ``tau`` holds (:data:`SIGNALS`); :meth:`scaled` turns currents into torques.
     """
 
     q: FloatArray
@@ -51,6 +57,22 @@ class IdentificationData:
     stretch: np.ndarray
     sources: tuple[str, ...] = ()
     data_hash: str = ""
+    signal: str = "torque"
+
+    def __post_init__(self) -> None:
+        if self.signal not in SIGNALS:
+            raise InvalidInput(f"signal must be one of {', '.join(SIGNALS)}, got {self.signal!r}")
+
+    @property
+    def unit(self) -> str:
+        """The unit of :attr:`tau` (``"N·m"`` or ``"A"``)."""
+        return SIGNALS[self.signal]
+
+    def scaled(self, gains: FloatArray) -> IdentificationData:
+        """Currents times per-joint torque constants ``gains`` (N·m/A): the same samples as torques."""
+        if self.signal != "current":
+            raise InvalidInput("only motor currents are scaled into torques; these data hold torques")
+        return replace(self, tau=self.tau * np.asarray(gains, dtype=float)[None, :], signal="torque")
 
     @property
     def n_samples(self) -> int:
@@ -71,6 +93,7 @@ class IdentificationData:
             stretch=self.stretch[mask],
             sources=self.sources,
             data_hash=self.data_hash,
+            signal=self.signal,
         )
 
     @classmethod
@@ -84,8 +107,12 @@ class IdentificationData:
         *,
         stretch: np.ndarray | None = None,
         source: str = "<arrays>",
+        signal: str = "torque",
     ) -> IdentificationData:
-        """Samples given directly (e.g. a plant's exact signals); checked for shape and finiteness."""
+        """Samples given directly (e.g. a plant's exact signals); checked for shape and finiteness.
+
+        ``tau`` holds torques (N·m), or motor currents (A) with ``signal="current"``.
+        """
         arrays = [np.asarray(a, dtype=float) for a in (q, qd, qdd, tau)]
         shape = arrays[0].shape
         if len(shape) != 2 or any(a.shape != shape for a in arrays):
@@ -108,6 +135,7 @@ class IdentificationData:
             stretch=lab,
             sources=(source,),
             data_hash=h.hexdigest(),
+            signal=signal,
         )
 
 
@@ -117,8 +145,34 @@ def _central(qd: FloatArray, t: FloatArray) -> FloatArray:
     return out
 
 
-def data_from_logs(paths: Sequence[str | os.PathLike[str]], robot: Robot) -> IdentificationData:
+def logged_signal(paths: Sequence[str | os.PathLike[str]]) -> str:
+    """What identification reads from the logs: ``"torque"`` when each logs ``tau{k}``, else ``"current"``.
+
+    Raises
+    ------
+    InvalidLog
+        A log that cannot be read, or logs of which some hold neither torques nor
+        currents for a signal the others hold (mixed torque-only and current-only logs).
+    """
+    logs = [read_log(Path(p)) for p in paths if not is_moves_sidecar(p)]
+    if all(log.tau is not None for log in logs):
+        return "torque"
+    missing = [log.source for log in logs if log.current is None]
+    if missing:
+        raise InvalidLog(
+            f"{missing[0]}: logs joint torques but no motor currents, while other logs hold currents "
+            "only; identify from one kind of log: all with torques tau{k}, or all with currents i{k}"
+        )
+    return "current"
+
+
+def data_from_logs(
+    paths: Sequence[str | os.PathLike[str]], robot: Robot, *, signal: str = "torque"
+) -> IdentificationData:
     """Read controller or generic logs of ``robot`` (see the module docstring for ``qdd``).
+
+    ``signal="current"`` reads the motor currents ``i{k}`` (A) of generic logs in place of
+    the torques (:attr:`IdentificationData.signal`).
 
     Raises
     ------
@@ -128,6 +182,8 @@ def data_from_logs(paths: Sequence[str | os.PathLike[str]], robot: Robot) -> Ide
     InvalidInput
         The robot's joint count differs from the logs'.
     """
+    if signal not in SIGNALS:
+        raise InvalidInput(f"signal must be one of {', '.join(SIGNALS)}, got {signal!r}")
     from joulepath.data._table import _check_limits  # the ingest check: ranges and speeds, named
 
     files = [Path(p) for p in paths if not is_moves_sidecar(p)]
@@ -142,7 +198,15 @@ def data_from_logs(paths: Sequence[str | os.PathLike[str]], robot: Robot) -> Ide
     n_stretch = 0
     for path in files:
         log = read_log(path)
-        tau = log.torques("identification")
+        if signal == "current":
+            if log.current is None:
+                raise InvalidLog(
+                    f"{path}: logs no motor currents; identifying from currents needs i1..i"
+                    f"{log.q.shape[1]} (A) in every log"
+                )
+            tau = log.current
+        else:
+            tau = log.torques("identification")
         if log.q.shape[1] != robot.n_joints:
             raise InvalidInput(
                 f"{path}: the log has {log.q.shape[1]} joints but robot {robot.name!r} has "
@@ -177,7 +241,8 @@ def data_from_logs(paths: Sequence[str | os.PathLike[str]], robot: Robot) -> Ide
         stretch=np.concatenate(labels),
         sources=tuple(str(p) for p in files),
         data_hash=h.hexdigest(),
+        signal=signal,
     )
 
 
-__all__ = ["IdentificationData", "data_from_logs"]
+__all__ = ["IdentificationData", "SIGNALS", "data_from_logs", "logged_signal"]

@@ -59,7 +59,7 @@ from joulepath.dynamics import Robot
 from joulepath.energy import DRIVES_SUFFIX, TWIN_DRIVES_FILE, joint_energy, read_drives_toml
 from joulepath.errors import InvalidInput
 from joulepath.identify._data import _central
-from joulepath.identify._fit import r2_per_joint
+from joulepath.identify._fit import gear_side_speed, r2_per_joint
 
 MOVE_COLUMNS = ("move", "t_start", "t_end", "energy_measured_J", "energy_predicted_J", "error_pct")
 """Columns of ``moves.csv``."""
@@ -378,10 +378,14 @@ def _rest_poses(s: _Samples, min_samples: int) -> list[np.ndarray]:
 
 
 def predict_torque(robot: Robot, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
-    """Torque as the drives log it: rigid body plus the robot's friction, through a twin's gear losses."""
+    """Torque as the drives log it: rigid body plus the robot's friction, through a twin's gear losses.
+
+    The side of the gear losses is decided by :func:`~joulepath.identify.gear_side_speed`
+    (a logged speed within the rest speed is rest).
+    """
     tau = robot.inverse_dynamics(q, qd, qdd, friction=robot.friction)
     if robot.calibration is not None:
-        tau = robot.calibration.motor_torque(tau, qd)
+        tau = robot.calibration.motor_torque(tau, gear_side_speed(qd))
     return tau
 
 

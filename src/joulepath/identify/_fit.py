@@ -28,6 +28,8 @@ Steps (:func:`identify`):
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -53,6 +55,10 @@ REST_SPEED = np.radians(1.0)
 MIN_TORQUE_SPREAD = 1e-6
 """N·m: a joint whose logged torque varies less (standard deviation) holds no torque information."""
 """A joint whose logged speed never exceeds this (rad/s) never moved: its friction cannot be identified."""
+
+GEAR_REST_SPEED = 0.005
+"""rad/s: an arm whose every logged joint speed is within this is at rest for the side of the gear
+losses (:func:`gear_side_speed`); the width of the friction model's ``sign(qd)`` by default."""
 
 MAX_CONDITION = 1e4
 """Default refusal threshold of the condition number of the column-normalised stacked regressor."""
@@ -85,6 +91,10 @@ class IdentifyOptions:
         Refuse data whose stacked, column-normalised regressor has a larger condition number.
     holdout : float
         Share of the samples (the last ones, in log order) kept out of the fit and scored.
+    rest_speed : float
+        rad/s: a sample whose every joint speed is within this counts as the arm at rest
+        for the side of the gear losses (:func:`gear_side_speed`): logged speeds that small
+        are sensor noise. 0 for exact speeds (a plant's signals).
     """
 
     offset: bool = True
@@ -96,6 +106,7 @@ class IdentifyOptions:
     prior_weight: float = 1e-4
     max_condition: float = MAX_CONDITION
     holdout: float = 0.0
+    rest_speed: float = GEAR_REST_SPEED
 
     def __post_init__(self) -> None:
         if not self.smoothing > 0:
@@ -110,6 +121,8 @@ class IdentifyOptions:
             raise InvalidInput(f"gear efficiency must be in (0, 1], got {self.gear_efficiency}")
         if not 0.0 <= self.holdout < 0.9:
             raise InvalidInput(f"holdout must be a share in [0, 0.9), got {self.holdout}")
+        if not (math.isfinite(self.rest_speed) and self.rest_speed >= 0):
+            raise InvalidInput(f"rest_speed must be a speed ≥ 0 in rad/s, got {self.rest_speed}")
         if not self.max_condition > 1 or not self.prior_weight >= 0:
             raise InvalidInput("max_condition must be > 1 and prior_weight ≥ 0")
 
@@ -187,7 +200,8 @@ class Identification:
 
     def motor_torque(self, robot: Robot, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
         """Torque as the drives log it (gear losses included), N·m."""
-        return motor_torque(self.joint_torque(robot, q, qd, qdd), qd, self.gear_efficiency)
+        side = gear_side_speed(qd, self.options.rest_speed)
+        return motor_torque(self.joint_torque(robot, q, qd, qdd), side, self.gear_efficiency)
 
     def card(self) -> dict[str, Any]:
         """JSON-ready summary (the twin's card adds what it was written from)."""
@@ -211,6 +225,20 @@ class Identification:
         }
 
 
+def gear_side_speed(qd: FloatArray, rest_speed: float = GEAR_REST_SPEED) -> FloatArray:
+    """The speeds that decide the side of the gear losses in a log: 0 while the arm is at rest.
+
+    The arm is at rest in a sample where every joint is within ``rest_speed``. Its
+    logged speeds are then the speed sensor's noise, not directions of motion: a joint
+    held at rest pays ``tau * eta`` (see :func:`motor_torque`) whatever the noise's sign.
+    A single joint passing through zero speed while others move keeps its sign.
+    Identification and evaluation decide the side of logged samples by these speeds.
+    """
+    rest = np.all(np.abs(qd) <= rest_speed, axis=-1, keepdims=True)
+    out: FloatArray = np.where(rest, 0.0, qd)
+    return out
+
+
 def joint_side(tau_motor: FloatArray, qd: FloatArray, eta: float) -> FloatArray:
     """Invert the drive-loss model: joint torque of a logged motor torque (see :func:`motor_torque`)."""
     if eta == 1.0:
@@ -230,10 +258,11 @@ def _check_motion(data: IdentificationData, n_params: int) -> None:
     flat = [j + 1 for j in range(data.n_joints) if not spread[j] > MIN_TORQUE_SPREAD]
     if flat:
         j = flat[0] - 1
+        what = "torque" if data.signal == "torque" else "current"
         raise InvalidInput(
-            f"the logged torque of joint(s) {', '.join(map(str, flat))} never varies (joint {j + 1}: "
-            f"{float(data.tau[0, j]):g} N·m in every sample): such logs hold no torque information, "
-            "whatever the motion; log the drives' torque (or current) and identify again"
+            f"the logged {what} of joint(s) {', '.join(map(str, flat))} never varies (joint {j + 1}: "
+            f"{float(data.tau[0, j]):g} {data.unit} in every sample): such logs hold no torque "
+            "information, whatever the motion; log the drives' torque (or current) and identify again"
         )
     still = [j + 1 for j in range(data.n_joints) if np.abs(data.qd[:, j]).max() <= REST_SPEED]
     if still:
@@ -306,6 +335,14 @@ def score_prediction(pred: FloatArray, data: IdentificationData) -> FitScores:
     )
 
 
+def search_eta(cost: Callable[[float], float], fixed: float | None) -> float:
+    """The gear efficiency in :data:`ETA_BOUNDS` of least ``cost`` (a bounded scalar search), or ``fixed``."""
+    if fixed is not None:
+        return fixed
+    best = minimize_scalar(cost, bounds=ETA_BOUNDS, method="bounded", options={"xatol": 1e-5})
+    return float(best.x)
+
+
 class _Problem:
     """The stacked weighted least-squares problem of one data set."""
 
@@ -324,12 +361,7 @@ class _Problem:
             pred = motor_torque(self.A @ x, self.qd, e)
             return float((((pred - self.tau) * w) ** 2).sum()), x
 
-        if eta is not None:
-            return eta, fit(eta)[1]
-        best = minimize_scalar(
-            lambda e: fit(e)[0], bounds=ETA_BOUNDS, method="bounded", options={"xatol": 1e-5}
-        )
-        e = float(best.x)
+        e = search_eta(lambda e: fit(e)[0], eta)
         return e, fit(e)[1]
 
 
@@ -424,6 +456,12 @@ def identify(
         excited parameter is named).
     """
     options = options or IdentifyOptions()
+    if data.signal != "torque":
+        raise InvalidInput(
+            "these data hold motor currents (A), not torques: identify them with "
+            "identify_from_currents and a reference for the torque scale (a payload log, or the "
+            "nominal masses)"
+        )
     if data.n_joints != robot.n_joints:
         raise InvalidInput(
             f"the data hold {data.n_joints} joints but robot {robot.name!r} has {robot.n_joints}"
@@ -442,11 +480,12 @@ def identify(
     Y = inertial_regressor(robot, fit_data.q, fit_data.qd, fit_data.qdd)
     A = np.concatenate([Y[:, :, base.independent], F], axis=2)
     names = (*base.names, *(f"joint{j + 1}.{t}" for t in terms for j in range(n)))
-    problem = _Problem(A, fit_data.tau, fit_data.qd)
+    side = gear_side_speed(fit_data.qd, options.rest_speed)
+    problem = _Problem(A, fit_data.tau, side)
     w = np.ones(n)
     eta, x = problem.solve(w, options.gear_efficiency)
     if options.weighted:
-        res = motor_torque(A @ x, fit_data.qd, eta) - fit_data.tau
+        res = motor_torque(A @ x, side, eta) - fit_data.tau
         sigma = np.sqrt((res**2).mean(axis=0))
         sigma = np.maximum(sigma, 1e-6 * max(float(sigma.max()), 1e-12))
         w = 1.0 / sigma
@@ -467,7 +506,7 @@ def identify(
         phi, f = _consistent(
             Y,
             F,
-            joint_side(fit_data.tau, fit_data.qd, eta),
+            joint_side(fit_data.tau, side, eta),
             w,
             phi,
             f_ls,
@@ -480,7 +519,7 @@ def identify(
 
     def predict(d: IdentificationData) -> FloatArray:
         Yd = inertial_regressor(robot, d.q, d.qd, d.qdd)
-        return motor_torque(Yd @ phi + friction.torque(d.qd), d.qd, eta)
+        return motor_torque(Yd @ phi + friction.torque(d.qd), gear_side_speed(d.qd, options.rest_speed), eta)
 
     return Identification(
         robot_name=robot.name,
@@ -492,9 +531,7 @@ def identify(
         condition_number=cond,
         weakest=weakest,
         weights=w,
-        fit=score_prediction(
-            motor_torque(Y @ phi + friction.torque(fit_data.qd), fit_data.qd, eta), fit_data
-        ),
+        fit=score_prediction(motor_torque(Y @ phi + friction.torque(fit_data.qd), side, eta), fit_data),
         held_out=None if held is None else score_prediction(predict(held), held),
         min_pseudo_inertia_eig=eig,
         consistent=bool(np.all(eig > 0)),
@@ -506,13 +543,16 @@ def identify(
 
 __all__ = [
     "ETA_BOUNDS",
+    "GEAR_REST_SPEED",
     "FitScores",
     "Identification",
     "IdentifyOptions",
     "MAX_CONDITION",
     "REST_SPEED",
     "identify",
+    "gear_side_speed",
     "joint_side",
     "r2_per_joint",
     "score_prediction",
+    "search_eta",
 ]

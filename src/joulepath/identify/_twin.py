@@ -7,7 +7,11 @@ and read back by :func:`joulepath.load_robot`:
   each link's identified mass, centre of mass and inertia (a payload logged with the
   robot is part of the last link; the description has no separate payload);
 * ``friction.json`` — identified friction and gear efficiency;
-* ``card.json`` — data hash, fit and held-out scores, condition number, base parameters.
+* ``card.json`` — data hash, fit and held-out scores, condition number, base parameters;
+* ``drives.toml`` — only for a twin identified from motor currents: the identified
+  joint-side torque constants and gear efficiency, the other drive data as the nominal
+  robot's drives file gives them (:func:`joulepath.identify.identified_drives`), in
+  :mod:`joulepath.energy`'s format, so the energy measures use the identified ``k``.
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ from joulepath.dynamics import (
     Calibration,
     Robot,
 )
+from joulepath.energy import TWIN_DRIVES_FILE, DriveModel, drives_toml
 from joulepath.errors import InvalidInput
 from joulepath.identify._fit import Identification
 
@@ -109,16 +114,23 @@ def write_twin(
     out: str | os.PathLike[str],
     *,
     extra: dict[str, Any] | None = None,
+    drives: DriveModel | None = None,
 ) -> list[Path]:
     """Write the twin folder; refuses (before writing anything) files it may not replace.
 
-    Returns the paths written. ``extra`` adds entries to the card.
+    Returns the paths written. ``extra`` adds entries to the card; ``drives`` (identified
+    drive data) is written as the folder's ``drives.toml``.
     """
     from joulepath.description import irml_string
 
     robot = twin_robot(nominal, ident)
     folder = Path(out)
-    paths = [folder / name for name in (TWIN_ROBOT_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE)]
+    names = (TWIN_ROBOT_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE, *((TWIN_DRIVES_FILE,) if drives else ()))
+    paths = [folder / name for name in names]
+    if drives is not None and drives.n_joints != nominal.n_joints:
+        raise InvalidInput(
+            f"drive data of {drives.n_joints} joints for the {nominal.n_joints} of {nominal.name!r}"
+        )
     for p in paths:
         check_replaceable(p)
     make_folder(folder)
@@ -127,6 +139,12 @@ def write_twin(
     atomic_write_text(paths[0], irml_string(robot.description))
     atomic_write_text(paths[1], json.dumps(robot.calibration.to_json(), indent=2) + "\n")
     atomic_write_text(paths[2], json.dumps(finite_json(card), indent=2, default=_jsonable) + "\n")
+    if drives is not None:
+        comment = (
+            f"drives.toml of the twin of {robot.calibration.twin_of or nominal.name}: joint side.\n"
+            f"{drives.describe()}"
+        )
+        atomic_write_text(paths[3], drives_toml(drives, comment=comment))
     return paths
 
 
