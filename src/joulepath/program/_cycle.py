@@ -395,7 +395,7 @@ class CycleOptimizer:
         self.progress = progress or (lambda msg: None)
         self.deadline = deadline  # time.perf_counter() after which no new move is solved
         self.timed_out = False
-        self.plan: PlannedCycle = plan_cycle(spec, settings.controller)
+        self.plan: PlannedCycle = plan_cycle(spec, settings.controller, progress=self.progress)
         self.gradient = replace(settings.gradient, energy_every=settings.energy_every)
         check_motion_time(self.plan, spec.source, optimized=True)
         if spec.module is None:
@@ -434,7 +434,8 @@ class CycleOptimizer:
         self.fixed_time = self.plan.cycle_time - sum(self.span.values()) - self.wait_total
         self.t_lo: dict[int, float] = {}
         self.leg_lo: dict[int, tuple[float, ...]] = {}  # each move's shortest rest-to-rest duration
-        for i, members in self.chains.items():
+        for n_unit, (i, members) in enumerate(self.chains.items(), start=1):
+            self.progress(f"unit {n_unit}/{len(self.chains)}: its shortest duration")
             if i in self.within:  # its ends are the taught motion's: its duration stays
                 self.leg_lo[i] = ()
                 self.t_lo[i] = self.span[i]
@@ -907,7 +908,8 @@ class CycleOptimizer:
 
     def _default_clearance(self) -> None:
         plan = self.plan
-        for m in plan.moves:
+        for k, m in enumerate(plan.moves, start=1):
+            self.progress(f"clearance of the taught cycle to the cell: move {k}/{len(plan.moves)}")
             if m.profile.duration == 0:
                 continue
             t = np.linspace(m.t0, m.t_end, max(2, int(np.ceil(m.profile.duration / FINE_DT)) + 1))
