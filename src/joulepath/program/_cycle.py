@@ -425,6 +425,15 @@ class CycleOptimizer:
                 self.segment_of[members[0]] = window
                 if inner:
                     self.within.add(members[0])
+        for i, members in self.chains.items():  # a fly-by chain is solved as one move: bounded as one
+            if len(members) > 1:
+                check_work(
+                    "move_s",
+                    self.span[i],
+                    f"{spec.source}:{self.by_index[i].step.line}: {len(members)} moves joined by zones",
+                    "they are optimized as one move through their targets; end one of them at a stop "
+                    "(fine) to split the chain, or optimize only moves from rest to rest (--stop-at-targets)",
+                )
         self.optimizable = list(self.chains)  # one unit per window, keyed by its first moving move
         in_units = {j for i in self.chains for j in self.segment_of[i].moves}
         self.kept = [m.index for m in moves if m.index not in in_units]
