@@ -147,7 +147,9 @@ def test_cycle_with_a_cell_at_the_obstacle_limit_shows_progress(tmp_path, capsys
     ]
     for phase in ("c.toml: step 2/2", "clearance of the taught cycle to the cell: move 2/2"):
         assert any(s.endswith(phase) for s in said), (phase, said)
-    assert any(s.startswith("unit 2/2: solving") for s in said) and "sharing the cycle time" in said
+    assert "unit 2/2: reshaping its taught motion" in said and "sharing the cycle time" in said
+    assert any(s.startswith("unit 2/2: solving") for s in said)
+    assert said[-1].startswith(f"writing {out}")
 
 
 def test_simulate_program_at_the_moves_limit_shows_progress_when_stderr_is_no_terminal(tmp_path):

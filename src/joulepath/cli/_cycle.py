@@ -166,20 +166,21 @@ def cycle(
         if pareto:
             say("energy against cycle time...")
             front = run_pareto(opt, points=points, use_waits=use_waits)
+        say(f"writing {out} (the written program is checked on the controller emulation)")
+        files = write_cycle_run(
+            out,
+            result,
+            pareto=front,
+            write_rapid=rapid,
+            cell=cell_data,
+            write_anyway=write_anyway,
+            egm="always" if export == "egm" else "fallback" if export == "auto" else "never",
+        )
     if use_waits and not any(s.idle for s in spec.steps if s.kind == "wait"):
         console.print(
             "note: --use-waits: no wait is declared idle (`! joulepath: idle` on its line, or --idle-wait "
             "LINE); every wait is process time and keeps its length"
         )
-    files = write_cycle_run(
-        out,
-        result,
-        pareto=front,
-        write_rapid=rapid,
-        cell=cell_data,
-        write_anyway=write_anyway,
-        egm="always" if export == "egm" else "fallback" if export == "auto" else "never",
-    )
     saved = json.loads(files["cycle.json"].read_text())
     if not result.limits_ok:
         console.print(

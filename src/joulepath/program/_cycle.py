@@ -1170,7 +1170,8 @@ class CycleOptimizer:
         shares = np.concatenate([[0.0], np.geomspace(0.06, 1.0, k - 1)])
         floor = {i: min(self.t_lo[i], self.span[i]) for i in self.optimizable}
         out: dict[int, list[Solved]] = {i: [self.taught(i)] for i in self.optimizable}
-        for i in self.optimizable:  # each unit reshaped from its taught motion, at its taught duration
+        for n_unit, i in enumerate(self.optimizable, start=1):  # each reshaped from its taught motion
+            self.progress(f"unit {n_unit}/{len(self.optimizable)}: reshaping its taught motion")
             try:
                 reshaped = self.solve_on_taught(i)
             except TimeBudgetSpent:
