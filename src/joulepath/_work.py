@@ -8,7 +8,8 @@ change in the input::
 
     name          default  what it bounds
     motion_s      120      seconds the moves of one cycle take together (at the default or given cycle time)
-    move_s        10       seconds one move to be optimized takes (its solve grows with the duration)
+    move_s        10       seconds one move to be optimized takes (its solve grows with the duration;
+                           moves joined by zones into one fly-by chain count as one move)
     moves         1000     moves in one cycle
     obstacles     1000     obstacles of a cell (boxes, cylinders, spheres, meshes)
     triangles     200000   triangles of all the meshes of a cell together

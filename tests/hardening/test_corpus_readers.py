@@ -15,7 +15,8 @@ traceback, nothing written and the inputs unchanged. The classes:
 * linear time: 30 procedures that each call the next twice; a 1 MB statement;
 * work bounded before it starts: tiny speeds, ``\\T:=600``, ``WaitTime 3600`` with
   ``--use-waits``, ``--cycle-time 3599``, 10,000 moves, 10,000 cycle-TOML steps,
-  20,000 boxes; each refused with one line naming the limit and its variable;
+  20,000 boxes, a fly-by chain of 40 moves (solved as one move); each refused with one
+  line naming the limit and its variable;
 * crashes: two identical consecutive targets, a cycle that never moves, a RAPID
   module given to a 7-joint arm.
 
@@ -182,6 +183,7 @@ CASES = [
     C("rapid-cycle-time-3599", CYC + " --cycle-time 3599", 2, "JOULEPATH_MAX_MOTION_S", {"p.mod": mod(*AB)}),
     C("rapid-10000-moves", CYC, 2, "JOULEPATH_MAX_MOVES", {"p.mod": mod(*(AB * 5000))}),
     C("cycle-toml-10000-steps", CYT, 2, "JOULEPATH_MAX_MOVES", {"c.toml": CYCLE_TOML * 5000}),
+    C("rapid-fly-by-chain-over-move-s", CYC, 2, "40 moves joined by zones", {"p.mod": mod(*[a.replace("fine", "z10") for a in AB * 20])}),
     C("cell-20000-boxes", CELLCMD, 2, "JOULEPATH_MAX_OBSTACLES", {"p.mod": mod(*AB), "c.toml": "".join(CELL.replace('"table"', f'"b{i}"') for i in range(20000))}),
     C("simulate-tiny-v", "simulate --program {in}/p.mod --out {out}/a.csv", 2, "JOULEPATH_MAX_MOTION_S", {"p.mod": mod(AB[0], "MoveAbsJ jB, v1000\\V:=0.0001, fine, tool0;")}),
     # ---- crashes

@@ -10,12 +10,21 @@ Output checks run before any work, so a refused ``--out`` writes nothing:
   it are checked like output files;
 * no output, and no folder above it, may be a symbolic link to nothing (a dangling link);
 * the nearest existing folder above the output must be writable.
+
+Progress of long work (:func:`progress_lines`) goes to stderr and never to stdout: a
+live status line when stderr is a terminal, else plain lines, at most one per
+``JOULEPATH_PROGRESS_S`` seconds (default 1; the first after one interval of work, so
+a quick command, or a quick refusal, prints only its result or its one error line).
 """
 
 from __future__ import annotations
 
+import math
 import os
-from collections.abc import Iterable
+import sys
+import time
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import typer
@@ -25,6 +34,12 @@ from joulepath._io import check_replaceable
 from joulepath.errors import InvalidInput
 
 console = Console(highlight=False, soft_wrap=True)
+err_console = Console(stderr=True, highlight=False, soft_wrap=True)
+"""Progress only (a live status on a terminal); results go to ``console`` (stdout)."""
+
+PROGRESS_ENV = "JOULEPATH_PROGRESS_S"
+"""Environment variable: seconds between two progress lines when stderr is not a terminal."""
+DEFAULT_PROGRESS_S = 1.0
 
 PathLike = str | os.PathLike[str]
 
@@ -156,3 +171,64 @@ def robot_inputs(robot: str) -> list[str]:
     if path.is_dir():
         return [robot, *(str(path / name) for name in TWIN_FILES)]
     return [robot] if path.is_file() else []
+
+
+def progress_interval() -> float:
+    """Seconds between progress lines: ``JOULEPATH_PROGRESS_S`` if set (0: every message), else 1.
+
+    Raises
+    ------
+    InvalidInput
+        The variable is set but is not a finite number of seconds ≥ 0.
+    """
+    raw = os.environ.get(PROGRESS_ENV, "")
+    if not raw.strip():
+        return DEFAULT_PROGRESS_S
+    try:
+        value = float(raw)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0):
+        raise InvalidInput(f"{PROGRESS_ENV}={raw[:40]!r}: give a number of seconds ≥ 0 (or unset it)")
+    return value
+
+
+class ProgressLines:
+    """A progress callback that prints plain lines on stderr, at most one per ``interval`` seconds.
+
+    A message is printed when ``interval`` seconds have passed since the last line (or since
+    the start, for the first), prefixed with the seconds since the start; the others are
+    dropped. So a command that ends within one interval prints no progress at all.
+    """
+
+    def __init__(self, interval: float, clock: Callable[[], float] = time.monotonic) -> None:
+        self.interval = interval
+        self.clock = clock
+        self.start = clock()
+        self.last = self.start
+        self.printed = 0
+
+    def __call__(self, message: str) -> None:
+        """Print ``message`` if the interval has passed since the last line."""
+        now = self.clock()
+        if now - self.last < self.interval:
+            return
+        print(f"[{now - self.start:.0f} s] {message}", file=sys.stderr, flush=True)
+        self.last = now
+        self.printed += 1
+
+
+@contextmanager
+def progress_lines(label: str) -> Iterator[Callable[[str], None]]:
+    """A progress callback for long work, shown on stderr only (stdout keeps the results alone).
+
+    On a terminal: a live status line that starts with ``label`` and shows each message (gone
+    when the block ends). Otherwise: :class:`ProgressLines` at :func:`progress_interval`.
+    """
+    if err_console.is_terminal:
+        from rich.text import Text
+
+        with err_console.status(label) as status:
+            yield lambda message: status.update(Text(message))
+        return
+    yield ProgressLines(progress_interval())

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import typer
 
-from joulepath.cli._common import check_out_folder, console
+from joulepath.cli._common import check_out_folder, console, progress_lines
 from joulepath.cli._robot import load_robot_for_cli, unchecked_option
 
 
@@ -141,17 +141,9 @@ def cycle(
         raise typer.BadParameter(f"{program}: no such file", param_hint="PROGRAM")
     r = load_robot_for_cli(robot, unchecked=unchecked)
     check_measure(energy, r.drivetrain)  # one line saying what to provide
-    spec, rapid = read_cycle_program(program, r, idle_waits=idle_wait)
-    if use_waits and not any(s.idle for s in spec.steps if s.kind == "wait"):
-        console.print(
-            "note: --use-waits: no wait is declared idle (`! joulepath: idle` on its line, or --idle-wait "
-            "LINE); every wait is process time and keeps its length"
-        )
     from joulepath.program._cell import read_cell
 
-    cell_data = read_cell(cell) if cell is not None else None
     settings = CycleSettings(
-        cell=cell_data,
         cycle_time=target,
         use_waits=use_waits,
         fly_by=not stop_at_targets,
@@ -166,21 +158,29 @@ def cycle(
     )
     if jerk_time is not None:  # else the controller's default (CycleSettings')
         settings = replace(settings, jerk_time=jerk_time)
-    with console.status("optimizing the cycle...") as status:
-        result, opt = optimize_cycle(spec, settings, progress=lambda msg: status.update(msg))
+    with progress_lines("optimizing the cycle...") as say:  # on stderr only: stdout keeps the results
+        spec, rapid = read_cycle_program(program, r, idle_waits=idle_wait, progress=say)
+        cell_data = read_cell(cell, progress=say) if cell is not None else None
+        result, opt = optimize_cycle(spec, replace(settings, cell=cell_data), progress=say)
         front = None
         if pareto:
-            status.update("energy against cycle time...")
+            say("energy against cycle time...")
             front = run_pareto(opt, points=points, use_waits=use_waits)
-    files = write_cycle_run(
-        out,
-        result,
-        pareto=front,
-        write_rapid=rapid,
-        cell=cell_data,
-        write_anyway=write_anyway,
-        egm="always" if export == "egm" else "fallback" if export == "auto" else "never",
-    )
+        say(f"writing {out} (the written program is checked on the controller emulation)")
+        files = write_cycle_run(
+            out,
+            result,
+            pareto=front,
+            write_rapid=rapid,
+            cell=cell_data,
+            write_anyway=write_anyway,
+            egm="always" if export == "egm" else "fallback" if export == "auto" else "never",
+        )
+    if use_waits and not any(s.idle for s in spec.steps if s.kind == "wait"):
+        console.print(
+            "note: --use-waits: no wait is declared idle (`! joulepath: idle` on its line, or --idle-wait "
+            "LINE); every wait is process time and keeps its length"
+        )
     saved = json.loads(files["cycle.json"].read_text())
     if not result.limits_ok:
         console.print(

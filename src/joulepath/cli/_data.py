@@ -8,7 +8,14 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from joulepath.cli._common import check_out_file, check_out_folder, console, parse_joints, robot_inputs
+from joulepath.cli._common import (
+    check_out_file,
+    check_out_folder,
+    console,
+    parse_joints,
+    progress_lines,
+    robot_inputs,
+)
 from joulepath.description import DEFAULT_ROBOT
 
 if TYPE_CHECKING:
@@ -227,8 +234,8 @@ def _simulate_program(
     check_out_file(out, example="path-run.csv", inputs=[program, *robot_inputs(robot)])
     r = load_robot(robot)
     q0 = parse_joints(start, option="--start", degrees=degrees, n=r.n_joints) if start else None
-    with console.status(f"running {program.name} on the emulated controller and the {plant} plant..."):
-        res = simulate_program(program, out, robot=r, plant=plant, seed=seed, start=q0)
+    with progress_lines(f"running {program.name} on the emulated controller and the {plant} plant...") as say:
+        res = simulate_program(program, out, robot=r, plant=plant, seed=seed, start=q0, progress=say)
     console.print(
         f"wrote {res.log} ({res.n_rows:,} rows: {res.n_moves} moves of {program.name} in "
         f"{res.program_time_s:.2f} s on the {res.plant} plant, {res.plant_note})"

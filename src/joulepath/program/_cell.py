@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -82,6 +83,12 @@ _FEWER_TRIANGLES = "simplify the meshes (a cell needs coarse hulls: a few thousa
 _MESH_SUFFIXES = (".stl", ".obj")
 _IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 Rotation = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
+Progress = Callable[[str], None]
+"""A progress callback: told what is being done now (the caller decides whether and how to show it)."""
+
+
+def _quiet(message: str) -> None:
+    """The progress callback of a caller that gave none."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -199,8 +206,14 @@ def _refuse_nonfinite_vertices(path: Path, where: str) -> None:
         )
 
 
-def load_mesh(path: Path, scale: tuple[float, float, float], where: str) -> Any:
-    """A mesh file (STL or OBJ) as a coal ``BVHModel``, scaled; ``InvalidInput`` if it cannot be used."""
+def load_mesh(
+    path: Path, scale: tuple[float, float, float], where: str, *, progress: Progress = _quiet
+) -> Any:
+    """A mesh file (STL or OBJ) as a coal ``BVHModel``, scaled; ``InvalidInput`` if it cannot be used.
+
+    ``progress`` is told when the file is checked and when coal reads it and builds its
+    bounding-volume hierarchy (the collision model; seconds for 10⁵ triangles).
+    """
     if path.suffix.lower() not in _MESH_SUFFIXES:
         raise InvalidInput(f"{where}: mesh {path} is not .stl or .obj; export it as STL or OBJ")
     if not path.exists():
@@ -221,9 +234,13 @@ def load_mesh(path: Path, scale: tuple[float, float, float], where: str) -> Any:
             "simplify it (a cell needs a coarse hull)"
         )
     n_binary = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
-    if path.suffix.lower() == ".stl" and n_bytes == 84 + 50 * n_binary:  # a binary STL: counted unread
+    binary = path.suffix.lower() == ".stl" and n_bytes == 84 + 50 * n_binary
+    if binary:  # a binary STL: counted unread
         check_work("triangles", n_binary, f"{where}: mesh {path}", _FEWER_TRIANGLES)
+    size = f"{n_binary:,} triangles" if binary else f"{n_bytes / 2**20:.1f} MiB"
+    progress(f"{where}: checking the vertices of mesh {path.name} ({size})")
     _refuse_nonfinite_vertices(path, where)  # before coal: its OBB fit chokes (and prints) on NaN
+    progress(f"{where}: building the collision model of mesh {path.name} ({size})")
     coal = _coal()
     try:
         model = coal.MeshLoader().load(str(path), np.asarray(scale, dtype=float))
@@ -251,7 +268,9 @@ _KINDS: dict[str, tuple[set[str], set[str]]] = {
 }
 
 
-def _toml_obstacle(kind: str, item: dict[str, Any], where: str, base: Path) -> Obstacle:
+def _toml_obstacle(
+    kind: str, item: dict[str, Any], where: str, base: Path, progress: Progress = _quiet
+) -> Obstacle:
     name = item["name"]
     if not isinstance(name, str) or not name:
         raise InvalidInput(f"{where}: name must be a text")
@@ -280,17 +299,21 @@ def _toml_obstacle(kind: str, item: dict[str, Any], where: str, base: Path) -> O
         raise InvalidInput(f"{where}: file must be a text (a path relative to the cell file)")
     scale = _scale(item.get("scale", 1.0), where)
     path = base / file
-    return Obstacle(name, kind, center, scale, rotation, load_mesh(path, scale, where), str(path))
+    mesh = load_mesh(path, scale, where, progress=progress)
+    return Obstacle(name, kind, center, scale, rotation, mesh, str(path))
 
 
-def read_cell(path: str | Path) -> Cell:
+def read_cell(path: str | Path, *, progress: Progress | None = None) -> Cell:
     """Read a cell file: TOML, or a URDF for ``.urdf``.
 
+    ``progress`` (optional) is told each obstacle read and each mesh loaded, once the
+    file's size, obstacle count and triangle counts are within their limits.
     A file that cannot be used raises ``InvalidInput``: one line naming the file and entry.
     """
     p = Path(path)
+    say = progress or _quiet
     if p.suffix.lower() == ".urdf":
-        return read_urdf_cell(p)
+        return read_urdf_cell(p, progress=say)
     data = load_toml(p, max_bytes=MAX_CELL_FILE_BYTES, what="a TOML cell file")
     allowed = {"margin_mm", "robot", *_KINDS}
     unknown = set(data) - allowed
@@ -324,7 +347,8 @@ def read_cell(path: str | Path) -> Cell:
             if not isinstance(item, dict) or not required <= set(item) <= required | optional:
                 extra = f" (optional: {sorted(optional)})" if optional else ""
                 raise InvalidInput(f"{where}: needs exactly {sorted(required)}{extra}")
-            obstacles.append(_toml_obstacle(kind, item, where, p.parent))
+            say(f"reading the cell: {kind} {k}/{len(items)}")
+            obstacles.append(_toml_obstacle(kind, item, where, p.parent, say))
     if not obstacles:
         raise InvalidInput(f"{p}: no obstacle; add " + ", ".join(f"[[{k}]]" for k in _KINDS) + " tables")
     check_work(
@@ -373,7 +397,9 @@ def _origin(el: ET.Element, where: str) -> FloatArray:
     return T
 
 
-def _urdf_geometry(col: ET.Element, name: str, T: FloatArray, where: str, base: Path) -> Obstacle:
+def _urdf_geometry(
+    col: ET.Element, name: str, T: FloatArray, where: str, base: Path, progress: Progress = _quiet
+) -> Obstacle:
     geoms = col.findall("geometry")
     shapes = [s for g in geoms for s in g]
     if len(geoms) != 1 or len(shapes) != 1:
@@ -411,15 +437,18 @@ def _urdf_geometry(col: ET.Element, name: str, T: FloatArray, where: str, base: 
             raise InvalidInput(f"{where}: <mesh scale> must be positive")
         scale = (float(f[0]), float(f[1]), float(f[2]))
         path = base / filename
-        return Obstacle(name, "mesh", center, scale, rotation, load_mesh(path, scale, where), str(path))
+        mesh = load_mesh(path, scale, where, progress=progress)
+        return Obstacle(name, "mesh", center, scale, rotation, mesh, str(path))
     raise InvalidInput(f"{where}: <{str(kind)[:20]}> is not a box, cylinder, sphere or mesh")
 
 
-def read_urdf_cell(path: str | Path) -> Cell:
+def read_urdf_cell(path: str | Path, *, progress: Progress | None = None) -> Cell:
     """Read a URDF of the cell: every link's collision geometry, placed by fixed joints from the root.
 
     The root link's frame is the robot's base frame; the margin is ``DEFAULT_MARGIN_MM``.
+    ``progress`` (optional) is told each collision geometry read and each mesh loaded.
     """
+    say = progress or _quiet
     p = Path(path)
     data = read_capped(p, max_bytes=MAX_URDF_BYTES, what="a URDF or TOML cell file")
     try:
@@ -476,9 +505,10 @@ def read_urdf_cell(path: str | Path) -> Cell:
         lost = next(name for name in links if name not in pose)
         raise InvalidInput(f"{p}: link {lost!r} is not connected to the root {roots[0]!r}")
     obstacles: list[Obstacle] = []
+    n_collisions = sum(len(el.findall("collision")) for el in links.values())
     check_work(
         "obstacles",
-        sum(len(el.findall("collision")) for el in links.values()),
+        n_collisions,
         str(p),
         "merge neighbouring collision shapes into one box, or cover the area with one coarse mesh",
     )
@@ -488,7 +518,8 @@ def read_urdf_cell(path: str | Path) -> Cell:
             label = collision.get("name") or (name if len(cols) == 1 else f"{name}/{n}")
             at = f"{p}: link {name!r} collision {n}"
             T = pose[name] @ _origin(collision, at)
-            obstacles.append(_urdf_geometry(collision, label, T, at, p.parent))
+            say(f"reading the cell: collision {len(obstacles) + 1}/{n_collisions}")
+            obstacles.append(_urdf_geometry(collision, label, T, at, p.parent, say))
     if not obstacles:
         raise InvalidInput(f"{p}: no <collision> geometry in any link; a cell needs obstacles")
     check_work(

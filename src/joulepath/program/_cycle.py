@@ -395,7 +395,7 @@ class CycleOptimizer:
         self.progress = progress or (lambda msg: None)
         self.deadline = deadline  # time.perf_counter() after which no new move is solved
         self.timed_out = False
-        self.plan: PlannedCycle = plan_cycle(spec, settings.controller)
+        self.plan: PlannedCycle = plan_cycle(spec, settings.controller, progress=self.progress)
         self.gradient = replace(settings.gradient, energy_every=settings.energy_every)
         check_motion_time(self.plan, spec.source, optimized=True)
         if spec.module is None:
@@ -425,6 +425,15 @@ class CycleOptimizer:
                 self.segment_of[members[0]] = window
                 if inner:
                     self.within.add(members[0])
+        for i, members in self.chains.items():  # a fly-by chain is solved as one move: bounded as one
+            if len(members) > 1:
+                check_work(
+                    "move_s",
+                    self.span[i],
+                    f"{spec.source}:{self.by_index[i].step.line}: {len(members)} moves joined by zones",
+                    "they are optimized as one move through their targets; end one of them at a stop "
+                    "(fine) to split the chain, or optimize only moves from rest to rest (--stop-at-targets)",
+                )
         self.optimizable = list(self.chains)  # one unit per window, keyed by its first moving move
         in_units = {j for i in self.chains for j in self.segment_of[i].moves}
         self.kept = [m.index for m in moves if m.index not in in_units]
@@ -434,7 +443,8 @@ class CycleOptimizer:
         self.fixed_time = self.plan.cycle_time - sum(self.span.values()) - self.wait_total
         self.t_lo: dict[int, float] = {}
         self.leg_lo: dict[int, tuple[float, ...]] = {}  # each move's shortest rest-to-rest duration
-        for i, members in self.chains.items():
+        for n_unit, (i, members) in enumerate(self.chains.items(), start=1):
+            self.progress(f"unit {n_unit}/{len(self.chains)}: its shortest duration")
             if i in self.within:  # its ends are the taught motion's: its duration stays
                 self.leg_lo[i] = ()
                 self.t_lo[i] = self.span[i]
@@ -907,7 +917,8 @@ class CycleOptimizer:
 
     def _default_clearance(self) -> None:
         plan = self.plan
-        for m in plan.moves:
+        for k, m in enumerate(plan.moves, start=1):
+            self.progress(f"clearance of the taught cycle to the cell: move {k}/{len(plan.moves)}")
             if m.profile.duration == 0:
                 continue
             t = np.linspace(m.t0, m.t_end, max(2, int(np.ceil(m.profile.duration / FINE_DT)) + 1))
@@ -1160,7 +1171,8 @@ class CycleOptimizer:
         shares = np.concatenate([[0.0], np.geomspace(0.06, 1.0, k - 1)])
         floor = {i: min(self.t_lo[i], self.span[i]) for i in self.optimizable}
         out: dict[int, list[Solved]] = {i: [self.taught(i)] for i in self.optimizable}
-        for i in self.optimizable:  # each unit reshaped from its taught motion, at its taught duration
+        for n_unit, i in enumerate(self.optimizable, start=1):  # each reshaped from its taught motion
+            self.progress(f"unit {n_unit}/{len(self.optimizable)}: reshaping its taught motion")
             try:
                 reshaped = self.solve_on_taught(i)
             except TimeBudgetSpent:

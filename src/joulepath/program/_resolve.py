@@ -12,7 +12,7 @@ are taken into account (targets are TCP poses, the load is carried in the dynami
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -168,8 +168,17 @@ def _lookup(module: Module, name: str, type_: str, line: int) -> object:
     return d.value
 
 
-def resolve_module(module: Module, robot: Robot, *, idle_waits: Collection[int] = ()) -> CycleSpec:
+def resolve_module(
+    module: Module,
+    robot: Robot,
+    *,
+    idle_waits: Collection[int] = (),
+    progress: Callable[[str], None] | None = None,
+) -> CycleSpec:
     """The cycle of a parsed module on ``robot``; ``RapidError`` naming the line otherwise.
+
+    ``progress`` (optional) is told each move resolved (its target's inverse kinematics),
+    once the unrolled cycle is within the moves limit.
 
     A ``WaitTime`` is idle time (``Step.idle``: an optimizer may spend it on the moves)
     when it is marked ``! joulepath: idle`` or its line is in ``idle_waits``; every run
@@ -215,6 +224,7 @@ def resolve_module(module: Module, robot: Robot, *, idle_waits: Collection[int] 
     robots: dict[str, Robot] = {}
     steps: list[Step] = []
     fixed: list[int] = []
+    n_moves, k = sum(isinstance(s, Move) for s in flat), 0
     for s in flat:
         if isinstance(s, WaitTime):
             idle = s.idle or s.line in idle_waits
@@ -224,6 +234,9 @@ def resolve_module(module: Module, robot: Robot, *, idle_waits: Collection[int] 
             steps.append(Step("fixed", s.line, s.text, s))
             fixed.append(s.line)
         elif isinstance(s, Move):
+            k += 1
+            if progress is not None:
+                progress(f"reading {module.path}: move {k}/{n_moves}")
             steps.append(_move_step(module, robot, s, lo, hi, robots, counts[s.line] > 1))
     moves = [st for st in steps if st.kind == "move"]
     if not moves:
@@ -415,7 +428,9 @@ def robtarget_joints(
 
 
 # ---------------------------------------------------------------- plain cycle file
-def read_cycle_toml(path: str | Path, robot: Robot) -> CycleSpec:
+def read_cycle_toml(
+    path: str | Path, robot: Robot, *, progress: Callable[[str], None] | None = None
+) -> CycleSpec:
     """A plain cycle file for arms without RAPID (TOML), e.g.::
 
         start_deg = [0, 0, 0, 0, 30, 0]      # optional: default the last waypoint
@@ -426,7 +441,8 @@ def read_cycle_toml(path: str | Path, robot: Robot) -> CycleSpec:
         wait_s = 0.3
 
     Every move is a joint move that stops at its waypoint; its default is the
-    controller's jerk-limited profile stretched to ``duration_s``.
+    controller's jerk-limited profile stretched to ``duration_s``. ``progress`` (optional)
+    is told each step read once the file is within the moves limit.
     """
     p = Path(path)
     data = load_toml(p, max_bytes=MAX_CYCLE_FILE_BYTES, what="a TOML cycle file")
@@ -447,6 +463,8 @@ def read_cycle_toml(path: str | Path, robot: Robot) -> CycleSpec:
     steps: list[Step] = []
     for k, st in enumerate(raw, start=1):
         where = f"{p}: step {k}"
+        if progress is not None:
+            progress(f"reading {p}: step {k}/{len(raw)}")
         if not isinstance(st, dict):
             raise InvalidInput(f"{where}: must be a table")
         if set(st) == {"wait_s"}:
@@ -524,7 +542,11 @@ def check_moves_arm(spec: CycleSpec) -> None:
 
 
 def read_cycle_program(
-    path: str | Path, robot: Robot, *, idle_waits: Collection[int] = ()
+    path: str | Path,
+    robot: Robot,
+    *,
+    idle_waits: Collection[int] = (),
+    progress: Callable[[str], None] | None = None,
 ) -> tuple[CycleSpec, bool]:
     """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID module.
 
@@ -532,6 +554,8 @@ def read_cycle_program(
     :func:`resolve_module`); for a ``.toml`` file, numbers of ``wait_s`` steps. A module
     joulepath wrote is read as the program it was written from (its targets as they are
     now: re-taught ones included; :func:`joulepath.program._rapid_write.restore_program`).
+    ``progress`` (optional) is told each move (or step) read once the cycle is within the
+    moves limit.
     """
     p = Path(path)
     rapid = p.suffix.lower() != ".toml"
@@ -543,8 +567,8 @@ def read_cycle_program(
         original = restore_program("\n".join(module.source))
         if original is not None:  # written by joulepath: optimize the program it was written from
             module = parse_module(original, path=f"{p} (the program it was optimized from)")
-        return resolve_module(module, robot, idle_waits=idle_waits), True
-    spec = read_cycle_toml(p, robot)
+        return resolve_module(module, robot, idle_waits=idle_waits, progress=progress), True
+    spec = read_cycle_toml(p, robot, progress=progress)
     if not idle_waits:
         return spec, False
     steps = list(spec.steps)

@@ -16,7 +16,7 @@ and after the last, as :func:`joulepath.sim.simulate` does.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -74,12 +74,19 @@ class ProgramRun:
 
 
 def program_motion(
-    spec: CycleSpec, config: ControllerConfig, *, start: FloatArray | None = None
+    spec: CycleSpec,
+    config: ControllerConfig,
+    *,
+    start: FloatArray | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> ProgramMotion:
-    """The controller's plan of a program's steps from ``start`` (default: the first move's target)."""
+    """The controller's plan of a program's steps from ``start`` (default: the first move's target).
+
+    ``progress`` (optional) is told each move planned.
+    """
     first = next(s.q for s in spec.steps if s.kind == "move" and s.q is not None)
     q0 = first.copy() if start is None else np.asarray(start, dtype=float)
-    plan = plan_cycle(replace(spec, start=q0), config)
+    plan = plan_cycle(replace(spec, start=q0), config, progress=progress)
     return ProgramMotion(plan, config.idle)
 
 
@@ -110,6 +117,7 @@ def simulate_program(
     start: FloatArray | Sequence[float] | None = None,
     config: ControllerConfig | None = None,
     instance_seed: int = 120,
+    progress: Callable[[str], None] | None = None,
 ) -> ProgramRun:
     """Run a RAPID module's ``main`` once on the emulated controller and a plant; write the log.
 
@@ -132,6 +140,8 @@ def simulate_program(
         The emulated controller and measurement loop.
     instance_seed : int
         Which lab robot (its perturbations).
+    progress : callable, optional
+        Told each move read and planned, then when the plant runs (for long programs).
 
     Raises
     ------
@@ -143,9 +153,11 @@ def simulate_program(
     r = robot
     config = config or ControllerConfig()
     q0 = None if start is None else _check_start(r, start)
-    spec = resolve_module(read_module(Path(program)), r)
-    motion = program_motion(spec, config, start=q0)
+    spec = resolve_module(read_module(Path(program)), r, progress=progress)
+    motion = program_motion(spec, config, start=q0, progress=progress)
     check_motion_time(motion.plan, spec.source)
+    if progress is not None:
+        progress(f"running {motion.plan.cycle_time:.1f} s of motion on the {plant} plant")
     the_plant = make_plant(plant, r, instance_seed=instance_seed)
     rng = np.random.default_rng(seed)
     t = log_times(motion.end_time + config.idle, config, rng=rng)

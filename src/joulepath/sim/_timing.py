@@ -34,7 +34,7 @@ program without such corners is timed exactly as before.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -392,11 +392,20 @@ def _chain_profiles(
     return profiles, None
 
 
-def plan_cycle(spec: StepSequence, config: ControllerConfig) -> PlannedCycle:
-    """The controller's timing of one cycle (it starts at rest at ``spec.start``)."""
+def plan_cycle(
+    spec: StepSequence, config: ControllerConfig, *, progress: Callable[[str], None] | None = None
+) -> PlannedCycle:
+    """The controller's timing of one cycle (it starts at rest at ``spec.start``).
+
+    ``progress`` (optional) is told each move planned (a ``MoveL`` solves the inverse
+    kinematics along its line: milliseconds each, minutes for thousands).
+    """
     q = spec.start
     plans: list[tuple[int, Step, SegmentPath, Profile, float, bool]] = []
-    for i in moves_of(spec):
+    indices = moves_of(spec)
+    for k, i in enumerate(indices, start=1):
+        if progress is not None:
+            progress(f"planning the taught cycle: move {k}/{len(indices)}")
         step = spec.steps[i]
         assert step.q is not None
         path = segment_path(step, q, spec.source)
