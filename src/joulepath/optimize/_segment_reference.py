@@ -75,6 +75,9 @@ LINE_SAMPLES = 257
 """Points along ``s`` where a line's joint path is sampled for its CasADi B-spline."""
 ON_LINE_RAD = 1e-6
 """Largest joint distance (rad) from a line's path at which a sample of ``initial`` is on the line."""
+KINEMATIC_CHECKS = 4
+"""On a line piece, the joint range, speed, acceleration and jerk are bounded at this many times
+``substeps`` points per interval (cheap: the path's spline, no dynamics)."""
 SPEED_TOLERANCE = 1e-4
 """Largest relative excess of ``ṡ`` over ``line_speed`` on the verification grid that still counts as held."""
 
@@ -229,15 +232,19 @@ def _pieces(cs: Any, seg: CycleSegment, n: int, name: str) -> list[_Piece]:
 
 
 def _line_interval_function(cs: Any, rnea: Any, friction: Any, path: Any, n: int, substeps: int) -> Any:
-    """One interval of a line piece: ``(s, sd, sdd, u, h, eps) -> (next (3,), s, sd (1, substeps + 1),
-    q, qd, qdd, qddd, tau (n, substeps + 1), smoothed energy)``, ``u`` the constant ``s⃛``: the
-    energy at ``substeps`` points, the values for the limits also at the interval's end."""
+    """One interval of a line piece: ``(s, sd, sdd, u, h, eps) -> (next (3,), q, qd, qdd, qddd
+    (n, KINEMATIC_CHECKS · substeps + 1), tau (n, substeps + 1), smoothed energy)``, ``u`` the
+    constant ``s⃛``. The energy at ``substeps`` points; the effort also at the interval's end; the
+    joint range, speed, acceleration and jerk (not polynomial in time on a line) at
+    ``KINEMATIC_CHECKS`` times as many points and the end."""
     s, sd, sdd, u, h, eps = (cs.SX.sym(x) for x in ("s", "sd", "sdd", "u", "h", "eps"))
     nxt = cs.vertcat(s + h * sd + h**2 / 2 * sdd + h**3 / 6 * u, sd + h * sdd + h**2 / 2 * u, sdd + h * u)
-    cols: list[list[Any]] = [[] for _ in range(7)]
+    kin: list[list[Any]] = [[] for _ in range(4)]
+    taus = []
     energy = cs.SX(0)
-    for j in range(substeps + 1):  # the limits also at the interval's end (not linear in s here)
-        t_ = h * (j / substeps)
+    dense = KINEMATIC_CHECKS * substeps
+    for j in range(dense + 1):
+        t_ = h * (j / dense)
         sj = s + t_ * sd + t_**2 / 2 * sdd + t_**3 / 6 * u
         vj = sd + t_ * sdd + t_**2 / 2 * u
         aj = sdd + t_ * u
@@ -245,16 +252,21 @@ def _line_interval_function(cs: Any, rnea: Any, friction: Any, path: Any, n: int
         qd = d1 * vj
         qdd = d2 * vj**2 + d1 * aj
         qddd = d3 * vj**3 + 3 * d2 * vj * aj + d1 * u
+        for col, x in zip(kin, (q, qd, qdd, qddd), strict=True):
+            col.append(x)
+        if j % KINEMATIC_CHECKS:
+            continue
         tau = rnea(q, qd, qdd)
         if friction is not None:
             tau = tau + friction(qd)
-        if j < substeps:
+        taus.append(tau)
+        if j < dense:
             power = tau * qd
             energy = energy + cs.sum1(cs.sqrt(power**2 + eps**2) - eps) * (h / substeps)
-        for col, x in zip(cols, (sj, vj, q, qd, qdd, qddd, tau), strict=True):
-            col.append(x)
     return cs.Function(
-        "line_interval", [s, sd, sdd, u, h, eps], [nxt, *(cs.horzcat(*c) for c in cols), energy]
+        "line_interval",
+        [s, sd, sdd, u, h, eps],
+        [nxt, *(cs.horzcat(*c) for c in kin), cs.horzcat(*taus), energy],
     )
 
 
@@ -312,7 +324,7 @@ def _windows(pieces: list[_Piece], path: Trajectory) -> list[tuple[int, int]]:
         first = lo + int(on[0])
         breaks = np.flatnonzero(np.diff(on) > 1)
         last = lo + int(on[breaks[0]] if breaks.size else on[-1])
-        spans.append((first, max(last, first + 1)))
+        spans.append((min(first, K - 2), min(max(last, first + 1), K - 1)))
         lo = last
     edge = 0
     for k, span in enumerate(spans):
@@ -322,7 +334,7 @@ def _windows(pieces: list[_Piece], path: Trajectory) -> list[tuple[int, int]]:
             continue
         nxt = next((x for x in spans[k + 1 :] if x is not None), None)
         end = K - 1 if nxt is None else nxt[0]
-        out.append((edge, max(end, edge + 1)))
+        out.append((min(edge, K - 2), min(max(end, edge + 1), K - 1)))
     return out
 
 
@@ -654,7 +666,7 @@ def segment_optimum(
                 T = opti.variable(1)
                 fn = _line_interval_function(cs, rnea, fr, p.fn, n, substeps)
                 out = fn.map(N)(X[:, :-1], XD[:, :-1], XDD[:, :-1], U, cs.repmat(T / N, 1, N), eps)
-                nxt, _, _, qs, vs, accs, jerks, taus, e = out
+                nxt, qs, vs, accs, jerks, taus, e = out
                 opti.subject_to(cs.vertcat(X[:, 1:], XD[:, 1:], XDD[:, 1:]) == nxt)
                 opti.subject_to(opti.bounded(0.0, X, 1.0))
                 opti.subject_to(opti.bounded(p.s0[0], X[0, 0], p.s0[1]))
