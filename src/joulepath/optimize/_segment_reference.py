@@ -31,7 +31,11 @@ the initial motion lies inside the relaxation: the line parts ``initial`` spends
 lines, and its closest approach to each joint target. So the optimum is at least as free
 as the controller's motion (and the plan's, which keeps the lines), and its saving is an
 upper bound of what the plan can save on the same time: a yardstick, never tighter than
-the taught motion. Joint, speed, acceleration, jerk and effort limits hold at
+the taught motion. Two limits to that, stated: the transcription's resolution (a piecewise
+cubic of ``intervals`` steps per piece; a taught motion near its shortest time, e.g. a MoveL
+at its speeddata from rest to rest, may need more intervals to be matched), and IPOPT's
+local optimum (it starts from ``initial`` and, in the tests and the bundled examples, ends
+below it). Joint, speed, acceleration, jerk and effort limits hold at
 ``substeps`` points per interval of every piece.
 
 Verified as :func:`cycle_optimum` is: each segment resampled on a grid of at most
@@ -317,13 +321,17 @@ def _windows(pieces: list[_Piece], path: Trajectory) -> list[tuple[int, int]]:
         if not isinstance(p, _Line):
             spans.append(None)
             continue
-        _, dist = _project(p.path, path.q[lo:])
+        s, dist = _project(p.path, path.q[lo:])
         on = np.flatnonzero(dist <= ON_LINE_RAD)
         if on.size == 0:
             raise InvalidInput("initial does not run on one of the segment's lines; give the taught motion")
-        first = lo + int(on[0])
         breaks = np.flatnonzero(np.diff(on) > 1)
-        last = lo + int(on[breaks[0]] if breaks.size else on[-1])
+        run = on[: breaks[0] + 1] if breaks.size else on
+        # the line is run forwards: the window ends where s turns back (a line retraced by the
+        # next, e.g. a MoveL down and the same MoveL up, stays on this line's path)
+        back = np.flatnonzero(np.diff(s[run]) < -1e-7)
+        run = run[: back[0] + 1] if back.size else run
+        first, last = lo + int(run[0]), lo + int(run[-1])
         spans.append((min(first, K - 2), min(max(last, first + 1), K - 1)))
         lo = last
     edge = 0
