@@ -132,3 +132,25 @@ def test_segment_optimum_invalid_input(irb120, segments, budget, match):
     with pytest.raises(InvalidInput, match=match) as err:
         segment_optimum(irb120, segments, budget)
     assert "\n" not in str(err.value)
+
+
+def test_plan_segments_window_of_a_line_retraced_by_the_next_ends_where_it_turns(irb120):
+    """payload_tool lifts the gripper with a MoveL (z50) and, after a MoveJ to where it already is,
+    lowers it along the same line: the taught motion stays on the first line's path throughout,
+    so its window must end where it turns back, not at the segment's end (else the relaxation
+    lets both lines be skipped)."""
+    from joulepath.optimize._reference import _casadi
+    from joulepath.optimize._segment_reference import _Line, _pieces, _widened, _windows
+
+    spec, _ = read_cycle_program(EXAMPLES / "payload_tool.mod", irb120)
+    segs = plan_segments(plan_cycle(spec, CycleSettings().controller))
+    seg = next(s for s in segs if [m.line is not None for m in s.segment.moves] == [True, True])
+    pieces = _pieces(_casadi(), seg.segment, irb120.n_joints, "segment")
+    windows = _windows(pieces, seg.taught)
+    lines = [(p, w) for p, w in zip(pieces, windows, strict=True) if isinstance(p, _Line)]
+    (first, (a0, b0)), (second, (a1, b1)) = lines
+    assert a0 == 0 and b0 <= a1 < b1 == seg.taught.t.size - 1
+    assert seg.taught.t[b0] < 0.75 * seg.span  # it turns back well before the segment ends
+    for p, q in zip(pieces, _widened(pieces, seg.taught, windows), strict=True):
+        if isinstance(p, _Line):  # the taught motion turns within the zone: nothing to widen
+            assert (q.s0, q.s1) == (p.s0, p.s1)
