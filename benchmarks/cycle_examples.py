@@ -12,8 +12,8 @@ whole cycle's taught energy; the share is the plan's saving over the optimum's. 
 pick_and_place, the optimum is also solved in one piece with the segments sharing the taught
 cycle's movable time (``SHARED=0`` skips it).
 
-Run: ``.venv/bin/python benchmarks/cycle_examples.py [PROGRAM ...]`` (one BLAS thread; several
-minutes, most of them the optimum on palletizing and inspection).
+Run: ``.venv/bin/python benchmarks/cycle_examples.py [PROGRAM ...]`` (one BLAS thread; about 25
+minutes on a shared 2-core machine, 16 of them the optimum's 13 segments of palletizing).
 Writes the table to stdout; BENCHMARKS.md holds a copy with the machine.
 """
 
