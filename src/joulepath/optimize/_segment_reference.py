@@ -73,6 +73,7 @@ from joulepath.optimize._cycle_reference import (
 from joulepath.optimize._reference import _casadi, _casadi_friction, casadi_rnea
 from joulepath.optimize._retime import JointPath
 from joulepath.optimize._verify import LimitReport, check_limits, energy_on_samples
+from joulepath.sim import PlannedCycle
 from joulepath.trajectory import Trajectory
 
 LINE_SAMPLES = 257
@@ -875,14 +876,25 @@ def _zone_box(step: Any, zone_mm: float) -> FloatArray:
     return np.full(n, 0.75 * zone_mm / 1000.0 / max(norm, 1e-9))
 
 
-def plan_segments(plan: Any) -> list[PlanSegment]:
-    """The planned cycle (:class:`joulepath.sim.PlannedCycle`) cut at every stop of the robot,
-    each piece as a :class:`CycleSegment` with its zones and its taught motion.
+def plan_segments(plan: PlannedCycle) -> list[PlanSegment]:
+    """The planned cycle cut at every stop of the robot, each piece as a :class:`CycleSegment`
+    with its zones and its taught motion.
 
     A fly-by corner's zone is its zone radius reduced to half the TCP length of either move
     (as the controller reduces it); between two joint moves it is a joint box (first order,
     a margin of 1/4), at a line's end a share of its ``s``. A line's ``line_speed`` is the
-    speeddata's TCP speed over its length and reorientation speed over its turn.
+    speeddata's TCP speed over its length and reorientation speed over its turn. Moves
+    without motion (to where the robot already is) are left out.
+
+    Parameters
+    ----------
+    plan : PlannedCycle
+        The controller emulation's timing of the cycle (:func:`joulepath.sim.plan_cycle`).
+
+    Returns
+    -------
+    list of PlanSegment
+        In the cycle's order; the segments' taught motions add up to the cycle's motion.
     """
     from joulepath.sim._timing import evaluate_cycle
 
