@@ -61,6 +61,7 @@ from joulepath.optimize._cycle_reference import (
     MIN_SUBLEG_S,
     SUCCESS,
     WARM_START,
+    CycleLeg,
     _from_initial,
     _held,
     _interval_function,
@@ -374,20 +375,19 @@ def _piece_lower_bound(
     if isinstance(p, _Line):
         q, _, _ = p.path.at(np.array([p.s0[1], p.s1[0]]))
         return max(
-            leg_lower_bound(robot, _cycle_leg(q[0], q[1]), acceleration_limit=amax, jerk_limit=jmax),
+            leg_lower_bound(
+                robot, CycleLeg(q_start=q[0], q_end=q[1]), acceleration_limit=amax, jerk_limit=jmax
+            ),
             (p.s1[0] - p.s0[1]) / p.speed,
             1e-3,
         )
     q1 = q0 if p.q1 is None else p.q1
     return max(
-        leg_lower_bound(robot, _cycle_leg(q0, q1, p.via), acceleration_limit=amax, jerk_limit=jmax), 1e-3
+        leg_lower_bound(
+            robot, CycleLeg(q_start=q0, q_end=q1, via=p.via), acceleration_limit=amax, jerk_limit=jmax
+        ),
+        1e-3,
     )
-
-
-def _cycle_leg(q0: FloatArray, q1: FloatArray, via: tuple[FloatArray, ...] = ()) -> Any:
-    from joulepath.optimize._cycle_reference import CycleLeg
-
-    return CycleLeg(q_start=q0, q_end=q1, via=via)
 
 
 def _default_start(
