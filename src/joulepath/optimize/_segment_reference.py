@@ -14,7 +14,8 @@ continuation), with two kinds of pieces:
   are the path coordinate ``s`` and its first two derivatives at the nodes, with a
   piecewise-constant ``s⃛``. Then ``qd = q' ṡ``, ``qdd = q'' ṡ² + q' s̈``. ``ṡ`` stays in
   ``[0, line_speed]`` (the speeddata's TCP and reorientation speeds over the line's
-  length and turn);
+  length and turn) everywhere: ``ṡ`` is quadratic in each interval, bounded at its nodes
+  and by its middle Bernstein coefficient;
 * a **joint piece** between two line pieces, or between a line piece and a stop: the
   joint moves in between (their path free, as in :func:`cycle_optimum`), passing each
   target between two joint moves within its joint box, and the blends at the corners.
@@ -36,7 +37,12 @@ cubic of ``intervals`` steps per piece; a taught motion near its shortest time, 
 at its speeddata from rest to rest, may need more intervals to be matched), and IPOPT's
 local optimum (it starts from ``initial`` and, in the tests and the bundled examples, ends
 below it). Joint, speed, acceleration, jerk and effort limits hold at
-``substeps`` points per interval of every piece.
+``substeps`` points per interval of every piece (on a line piece, the kinematic ones at
+``KINEMATIC_CHECKS`` times as many and at each interval's end: not polynomial there).
+
+Time: the segments share ``budget`` (``Σ durations ≤ budget``), each within its own
+``t_min``/``t_max``; one segment with ``budget`` = the time the taught program gives it is
+the comparison at the taught cycle time (benchmarks/cycle_examples.py).
 
 Verified as :func:`cycle_optimum` is: each segment resampled on a grid of at most
 ``FINE_DT``, the energy :func:`energy_on_samples` of it, the limits :func:`check_limits`
