@@ -4,16 +4,16 @@ and writes, against the cycle optimum, and its wall time on one core.
 For each program in examples/: the taught cycle (the controller emulation), the plan
 (``optimize_cycle`` with the CLI's defaults), what is written (``optimized.mod`` where the
 emulation runs it as the checks ask, with its emulated saving; else ``egm.mod`` streaming the
-plan), and the cycle optimum: one IPOPT transcription (CasADi) of the cycle's units from rest to
-rest of joint moves, with the same zones and the time the plan gives them
-(:func:`joulepath.optimize._cycle_reference.cycle_optimum`, where installed), on the robot with
-each move's tool and load as the plan has it (units with different tools: one optimum per tool,
-each within the time the plan gives its units). The share is the
-plan's saving on those units over the optimum's. Units inside MoveL segments and re-timed MoveL
-are not in the optimum (their ends or path are fixed); the share covers the units it holds.
+plan), and the cycle optimum: every segment of the taught cycle between two stops of the robot
+(:func:`joulepath.optimize.plan_segments`), MoveL included, solved by IPOPT through CasADi
+(:func:`joulepath.optimize.segment_optimum`) within the time the taught program gives it, from
+the taught motion, on the robot with the segment's tool and load. The optimum's saving is on the
+whole cycle's taught energy; the share is the plan's saving over the optimum's. For
+pick_and_place, the segments also share the taught cycle's movable time: each solved at 95, 100
+and 105 % of its span, the best combination within the sum (``SHARED=0`` skips it).
 
-Run: ``.venv/bin/python benchmarks/cycle_examples.py`` (one BLAS thread; about 7 minutes, 5 of
-them the cycle optimum on inspection, which stops at its 300 s limit).
+Run: ``.venv/bin/python benchmarks/cycle_examples.py [PROGRAM ...]`` (one BLAS thread; about 25
+minutes on a shared 2-core machine, 16 of them the optimum's 13 segments of palletizing).
 Writes the table to stdout; BENCHMARKS.md holds a copy with the machine.
 """
 
@@ -31,12 +31,19 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from joulepath import load_robot  # noqa: E402
 from joulepath.dynamics import NOMINAL_FRICTION  # noqa: E402
+from joulepath.optimize._verify import energy_on_samples  # noqa: E402
 from joulepath.program import CycleSettings, optimize_cycle, read_cycle_program, write_cycle_run  # noqa: E402
+from joulepath.program._cycle import CycleOptimizer  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-INTERVALS = 16
-"""Transcription intervals per sub-leg of the cycle optimum (8 agree with the single-move
-reference within 0.05 %, tests/optimize/test_cycle_reference.py)."""
+INTERVALS = 8
+"""Transcription intervals per piece of the cycle optimum (per line piece, per sub-leg of a joint
+piece; 8 agree with the single-move reference within 0.05 %, tests/optimize/test_cycle_reference.py)."""
+CONTINUATION = (0.1, 0.03)
+"""Smoothing stages of |tau qd| (shares of the mean power): the third stage of the reference (0.01)
+changed pick_and_place's LJJJ segment by 0.08 % and took 5 times as long as the first two."""
+SEGMENT_LIMIT_S = 300.0
+"""IPOPT's wall-time limit per segment (s)."""
 PROGRAMS = (
     "pick_and_place",
     "palletizing",
@@ -47,68 +54,98 @@ PROGRAMS = (
 )
 
 
-def optimum_share(result, opt) -> tuple[float | None, float | None, str]:
-    """(optimum's saving on the legs %, share of it reached %, note) for the units from rest to rest."""
-    try:
-        from joulepath.optimize._cycle_reference import CycleLeg, cycle_optimum
-    except ImportError:
-        return None, None, "no cycle optimum (module not installed)"
-    groups: dict[int, tuple[object, list, list[float]]] = {}  # by robot (tool and load): legs, budget
-    ours, taught = 0.0, 0.0
-    for i in opt.optimizable:
-        if i in opt.within or i in opt.linear:
-            continue
-        members = opt.chains[i]
-        first, last = opt.by_index[i], opt.by_index[members[-1]]
-        radius = opt.zone_radius(i)
-        robot = first.step.robot  # the robot with the move's tool and load, as the plan has it
-        _, legs, budget = groups.setdefault(id(robot), (robot, [], [0.0]))
-        legs.append(
-            CycleLeg(
-                q_start=first.path.q0,
-                q_end=last.path.q1,
-                via=tuple(opt.by_index[j].path.q1 for j in members[:-1]),
-                via_radius=tuple(radius),
+def cycle_optimum_of(opt) -> tuple[float, float, list[str], float]:
+    """The optimum over every segment of the taught cycle, each in its taught time.
+
+    (taught J, optimum J, per-segment notes, wall s). A segment whose solve does not end
+    feasible counts at its taught energy (0 % saved there): the figure is then a lower
+    bound of the optimum's saving, and the note says so.
+    """
+    from joulepath.optimize import plan_segments, segment_optimum
+
+    taught_J, best_J, notes = 0.0, 0.0, []
+    w0 = time.perf_counter()
+    for k, seg in enumerate(plan_segments(opt.plan)):
+        e0 = energy_on_samples(seg.robot, seg.taught, friction=NOMINAL_FRICTION)
+        taught_J += e0
+        kinds = "".join("L" if m.line is not None else "J" for m in seg.segment.moves)
+        tries = []
+        for intervals in (INTERVALS, 2 * INTERVALS):  # a nearly time-optimal taught motion needs finer steps
+            res = segment_optimum(
+                seg.robot,
+                [seg.segment],
+                seg.span,
+                acceleration_limit=opt._amax(seg.robot),
+                jerk_limit=opt._jmax(seg.robot),
+                friction=NOMINAL_FRICTION,
+                intervals=intervals,
+                initial=[seg.taught],
+                continuation=CONTINUATION,
+                time_limit_s=SEGMENT_LIMIT_S,
             )
-        )
-        t_entry = opt.taught(i)
-        taught += t_entry.energy_J
-        piece = [result.paths[j] for j in members if j in result.paths]
-        if piece:
-            ours += sum(p.energy_J for p in piece)
-            budget[0] += sum(p.duration for p in piece)
+            tries.append(f"{res.wall_s:.0f} s at {intervals}" + ("" if res.feasible else f" ({res.status})"))
+            if res.feasible:
+                break
+        if res.feasible:
+            best_J += res.energy_J
+            notes.append(f"{k}:{kinds} {100 * (1 - res.energy_J / e0):.1f} %, " + ", ".join(tries))
         else:
-            ours += t_entry.energy_J
-            budget[0] += t_entry.duration
-    if not groups:
-        return None, None, "no unit from rest to rest of joint moves"
-    best_J = 0.0
-    for robot, legs, budget in groups.values():
-        best = cycle_optimum(
-            robot,
-            legs,
-            budget[0],
-            acceleration_limit=opt._amax(robot),
-            jerk_limit=opt._jmax(robot),
-            friction=NOMINAL_FRICTION,
-            intervals=INTERVALS,
-            time_limit_s=300.0,
-        )
-        if not best.feasible:
-            return None, None, f"optimum: {best.status}"
-        best_J += best.energy_J
-    if taught - best_J <= 1e-9:
-        return None, None, "optimum: saves nothing"
-    opt_pct = 100 * (taught - best_J) / taught
-    share = 100 * (taught - ours) / (taught - best_J)
-    n = sum(len(legs) for _, legs, _ in groups.values())
-    return opt_pct, share, f"{n} unit(s)"
+            best_J += e0
+            notes.append(f"{k}:{kinds} not solved, counted as taught: " + ", ".join(tries))
+        print(f"  segment {notes[-1]} (taught {e0:.2f} J, {seg.span:.3f} s)", flush=True)
+    return taught_J, best_J, notes, time.perf_counter() - w0
 
 
-def main() -> None:
+SHARES = (0.95, 1.0, 1.05)
+"""Durations tried per segment for the shared-time optimum, as shares of its taught span."""
+
+
+def shared_optimum(opt) -> tuple[float, float, str, float]:
+    """The optimum with the segments sharing the taught cycle's movable time: each segment solved
+    at ``SHARES`` of its taught span, the best combination with Σ durations ≤ Σ spans (a lower
+    bound of the shared optimum's saving, at least the per-segment one). (taught J, optimum J,
+    chosen shares, wall s)."""
+    import itertools
+
+    from joulepath.optimize import plan_segments, segment_optimum
+
+    w0 = time.perf_counter()
+    segs = plan_segments(opt.plan)
+    table: list[dict[float, float]] = []
+    for seg in segs:
+        row = {}
+        for share in SHARES:
+            res = segment_optimum(
+                seg.robot,
+                [seg.segment],
+                share * seg.span,
+                acceleration_limit=opt._amax(seg.robot),
+                jerk_limit=opt._jmax(seg.robot),
+                friction=NOMINAL_FRICTION,
+                intervals=INTERVALS,
+                initial=[seg.taught],
+                continuation=CONTINUATION,
+                time_limit_s=SEGMENT_LIMIT_S,
+            )
+            if res.feasible:
+                row[share] = res.energy_J
+        table.append(row)
+    total = sum(seg.span for seg in segs)
+    best, chosen = float("inf"), ()
+    for combo in itertools.product(*(sorted(r) for r in table)):
+        if sum(c * seg.span for c, seg in zip(combo, segs, strict=True)) <= total + 1e-9:
+            e = sum(r[c] for r, c in zip(table, combo, strict=True))
+            if e < best:
+                best, chosen = e, combo
+    taught = sum(energy_on_samples(s.robot, s.taught, friction=NOMINAL_FRICTION) for s in segs)
+    return taught, best, "shares " + ", ".join(f"{c:g}" for c in chosen), time.perf_counter() - w0
+
+
+def main(argv: list[str] | None = None) -> None:
+    names = tuple(argv) if argv else PROGRAMS
     robot = load_robot("irb120")
     rows = []
-    for name in PROGRAMS:
+    for name in names:
         spec, rapid = read_cycle_program(EXAMPLES / f"{name}.mod", robot)
         t0 = time.process_time()
         w0 = time.perf_counter()
@@ -121,48 +158,47 @@ def main() -> None:
         if "optimized.mod" in files:
             written = f"RAPID, emulated {data['executed_saved_pct']:.1f} %"
         else:
-            via = data["rapid_plan_saved_pct"]
-            written = f"EGM, {result.saved_pct:.1f} % (the plan); via-point plan: " + (
-                "none saves" if via is None else f"{via:.1f} %, refused"
-            )
-        opt_pct, share, note = optimum_share(result, opt)
+            written = f"EGM, {result.saved_pct:.1f} %"
+        print(f"{name}: {result.saved_pct:.1f} %, {wall:.1f} s", flush=True)
+        taught_J, best_J, notes, opt_wall = cycle_optimum_of(CycleOptimizer(spec, CycleSettings()))
+        opt_pct = 100 * (taught_J - best_J) / taught_J
+        plan_saved = result.default_energy_J - result.optimized_energy_J
+        share = 100 * plan_saved / (result.default_energy_J * opt_pct / 100) if opt_pct > 0 else None
         n_moves = sum(1 for s in spec.steps if s.kind == "move")
         rows.append(
-            (
-                name,
-                n_moves,
-                result.default_cycle_s,
-                result.optimized_cycle_s,
-                result.default_energy_J,
-                result.optimized_energy_J,
-                result.saved_pct,
-                written,
-                opt_pct,
-                share,
-                note,
-                wall,
-                cpu,
-            )
+            (name, n_moves, result, written, taught_J, best_J, opt_pct, share, notes, wall, cpu, opt_wall)
         )
-        print(f"{name}: {result.saved_pct:.1f} %, {wall:.1f} s", flush=True)
+        print(
+            f"  optimum {opt_pct:.1f} % (taught {taught_J:.2f} J), share {share} , {opt_wall:.0f} s",
+            flush=True,
+        )
+        if name == "pick_and_place" and os.environ.get("SHARED", "1") == "1":
+            s_taught, s_best, status, s_wall = shared_optimum(CycleOptimizer(spec, CycleSettings()))
+            print(
+                f"  shared time: optimum {100 * (s_taught - s_best) / s_taught:.1f} % ({status}), {s_wall:.0f} s",
+                flush=True,
+            )
     print()
     print(f"Machine: {platform.machine()}, {platform.processor() or platform.platform()}, one BLAS thread")
     print()
     print(
         "| program | moves | cycle taught → planned (s) | energy taught → planned (J) | saved (plan) | written | "
-        "optimum on its units | share of it | wall / CPU (s) |"
+        "optimum (J, saved) | share of it | plan wall / CPU (s) | optimum wall (s) |"
     )
-    print("|---|---|---|---|---|---|---|---|---|")
-    for r in rows:
-        opt_txt = "—" if r[8] is None else f"{r[8]:.1f} % ({r[10]})"
-        share_txt = "—" if r[9] is None else f"{r[9]:.0f} %"
-        if r[8] is None:
-            opt_txt = f"— ({r[10]})"
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for name, n_moves, r, written, _, best_J, opt_pct, share, _, wall, cpu, opt_wall in rows:
+        share_txt = "—" if share is None else f"{share:.0f} %"
         print(
-            f"| {r[0]} | {r[1]} | {r[2]:.3f} → {r[3]:.3f} | {r[4]:.2f} → {r[5]:.2f} | {r[6]:.1f} % | {r[7]} | "
-            f"{opt_txt} | {share_txt} | {r[11]:.1f} / {r[12]:.1f} |"
+            f"| {name} | {n_moves} | {r.default_cycle_s:.3f} → {r.optimized_cycle_s:.3f} | "
+            f"{r.default_energy_J:.2f} → {r.optimized_energy_J:.2f} | {r.saved_pct:.1f} % | {written} | "
+            f"{best_J:.2f}, {opt_pct:.1f} % | {share_txt} | {wall:.1f} / {cpu:.1f} | {opt_wall:.0f} |"
         )
+    print()
+    for name, *_, notes, _, _, _ in rows:
+        print(f"- {name}: " + "; ".join(notes))
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    main(sys.argv[1:])
