@@ -439,3 +439,66 @@ def test_electrical_search_saves_electrical_energy_and_reports_every_measure(irb
     assert "irb120.drives.toml" in electrical.source
     out = s.to_json()
     assert set(out["energies"]) == {"thesis", "mechanical", "electrical"}
+
+
+# ------------------------------------------------------------------ long moves
+def test_near_limit_keeps_every_bump_of_a_long_move_within_the_band(rng):
+    """Over the row cap only each bump's deepest samples enter the solve: a subset of the samples
+    within the band, and every contiguous run of them keeps its deepest sample."""
+    from joulepath.optimize._gradient import _near_limit
+
+    t = np.linspace(0.0, 6.0, 2401)
+    slack = np.column_stack([1.0 + (0.9 + 0.2 * rng.random()) * np.sin((2 + p) * t + p) for p in range(6)])
+    within = np.full(6, 0.5)
+    near = slack < within
+    every = _near_limit(slack, within, cap=10**9)
+    np.testing.assert_array_equal(every, np.flatnonzero(near.ravel()))
+    thin = _near_limit(slack, within, cap=10)
+    assert 0 < thin.size < every.size / 4
+    assert np.isin(thin, every).all()
+    kept = np.zeros(slack.size, bool)
+    kept[thin] = True
+    kept = kept.reshape(slack.shape)
+    for j in range(6):  # each run of samples within the band keeps its deepest one
+        edges = np.flatnonzero(np.diff(np.r_[0, near[:, j].astype(int), 0]))
+        for a, b in zip(edges[::2], edges[1::2], strict=True):
+            assert kept[a + int(np.argmin(slack[a:b, j])), j]
+
+
+def test_a_long_move_gets_at_most_max_knots_and_stays_within_every_limit(irb120):
+    from joulepath.optimize._gradient import GradientSettings, solve_move
+
+    amax = acceleration_limit(irb120, 0.25)
+    settings = GradientSettings(knot_spacing=0.05, continuation=(0.3, 0.03), max_knots=20)
+    assert settings.spacing_for(1.0) == pytest.approx(0.05)
+    assert settings.spacing_for(4.0) == pytest.approx(0.2)
+    res, problem = solve_move(
+        irb120, Q0, QF, 4.0, friction=NOMINAL_FRICTION, settings=settings,
+        rng=np.random.default_rng(0), acceleration_limit=amax,
+    )  # fmt: skip
+    assert problem.basis.knot_spacing == pytest.approx(0.2)
+    assert problem.thin_rows and settings.is_long(4.0) and not settings.is_long(1.0)
+    assert res.feasible
+    fine = problem.path(res.coefficients.ravel(), fine=True)
+    assert check_limits(irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax).ok
+    with pytest.raises(InvalidInput, match="max_knots"):
+        GradientSettings(max_knots=2)
+
+
+def test_a_deadline_stops_the_search_where_it_is(irb120):
+    """Past its deadline the search takes no further iteration, round, start or refinement (the
+    cycle's --max-time holds inside a solve); without one the same search iterates on."""
+    import time
+
+    from joulepath.optimize._gradient import GradientSettings, solve_move
+
+    amax = acceleration_limit(irb120, 0.25)
+    settings = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), n_starts=3)
+    args = dict(friction=NOMINAL_FRICTION, settings=settings, acceleration_limit=amax)
+    free, _ = solve_move(irb120, Q0, QF, 1.5, rng=np.random.default_rng(0), **args)
+    late, _ = solve_move(
+        irb120, Q0, QF, 1.5, rng=np.random.default_rng(0), deadline=time.perf_counter(), **args
+    )
+    assert free.n_iterations > 5
+    assert late.n_iterations <= 1
+    assert len(late.starts) == 1

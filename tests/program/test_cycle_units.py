@@ -363,3 +363,55 @@ def test_for_every_move_kind_the_optimizer_moves_as_fast_as_the_controller(robot
             assert own.duration == pytest.approx(span)
     assert all(kinds.values()), kinds
     assert opt.shortest_cycle <= opt.plan.cycle_time + 1e-9
+
+
+def test_ordered_closest_agrees_with_every_ordered_choice():
+    """When a chain passes its targets: the least summed distance over indices in order, at least
+    ``gap`` apart, as found by trying every such choice."""
+    import itertools
+
+    from joulepath.program._cycle import _ordered_closest
+
+    rng = np.random.default_rng(3)
+    for _ in range(150):
+        m, n = int(rng.integers(1, 4)), int(rng.integers(8, 14))
+        d = rng.random((m, n))
+        ks = _ordered_closest(d, lo=2, hi=n - 3, gap=2)
+        choices = [
+            c
+            for c in itertools.combinations(range(2, n - 2), m)
+            if all(b - a >= 2 for a, b in zip(c, c[1:], strict=False))
+        ]
+        if not choices:
+            continue
+        best = min(sum(d[j, c[j]] for j in range(m)) for c in choices)
+        assert sum(d[j, ks[j]] for j in range(m)) == pytest.approx(best, abs=1e-12)
+        assert all(b - a >= 2 for a, b in zip(ks, ks[1:], strict=False))
+
+
+def test_a_chain_through_the_same_target_twice_passes_each_in_turn(robot):
+    """A fly-by chain back and forth between two targets (a legal program that raised a traceback):
+    the taught motion's passes are found in order, each near its own target."""
+    text = (
+        "MODULE BackAndForth\n"
+        + TARGETS
+        + "    PROC main()\n"
+        + "".join(f"        MoveJ {p}, v1000, z10, tool0;\n" for p in ("pAUp", "pBUp") * 3)
+        + "    ENDPROC\nENDMODULE\n"
+    )
+    spec = resolve_module(parse_module(text, path="back_and_forth.mod"), robot)
+    opt = CycleOptimizer(spec, CycleSettings(gradient=FAST))
+    chains = [i for i, c in opt.chains.items() if len(c) > 2]
+    assert chains
+    for i in chains:
+        n = int(np.floor(opt.segment_of[i].span / 0.025 + 1e-9))
+        base = opt.base(i, n)
+        passes = opt._taught_passes(i, base)
+        times = [t for t, _ in passes]
+        assert len(passes) == len(opt.chains[i]) - 1
+        assert all(b > a for a, b in zip(times, times[1:], strict=False))
+        for t, q in passes:
+            k = int(np.argmin(np.abs(base.t - t)))
+            at, _ = _tcp(robot, base.q[k][None, :], spec.steps[0].tcp)
+            want, _ = _tcp(robot, q[None, :], spec.steps[0].tcp)
+            assert 1000 * np.linalg.norm(at - want) < 15.0  # within its z10 zone (and the grid)

@@ -53,6 +53,8 @@ from joulepath.units import SAMPLE_PERIOD
 
 SCREEN_BAND = 0.25
 """A fine-grid constraint enters the solve when its value is within this share of its limit."""
+THIN_ROWS = 2
+"""Rows of one rate kind, per variable, above which only each bump's deepest samples enter a solve."""
 RANGE_MARGIN = 1e-6
 """rad kept from each range end inside the solve (solver tolerance)."""
 RATE_MARGIN = 1e-6
@@ -80,9 +82,15 @@ class GradientSettings:
     than the samples (a divisor of ``check_factor``). ``give_up``: a start whose
     continuation stage ends outside a limit is not carried through the later stages, nor
     refined on the fine knots (a probe that may be infeasible costs one stage).
+    ``max_knots``: at most this many knot intervals on the fine knots; a longer move gets
+    its knots wider apart, and its rate rows thinned (``SplineProblem.thin_rows``): the dense
+    solver's work grows with the variables and the rows (a 5.3 s fly-by chain of 8 moves
+    took 392 s on 106 knots with every row; on 52 knots 21 s, thinned 11 s, for 1.2 % more
+    energy).
     """
 
     knot_spacing: float = DEFAULT_KNOT_SPACING
+    max_knots: int = 64
     degree: int = 5
     n_starts: int = 1
     continuation: tuple[float, ...] = (0.3, 0.03, 0.003)
@@ -109,6 +117,16 @@ class GradientSettings:
             raise InvalidInput(f"continuation must be positive shares, got {self.continuation}")
         if self.check_factor < 1:
             raise InvalidInput(f"check_factor must be ≥ 1, got {self.check_factor}")
+        if self.max_knots < 4:
+            raise InvalidInput(f"max_knots must be ≥ 4, got {self.max_knots}")
+
+    def spacing_for(self, duration: float) -> float:
+        """s between the fine knots of a ``duration`` s move (``knot_spacing``, wider past ``max_knots``)."""
+        return max(self.knot_spacing, duration / self.max_knots)
+
+    def is_long(self, duration: float) -> bool:
+        """A move past ``max_knots`` knots at ``knot_spacing``: wider knots and thinned rows."""
+        return duration > self.knot_spacing * self.max_knots + 1e-9
 
 
 @dataclass(frozen=True, slots=True)
@@ -130,7 +148,11 @@ class GradientResult:
 
 @dataclass(eq=False)
 class SplineProblem:
-    """Energy, limits and corridor of one move as functions of the spline coefficients."""
+    """Energy, limits and corridor of one move as functions of the spline coefficients.
+
+    ``thin_rows``: a long move's rate rows (accelerations, jerks, efforts) enter a solve thinned
+    to each bump's deepest samples once they pass :data:`THIN_ROWS` per variable (:func:`_near_limit`).
+    """
 
     robot: Robot
     q_start: FloatArray
@@ -147,6 +169,7 @@ class SplineProblem:
     base: Trajectory | None = None
     energy_measure: str = DEFAULT_MEASURE
     energy_every: int = 1
+    thin_rows: bool = False
     n_evaluations: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -494,16 +517,16 @@ class SplineProblem:
 
     def screen(self, x: FloatArray, band: float) -> dict[str, np.ndarray]:
         """Indices of the constraints within ``band`` of their limits, or violated."""
+        cap = THIN_ROWS * self.m * self.n if self.thin_rows else np.iinfo(np.int64).max
         out = {
             "hull": np.flatnonzero(self.hull_slack(x) < band * self.hull_scale),
-            "qdd": np.flatnonzero((self.accel_slack(x) < band * np.tile(self.amax, 1)).ravel()),
+            "qdd": _near_limit(self.accel_slack(x), band * self.amax, cap),
         }
         if self.has_jerk:
-            out["qddd"] = np.flatnonzero((self.jerk_slack(x) < band * self.jmax).ravel())
+            out["qddd"] = _near_limit(self.jerk_slack(x), band * self.jmax, cap)
         if self.has_effort:
-            e = self.effort_slack(x)
             lim = np.where(np.isfinite(self.emax), self.emax, np.inf)
-            out["tau"] = np.flatnonzero((e < band * lim).ravel())
+            out["tau"] = _near_limit(self.effort_slack(x), band * lim, cap)
         if self.max_deviation_m is not None:
             out["tcp"] = np.flatnonzero(self.deviation(x) > (1.0 - band) * self.max_deviation_m)
         return out
@@ -521,6 +544,23 @@ class SplineProblem:
         return max(worst, 0.0)
 
 
+def _near_limit(slack: FloatArray, within: FloatArray, cap: int) -> np.ndarray:
+    """Flat indices of the fine-grid rate constraints (``slack`` (R, n)) within ``within`` of their
+    limits; over ``cap`` of them (a long move that runs along its limits), only each bump's deepest
+    sample and its two neighbours: neighbouring samples of the fine grid
+    carry nearly the same row, and a dense solver's work grows with the rows it carries. A bump
+    missed this way is violated after the solve, and :func:`_solve_from` adds it then."""
+    near = slack < within
+    if np.count_nonzero(near) <= cap:
+        return np.flatnonzero(near.ravel())
+    pad = np.pad(slack, ((1, 1), (0, 0)), constant_values=np.inf)
+    deepest = (slack <= pad[:-2]) & (slack <= pad[2:])
+    keep = deepest.copy()
+    keep[1:] |= deepest[:-1]
+    keep[:-1] |= deepest[1:]
+    return np.flatnonzero((near & keep).ravel())
+
+
 def _merge(a: dict[str, np.ndarray], b: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return {
         k: np.union1d(a.get(k, np.empty(0, int)), b.get(k, np.empty(0, int))) for k in a.keys() | b.keys()
@@ -535,12 +575,21 @@ def _solve_from(
     eps_unit: float,
     history: list[float],
     known: dict[str, np.ndarray] | None = None,
+    deadline: float | None = None,
 ) -> tuple[FloatArray, int, dict[str, np.ndarray]]:
     """Continuation stages from ``x0``; each stage regenerates constraints until none is violated.
 
     ``known`` adds constraints found active by an earlier search on the same fine grid.
+    ``deadline`` (``time.perf_counter()``): past it the solver stops at its current iterate.
     """
     from scipy.optimize import minimize
+
+    def late() -> bool:
+        return deadline is not None and time.perf_counter() > deadline
+
+    def stop_when_late(_: Any) -> None:
+        if late():
+            raise StopIteration
 
     x = x0.copy()
     n_iter = 0
@@ -562,6 +611,7 @@ def _solve_from(
                 method="SLSQP",
                 constraints=problem.constraints(active),
                 options={"maxiter": settings.max_iter, "ftol": settings.ftol},
+                callback=None if deadline is None else stop_when_late,
             )
             n_iter += int(res.nit)
             cand = np.asarray(res.x, dtype=float)
@@ -569,9 +619,9 @@ def _solve_from(
                 x = cand
             history.append(problem.true_energy(x))
             active = _merge(active, problem.screen(x, SCREEN_BAND))
-            if problem.violation(x) == 0.0:
+            if problem.violation(x) == 0.0 or late():
                 break
-        if settings.give_up and problem.violation(x) > 0.0:
+        if (settings.give_up and problem.violation(x) > 0.0) or late():
             break
     return x, n_iter, active
 
@@ -584,6 +634,7 @@ def optimize_spline(
     progress: Callable[[int, int], None] | None = None,
     initial: FloatArray | None = None,
     known: dict[str, np.ndarray] | None = None,
+    deadline: float | None = None,
 ) -> GradientResult:
     """Multi-start continuation SLSQP on ``problem``; returns the best feasible start.
 
@@ -591,14 +642,17 @@ def optimize_spline(
     add random smooth shapes of about ``start_scale`` times each joint's travel
     (at least 0.05 rad), drawn from ``rng``. A start's result counts only if it
     satisfies every constraint on the fine grid; the minimum-jerk move itself is
-    the fall-back when none does and it is feasible.
+    the fall-back when none does and it is feasible. ``deadline`` (``time.perf_counter()``):
+    past it the search stops where it is (no further iteration, round or start).
     """
     from threadpoolctl import threadpool_limits
 
     # the solver's small dense linear algebra runs many times faster on one BLAS
     # thread than on a pool that competes with other work for the same cores
     with threadpool_limits(limits=1, user_api="blas"):
-        return _optimize_spline(problem, settings, rng=rng, progress=progress, initial=initial, known=known)
+        return _optimize_spline(
+            problem, settings, rng=rng, progress=progress, initial=initial, known=known, deadline=deadline
+        )
 
 
 def _optimize_spline(
@@ -609,6 +663,7 @@ def _optimize_spline(
     progress: Callable[[int, int], None] | None,
     initial: FloatArray | None,
     known: dict[str, np.ndarray] | None = None,
+    deadline: float | None = None,
 ) -> GradientResult:
     t0 = time.perf_counter()
     zero = problem.origin.copy()  # the minimum-jerk move, or the smoothest path through the waypoints
@@ -628,7 +683,9 @@ def _optimize_spline(
     finals: list[float] = []
     n_iter = 0
     for s, x0 in enumerate(starts):
-        x, it, active = _solve_from(problem, x0, settings, scale, eps_unit, history, known)
+        if s and deadline is not None and time.perf_counter() > deadline:
+            break
+        x, it, active = _solve_from(problem, x0, settings, scale, eps_unit, history, known, deadline)
         n_iter += it
         e = problem.true_energy(x)
         ok = problem.violation(x) == 0.0
@@ -668,6 +725,7 @@ def solve_move(
     waypoint_radius: tuple[FloatArray, ...] = (),
     base: Trajectory | None = None,
     energy_measure: str = DEFAULT_MEASURE,
+    deadline: float | None = None,
 ) -> tuple[GradientResult, SplineProblem]:
     """Coarse-to-fine gradient search of one move; the result and the problem it lives in.
 
@@ -677,7 +735,8 @@ def solve_move(
     ``base``: the motion (on the fine grid) the shape is added to instead of the
     minimum-jerk move; its start and end states (q, qd, qdd) are kept.
     ``energy_measure``: the energy minimized (:data:`joulepath.energy.MEASURES`), its data
-    from :attr:`Robot.drivetrain`.
+    from :attr:`Robot.drivetrain`. ``deadline`` (``time.perf_counter()``): past it the search
+    stops where it is (:func:`optimize_spline`).
     """
 
     def make(spacing: float) -> SplineProblem:
@@ -698,12 +757,14 @@ def solve_move(
             base=base,
             energy_measure=energy_measure,
             energy_every=settings.energy_every,
+            thin_rows=settings.is_long(duration),
         )
 
-    fine = make(settings.knot_spacing)
-    coarse_spacing = settings.knot_spacing * settings.coarse_factor
+    spacing = settings.spacing_for(duration)
+    fine = make(spacing)
+    coarse_spacing = spacing * settings.coarse_factor
     if settings.coarse_factor <= 1 or round(duration / coarse_spacing) < 2:
-        return optimize_spline(fine, settings, rng=rng), fine
+        return optimize_spline(fine, settings, rng=rng, deadline=deadline), fine
     coarse = make(coarse_spacing)
     # the continuation runs coarse to fine: the wide knots take the stages before the last
     # `refine_stages`, the fine knots those (measured against every stage on the wide knots
@@ -713,8 +774,8 @@ def solve_move(
         if settings.coarse_stages
         else settings.continuation[: -settings.refine_stages] or settings.continuation[:1]
     )
-    first = optimize_spline(coarse, replace(settings, continuation=head), rng=rng)
-    if settings.give_up and not first.feasible:
+    first = optimize_spline(coarse, replace(settings, continuation=head), rng=rng, deadline=deadline)
+    if (settings.give_up and not first.feasible) or (deadline is not None and time.perf_counter() > deadline):
         return first, coarse
     # the coarse path in the fine basis: least squares on the fine grid (exact for nested knots)
     target = coarse.fine.B @ first.coefficients
@@ -723,7 +784,7 @@ def solve_move(
     # the limit grids (accelerations, jerks, efforts, corridor) are the same in both bases;
     # the control-point (hull) rows are not
     known = {kind: rows for kind, rows in first.active.items() if kind != "hull"}
-    second = optimize_spline(fine, refine, rng=rng, initial=start, known=known)
+    second = optimize_spline(fine, refine, rng=rng, initial=start, known=known, deadline=deadline)
     merged_history = np.minimum.accumulate(np.concatenate([first.history, second.history]))
     best, problem = (
         (second, fine) if second.feasible and second.energy_J <= first.energy_J else (first, coarse)

@@ -678,17 +678,12 @@ class CycleOptimizer:
         step = self.by_index[i].step
         assert step.robot is not None and step.tcp is not None
         p, _ = _tcp(step.robot, traj.q, step.tcp)
-        out: list[tuple[float, FloatArray]] = []
-        lo = 2
-        members = self.chains[i]
-        for j in members[:-1]:
-            q = self.by_index[j].path.q1
-            p0, _ = _tcp(step.robot, q[None, :], step.tcp)
-            d = np.linalg.norm(p - p0, axis=1)
-            k = lo + int(np.argmin(d[lo : max(lo + 1, d.size - 2)]))
-            out.append((float(traj.t[k]), q))
-            lo = k + 2
-        return tuple(out)
+        targets = [self.by_index[j].path.q1 for j in self.chains[i][:-1]]
+        dist = np.stack(
+            [np.linalg.norm(p - _tcp(step.robot, q[None, :], step.tcp)[0], axis=1) for q in targets]
+        )
+        ks = _ordered_closest(dist, lo=2, hi=p.shape[0] - 3, gap=2)
+        return tuple((float(traj.t[k]), q) for k, q in zip(ks, targets, strict=True))
 
     def base(self, i: int, n_steps: int | None = None) -> Trajectory:
         """The taught motion over unit ``i``'s window (or its first ``n_steps`` 25 ms samples), on
@@ -744,6 +739,7 @@ class CycleOptimizer:
             waypoint_radius=self.zone_radius(i),
             base=base,
             energy_measure=self.settings.energy,
+            deadline=self.deadline,
         )
         self.n_solves += 1
         x = res.coefficients.ravel()
@@ -850,7 +846,7 @@ class CycleOptimizer:
             m1.path.q1,
             T,
             NOMINAL_FRICTION,
-            SplineBasis(T, knot_spacing=g.knot_spacing, degree=g.degree, dt=STEP),
+            SplineBasis(T, knot_spacing=g.spacing_for(T), degree=g.degree, dt=STEP),
             check_factor=g.check_factor,
             acceleration_limit=self._amax(robot),
             waypoints=self.waypoints(i, T),
@@ -981,7 +977,7 @@ class CycleOptimizer:
         """The fine-knot problem at ``T`` and the warm path in its coefficients (time-scaled, lstsq)."""
         g = self.gradient
         robot = self._robot(m)
-        basis = SplineBasis(T, knot_spacing=g.knot_spacing, degree=g.degree, dt=STEP)
+        basis = SplineBasis(T, knot_spacing=g.spacing_for(T), degree=g.degree, dt=STEP)
         problem = SplineProblem(
             robot,
             m.path.q0,
@@ -994,6 +990,7 @@ class CycleOptimizer:
             acceleration_limit=self._amax(robot),
             jerk_limit=self._jmax(robot),
             energy_measure=self.settings.energy,
+            thin_rows=g.is_long(T),
         )
         t_old = problem.fine.t * (warm.duration / T)
         q_old = np.column_stack(
@@ -1027,7 +1024,7 @@ class CycleOptimizer:
             problem, start = self._warm_problem(m, T, corridor, warm)
             g = self.gradient
             refine = replace(g, n_starts=1, continuation=g.continuation[-g.refine_stages :])
-            res = optimize_spline(problem, refine, rng=rng, initial=start)
+            res = optimize_spline(problem, refine, rng=rng, initial=start, deadline=self.deadline)
         else:
             g = self.gradient if gradient is None else gradient
             res, problem = solve_move(
@@ -1052,6 +1049,7 @@ class CycleOptimizer:
                 waypoint_radius=self.zone_radius(m.index),
                 base=base,
                 energy_measure=self.settings.energy,
+                deadline=self.deadline,
             )
         self.n_solves += 1
         x = res.coefficients.ravel()
@@ -1777,6 +1775,36 @@ def _assemble(
         energies_unavailable=unavailable,
     )
     return result
+
+
+def _ordered_closest(dist: FloatArray, *, lo: int, hi: int, gap: int) -> list[int]:
+    """Sample indices ``k_0 < k_1 < ...`` (at least ``gap`` apart, within ``[lo, hi]``) that
+    minimize the summed distances ``dist[j, k_j]``: when the motion passes each target in order.
+
+    A target the chain visits twice is matched to its own pass, not to the closer other one (a
+    greedy nearest match could take a later pass and leave no samples for the targets after it).
+    Too few samples for the targets: spread evenly over the window."""
+    m, n = dist.shape
+    hi = min(hi, n - 1)
+    if m == 0:
+        return []
+    if hi - lo < gap * (m - 1):
+        return [int(round(v)) for v in np.linspace(0, n - 1, m + 2)[1:-1]]
+    cost = np.full((m, n), np.inf)
+    arg = np.zeros((m, n), dtype=int)
+    cost[0, lo : hi + 1] = dist[0, lo : hi + 1]
+    for j in range(1, m):
+        prev = cost[j - 1]
+        # best predecessor at or before k - gap: a running minimum and where it is
+        run = np.minimum.accumulate(prev)
+        where = np.maximum.accumulate(np.where(prev == run, np.arange(n), 0))
+        ks = np.arange(lo + gap * j, hi + 1)
+        cost[j, ks] = dist[j, ks] + run[ks - gap]
+        arg[j, ks] = where[ks - gap]
+    ks_out = [int(np.argmin(cost[-1]))]
+    for j in range(m - 1, 0, -1):
+        ks_out.append(int(arg[j, ks_out[-1]]))
+    return ks_out[::-1]
 
 
 def _segment_with(opt: CycleOptimizer, index: int) -> Segment:
