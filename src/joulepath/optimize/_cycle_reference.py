@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -544,9 +544,62 @@ def cycle_optimum(
             opti.set_initial(T, np.asarray(T0))
 
     set_start(start)
+    current, status, succeeded = ipopt_stages(
+        opti,
+        eps,
+        unit,
+        continuation,
+        read=lambda value: [_values(value, X) for X in variables],
+        set_start=set_start,
+        tol=tol,
+        max_iter=max_iter,
+        deadline=t_start + time_limit_s,
+        start=start,
+    )
+
+    paths, energies, reports, vias = [], [], [], []
+    for Q0, V0, A0, T0 in current:
+        path = resample_leg(Q0, V0, A0, T0, intervals)
+        paths.append(path)
+        energies.append(energy_on_samples(robot, path, friction=friction))
+        reports.append(check_limits(robot, path, friction=friction, acceleration_limit=amax, jerk_limit=jmax))
+        vias.append(tuple(float(x) for x in np.cumsum(T0)[:-1]))
+    durations = tuple(float(p.t[-1]) for p in paths)
+    feasible = succeeded and all(_held(r) for r in reports) and sum(durations) <= budget + 1e-6
+    return CycleOptimum(
+        durations=durations,
+        energy_J=float(sum(energies)),
+        legs_energy_J=tuple(energies),
+        paths=tuple(paths),
+        feasible=feasible,
+        status=status,
+        wall_s=time.perf_counter() - t_start,
+        via_times_s=tuple(vias),
+        limits=tuple(reports),
+    )
+
+
+def ipopt_stages(
+    opti: Any,
+    eps: Any,
+    unit: float,
+    continuation: Sequence[float],
+    *,
+    read: Callable[[Callable[[Any], Any]], Any],
+    set_start: Callable[[Any], None],
+    tol: float,
+    max_iter: int,
+    deadline: float,
+    start: Any,
+) -> tuple[Any, str, bool]:
+    """IPOPT through the smoothing stages ``continuation`` (ε = share · ``unit``), each warm-started
+    from the one before, within the wall-time ``deadline`` (``time.perf_counter()``).
+
+    ``read(value)`` turns a solve's values into the start ``set_start`` takes. A stage that fails
+    after one converged keeps the converged one (the optimum of a slightly smoother objective).
+    Returns the values, IPOPT's status and whether a stage converged and was kept."""
     status = "not run"
     current, converged = start, ""
-    deadline = t_start + time_limit_s
     for stage, share in enumerate(continuation):
         left = deadline - time.perf_counter()
         if left <= 0:
@@ -574,33 +627,11 @@ def cycle_optimum(
             status = str(opti.stats()["return_status"])
             value = opti.debug.value
         if status not in SUCCESS and converged:
-            # keep the last converged stage (the optimum of a slightly smoother objective)
             status = f"{converged} (stage ε share {share:g}: {status}; kept the stage before)"
             break
-        current = [_values(value, X) for X in variables]
+        current = read(value)
         set_start(current)
         if status not in SUCCESS:
             break
         converged = status
-    succeeded = bool(converged) and status.startswith(converged)
-
-    paths, energies, reports, vias = [], [], [], []
-    for Q0, V0, A0, T0 in current:
-        path = resample_leg(Q0, V0, A0, T0, intervals)
-        paths.append(path)
-        energies.append(energy_on_samples(robot, path, friction=friction))
-        reports.append(check_limits(robot, path, friction=friction, acceleration_limit=amax, jerk_limit=jmax))
-        vias.append(tuple(float(x) for x in np.cumsum(T0)[:-1]))
-    durations = tuple(float(p.t[-1]) for p in paths)
-    feasible = succeeded and all(_held(r) for r in reports) and sum(durations) <= budget + 1e-6
-    return CycleOptimum(
-        durations=durations,
-        energy_J=float(sum(energies)),
-        legs_energy_J=tuple(energies),
-        paths=tuple(paths),
-        feasible=feasible,
-        status=status,
-        wall_s=time.perf_counter() - t_start,
-        via_times_s=tuple(vias),
-        limits=tuple(reports),
-    )
+    return current, status, bool(converged) and status.startswith(converged)

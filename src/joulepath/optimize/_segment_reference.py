@@ -53,7 +53,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -65,8 +65,6 @@ from joulepath.errors import InvalidInput
 from joulepath.optimize._cycle_reference import (
     FINE_DT,
     MIN_SUBLEG_S,
-    SUCCESS,
-    WARM_START,
     CycleLeg,
     _from_initial,
     _held,
@@ -75,6 +73,7 @@ from joulepath.optimize._cycle_reference import (
     _node_times,
     _vector,
     _warm_start,
+    ipopt_stages,
     leg_lower_bound,
 )
 from joulepath.optimize._reference import _casadi, _casadi_friction, casadi_rnea
@@ -763,39 +762,9 @@ def segment_optimum(
                 opti.set_initial(var[4], np.asarray(v[3], dtype=float))
 
     set_start(starts)
-    status = "not run"
-    current, converged = starts, ""
-    deadline = t_start + time_limit_s
-    for stage, share in enumerate(continuation):
-        left = deadline - time.perf_counter()
-        if left <= 0:
-            status = "Maximum_WallTime_Exceeded"
-            break
-        opti.solver(
-            "ipopt",
-            {"print_time": False},
-            {
-                "print_level": 0,
-                "tol": tol,
-                "max_iter": max_iter,
-                "sb": "yes",
-                "mu_strategy": "adaptive",
-                **(WARM_START if stage else {}),
-                "max_wall_time": float(left),
-            },
-        )
-        opti.set_value(eps, share * unit)
-        try:
-            sol = opti.solve()
-            status = str(sol.stats()["return_status"])
-            value = sol.value
-        except RuntimeError:
-            status = str(opti.stats()["return_status"])
-            value = opti.debug.value
-        if status not in SUCCESS and converged:
-            status = f"{converged} (stage ε share {share:g}: {status}; kept the stage before)"
-            break
-        current = [
+
+    def read(value: Callable[[Any], Any]) -> list[list[Any]]:
+        raw = [
             [
                 tuple(np.atleast_2d(np.asarray(value(X), dtype=float)) for X in var[:3])
                 + (np.atleast_1d(np.asarray(value(var[4]), dtype=float)).ravel(),)
@@ -803,18 +772,26 @@ def segment_optimum(
             ]
             for seg_vars in variables
         ]
-        current = [
+        return [
             [
                 v if isinstance(p, _Joint) else (v[0][0], v[1][0], v[2][0], v[3])
                 for p, v in zip(pieces, vals, strict=True)
             ]
-            for pieces, vals in zip(all_pieces, current, strict=True)
+            for pieces, vals in zip(all_pieces, raw, strict=True)
         ]
-        set_start(current)
-        if status not in SUCCESS:
-            break
-        converged = status
-    succeeded = bool(converged) and status.startswith(converged)
+
+    current, status, succeeded = ipopt_stages(
+        opti,
+        eps,
+        unit,
+        continuation,
+        read=read,
+        set_start=set_start,
+        tol=tol,
+        max_iter=max_iter,
+        deadline=t_start + time_limit_s,
+        start=starts,
+    )
 
     paths, energies, reports, lines = [], [], [], []
     speed_excess = 0.0

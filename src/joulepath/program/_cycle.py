@@ -679,6 +679,8 @@ class CycleOptimizer:
         assert step.robot is not None and step.tcp is not None
         p, _ = _tcp(step.robot, traj.q, step.tcp)
         targets = [self.by_index[j].path.q1 for j in self.chains[i][:-1]]
+        if not targets:
+            return ()
         dist = np.stack(
             [np.linalg.norm(p - _tcp(step.robot, q[None, :], step.tcp)[0], axis=1) for q in targets]
         )
