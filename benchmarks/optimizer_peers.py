@@ -190,7 +190,9 @@ def fine_path_of(result: Any, q0: np.ndarray, qf: np.ndarray, T: float) -> Traje
     dt_f = SAMPLE_PERIOD / FINE_FACTOR
     candidates: list[Callable[[], tuple[Trajectory, Trajectory]]] = []
     if s.representation == "bspline":
-        for spacing in (DEFAULT_KNOT_SPACING, 2 * DEFAULT_KNOT_SPACING, 4 * DEFAULT_KNOT_SPACING):
+        # the default spacing, or a long move's wider one (GradientSettings.spacing_for), and the coarse knots
+        wide = GradientSettings().spacing_for(T)
+        for spacing in dict.fromkeys(k * b for b in (DEFAULT_KNOT_SPACING, wide) for k in (1, 2, 4)):
             basis = SplineBasis(T, knot_spacing=spacing, dt=SAMPLE_PERIOD)
             if basis.n_free == P.shape[0]:
                 candidates.append(lambda b=basis: (b.trajectory(P, q0, qf), b.trajectory(P, q0, qf, dt=dt_f)))

@@ -34,7 +34,7 @@ from _report import ROOT, machine, single_core, write_section  # noqa: E402
 single_core()
 
 import numpy as np  # noqa: E402
-from optimizer_peers import FIXED_TASK, load1, run_timed  # noqa: E402
+from optimizer_peers import FIXED_TASK, fine_path_of, load1, run_timed  # noqa: E402
 
 import joulepath  # noqa: E402
 import joulepath.optimize._gradient as gradient  # noqa: E402
@@ -53,28 +53,13 @@ from joulepath.optimize import (  # noqa: E402
     random_tasks,
 )
 from joulepath.optimize._verify import energy_on_samples  # noqa: E402
-from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk  # noqa: E402
+from joulepath.trajectory import minimum_jerk  # noqa: E402
 from joulepath.units import SAMPLE_PERIOD  # noqa: E402
 
 SECTION = "optimizer_rows"
 SEED = 11
 FIELDS = ("task", "T_s", "method", "energy_fine_J", "saved_fine_pct", "limits_ok", "wall_s", "cpu_s", "load1")
 SHIPPED = gradient.THIN_ROWS
-
-
-def _fine(res: Any, q0: np.ndarray, qf: np.ndarray, T: float) -> Trajectory:
-    """The result's path on the 10x grid, from its coefficients on whichever knots it was solved on
-    (fine or coarse, at the knot spacing or the long move's wider one)."""
-    P = np.asarray(res.parameters)
-    g = gradient.GradientSettings()
-    for spacing in (g.knot_spacing, g.spacing_for(T)):
-        for k in (1, g.coarse_factor):
-            basis = SplineBasis(T, knot_spacing=k * spacing, dt=SAMPLE_PERIOD)
-            if basis.n_free == P.shape[0] and np.allclose(
-                basis.trajectory(P, q0, qf).q, res.optimized.q, atol=1e-9, rtol=0
-            ):
-                return basis.trajectory(P, q0, qf, dt=SAMPLE_PERIOD / FINE_FACTOR)
-    raise RuntimeError("no knot spacing rebuilds the result's path")
 
 
 def _one(robot: Any, q0: np.ndarray, qf: np.ndarray, T: float, thinned: bool) -> tuple[Any, float, float]:
@@ -122,7 +107,9 @@ def run(args: argparse.Namespace) -> None:
             )
             for method in ("thinned", "all rows"):
                 res, wall, cpu = _one(robot, q0, qf, T, method == "thinned")
-                fine = _fine(res, q0, qf, T)
+                fine = fine_path_of(res, q0, qf, T)
+                if fine is None:
+                    raise RuntimeError(f"task {name} {method}: could not rebuild the fine path")
                 e = energy_on_samples(robot, fine, friction=NOMINAL_FRICTION)
                 rep = check_limits(
                     robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=jmax

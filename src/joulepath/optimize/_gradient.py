@@ -561,6 +561,11 @@ def _near_limit(slack: FloatArray, within: FloatArray, cap: int) -> np.ndarray:
     return np.flatnonzero((near & keep).ravel())
 
 
+def _past(deadline: float | None) -> bool:
+    """Whether ``deadline`` (``time.perf_counter()``, None: none) has passed."""
+    return deadline is not None and time.perf_counter() > deadline
+
+
 def _merge(a: dict[str, np.ndarray], b: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return {
         k: np.union1d(a.get(k, np.empty(0, int)), b.get(k, np.empty(0, int))) for k in a.keys() | b.keys()
@@ -584,11 +589,8 @@ def _solve_from(
     """
     from scipy.optimize import minimize
 
-    def late() -> bool:
-        return deadline is not None and time.perf_counter() > deadline
-
     def stop_when_late(_: Any) -> None:
-        if late():
+        if _past(deadline):
             raise StopIteration
 
     x = x0.copy()
@@ -619,9 +621,9 @@ def _solve_from(
                 x = cand
             history.append(problem.true_energy(x))
             active = _merge(active, problem.screen(x, SCREEN_BAND))
-            if problem.violation(x) == 0.0 or late():
+            if problem.violation(x) == 0.0 or _past(deadline):
                 break
-        if (settings.give_up and problem.violation(x) > 0.0) or late():
+        if (settings.give_up and problem.violation(x) > 0.0) or _past(deadline):
             break
     return x, n_iter, active
 
@@ -683,7 +685,7 @@ def _optimize_spline(
     finals: list[float] = []
     n_iter = 0
     for s, x0 in enumerate(starts):
-        if s and deadline is not None and time.perf_counter() > deadline:
+        if s and _past(deadline):
             break
         x, it, active = _solve_from(problem, x0, settings, scale, eps_unit, history, known, deadline)
         n_iter += it
@@ -775,7 +777,7 @@ def solve_move(
         else settings.continuation[: -settings.refine_stages] or settings.continuation[:1]
     )
     first = optimize_spline(coarse, replace(settings, continuation=head), rng=rng, deadline=deadline)
-    if (settings.give_up and not first.feasible) or (deadline is not None and time.perf_counter() > deadline):
+    if (settings.give_up and not first.feasible) or _past(deadline):
         return first, coarse
     # the coarse path in the fine basis: least squares on the fine grid (exact for nested knots)
     target = coarse.fine.B @ first.coefficients
