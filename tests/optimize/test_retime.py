@@ -320,3 +320,122 @@ def test_retime_on_path_refuses_a_measure_without_its_data(tmp_path, lines, limi
 
 def _has_toppra() -> bool:
     return importlib.util.find_spec("toppra") is not None
+
+
+def _as_motion_path(line, duration, jerk_time):
+    """The controller's move along ``line`` at ``duration`` as a joint path ``q(s)``, ``s = t / T``
+    (a path that is itself a motion of this duration, as a cycle's segment is)."""
+    _, ref = _controller(line, duration, jerk_time)
+    from scipy.interpolate import BPoly
+
+    T = float(ref.t[-1])
+    poly = BPoly.from_derivatives(ref.t / T, np.stack([ref.q, ref.qd * T, ref.qdd * T * T], axis=1))
+    d1, d2 = poly.derivative(1), poly.derivative(2)
+    return T, lambda s: (poly(s), d1(s), d2(s))
+
+
+def test_identity_start_keeps_the_ends_and_never_loses_to_its_start(irb120, lines, limits):
+    """From a motion's own timing: the same path, the same duration, position, speed and acceleration at
+    both ends as the motion's, every limit held and the energy at most the motion's own."""
+    line = lines["fast"]
+    shortest, _ = _controller(line, None, 0.125)
+    T, path = _as_motion_path(line, 1.3 * shortest, 0.125)
+    r = retime_on_path(
+        irb120, path, T, acceleration_limit=limits[0], jerk_limit=limits[1], tcp=TOOL, start="identity"
+    )
+    assert r.feasible, r.limit_excess
+    assert r.energy_J <= r.start_energy_J
+    q, q1, q2 = path(np.array([0.0, 1.0]))
+    np.testing.assert_allclose(r.fine.q[[0, -1]], q, atol=1e-9)
+    np.testing.assert_allclose(r.fine.qd[[0, -1]], q1 / T, atol=1e-7)
+    np.testing.assert_allclose(r.fine.qdd[[0, -1]], q2 / T**2, atol=1e-5)
+    qs, _, _ = path(r.s)
+    np.testing.assert_allclose(r.fine.q, qs, atol=1e-12)  # on the path at every sample
+    # the identity itself is the motion: its energy is the controller move's, on the same grid
+    _, ref = _controller(line, 1.3 * shortest, 0.125)
+    assert r.start_energy_J == pytest.approx(
+        energy_on_samples(irb120, ref, friction=NOMINAL_FRICTION), rel=2e-3
+    )
+
+
+def test_a_bound_per_point_holds_where_it_is_given(irb120, lines, limits):
+    """A TCP speed bound per path point, tight over the middle half of the path only: held there, and
+    a constant function gives the same timing as the same number."""
+    line = lines["slow"]
+    shortest, _ = _controller(line, None, 0.0)
+    T, path = _as_motion_path(line, 1.2 * shortest, 0.0)
+    cap = 0.8 * line.v_tcp
+
+    def bound(s):
+        return np.where((s > 0.25) & (s < 0.75), cap, 1e3)
+
+    kwargs = dict(acceleration_limit=limits[0], tcp=TOOL, start="identity")
+    r = retime_on_path(irb120, path, T, tcp_speed_limit=bound, **kwargs)
+    speed = np.linalg.norm(tcp_velocity(irb120, r.fine.q, r.fine.qd, TOOL), axis=1)
+    mid = (r.s > 0.25) & (r.s < 0.75)
+    assert r.feasible, (
+        r.limit_excess
+    )  # the start breaks the cap (its cruise is v_tcp / 1.2); the search mends it
+    assert speed[mid].max() <= cap * (1 + 1e-6)
+    assert speed.max() > cap  # and the cap binds only where it is given
+    same = [
+        retime_on_path(irb120, path, T, tcp_speed_limit=v, **kwargs)
+        for v in (line.v_tcp, lambda s: np.full(s.shape, line.v_tcp))
+    ]
+    np.testing.assert_allclose(same[0].fine.q, same[1].fine.q, atol=1e-9)
+    assert same[0].energy_J == pytest.approx(same[1].energy_J, rel=1e-9)
+
+
+def test_identity_timing_gradients_with_a_bound_per_point_match_finite_differences(irb120, lines, limits):
+    from joulepath.optimize._retime import _identity_timing
+
+    line = lines["fast"]
+    duration = 0.8
+    timing = _identity_timing(duration, 12)
+    t = np.linspace(0.0, duration, 81)
+    bases = [timing.basis(t, nu) for nu in range(3)]
+    lo, hi = timing.fixed_lo, timing.n_ctrl - timing.fixed_hi
+    problem = _Search(
+        table=_table(irb120, line.path.at, TOOL),
+        friction=NOMINAL_FRICTION,
+        dt=float(t[1] - t[0]),
+        b0=bases[0][:, lo:hi],
+        b1=bases[1][:, lo:hi],
+        b2=bases[2][:, lo:hi],
+        off0=timing.fixed_part(bases[0]),
+        off1=timing.fixed_part(bases[1]),
+        off2=timing.fixed_part(bases[2]),
+        vmax=np.asarray(irb120.velocity_limit, dtype=float),
+        amax=limits[0],
+        jmax=limits[1],
+        tcp_speed=lambda s: line.v_tcp * (1.0 + 0.5 * s**2),  # smooth, so that its slope counts
+        drivetrain=irb120.drivetrain,
+    )
+    x = np.sort(np.random.default_rng(4).uniform(timing.lo_values[-1], timing.hi_values[0], timing.n_free))
+    h = 1e-6
+    _, jac = problem.constraints(x)
+    fd_g = np.empty((jac.shape[0], x.size))
+    for i in range(x.size):
+        step = np.zeros_like(x)
+        step[i] = h
+        fd_g[:, i] = (problem.constraints(x + step)[0] - problem.constraints(x - step)[0]) / (2 * h)
+    np.testing.assert_allclose(jac, fd_g, rtol=1e-4, atol=1e-6 * np.abs(fd_g).max())
+    # the identity's own control points give s = t / T exactly
+    s, sd, _ = timing.evaluate(_identity_free(timing), t)
+    np.testing.assert_allclose(s, t / duration, atol=1e-12)
+    np.testing.assert_allclose(sd, 1.0 / duration, atol=1e-9)
+
+
+def _identity_free(timing):
+    greville = np.array([timing.knots[k + 1 : k + 6].mean() for k in range(timing.n_ctrl)]) / timing.knots[-1]
+    return greville[timing.fixed_lo : timing.n_ctrl - timing.fixed_hi]
+
+
+def test_retime_on_path_refuses_an_unknown_start_and_a_bound_per_point_from_the_controller(
+    irb120, lines, limits
+):
+    kwargs = dict(acceleration_limit=limits[0])
+    with pytest.raises(InvalidInput, match="start must be one of"):
+        retime_on_path(irb120, lines["fast"].path, 1.0, start="zero", **kwargs)
+    with pytest.raises(InvalidInput, match="needs start='identity'"):
+        retime_on_path(irb120, lines["fast"].path, 1.0, tcp_speed_limit=lambda s: s + 1.0, **kwargs)

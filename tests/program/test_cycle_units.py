@@ -415,3 +415,70 @@ def test_a_chain_through_the_same_target_twice_passes_each_in_turn(robot):
             at, _ = _tcp(robot, base.q[k][None, :], spec.steps[0].tcp)
             want, _ = _tcp(robot, q[None, :], spec.steps[0].tcp)
             assert 1000 * np.linalg.norm(at - want) < 15.0  # within its z10 zone (and the grid)
+
+
+def test_segments_with_moveL_are_re_timed_along_their_own_path(blended, solved):
+    """The last stage re-times each segment with a MoveL along its own joint path: the TCP runs the
+    same path as the plan before it (every sample on it), in the same cycle time, with less energy
+    (the breakdown's last part), and where it is on a MoveL's line no faster than its speeddata."""
+    from joulepath.dynamics import NOMINAL_FRICTION
+    from joulepath.optimize import check_limits, tcp_velocity
+    from joulepath.sim import acceleration_limit
+
+    result, opt = solved
+    before = result.unretimed
+    assert before is not None and before.unretimed is None and result.path_retimed
+    assert not before.path_retimed and before.breakdown.path_retimed_J is None
+    assert result.optimized_cycle_s == pytest.approx(before.optimized_cycle_s, abs=1e-9)
+    assert result.optimized_energy_J < before.optimized_energy_J
+    pct = 100 * (before.optimized_energy_J - result.optimized_energy_J) / result.default_energy_J
+    # (the breakdown's step before is the allocation's energy: within 1e-3 J of the motion's)
+    assert result.breakdown.by_path_retiming_pct == pytest.approx(pct, abs=0.01)
+    robot = blended.robot
+    tcp = blended.steps[result.path_retimed[0]].tcp
+    new, _ = _tcp(robot, result.planned.q, tcp)
+    old, _ = _tcp(robot, before.planned.q, tcp)
+    a, d = old[:-1], np.diff(old, axis=0)
+    far = 0.0
+    for p in new:  # distance to the old TCP path, a polyline of its 2.5 ms samples
+        u = np.clip(((p - a) * d).sum(axis=1) / np.maximum((d * d).sum(axis=1), 1e-30), 0.0, 1.0)
+        far = max(far, float(np.linalg.norm(a + u[:, None] * d - p, axis=1).min()))
+    assert far < 5e-5  # 0.05 mm: the chords between samples
+    speed = np.linalg.norm(tcp_velocity(robot, result.planned.q, result.planned.qd, tcp), axis=1)
+    lines = [j for j in result.path_retimed if blended.steps[j].linear]
+    assert lines
+    for j in lines:
+        m = opt.by_index[j]
+        p0, p1 = (_tcp(robot, q[None, :], tcp)[0][0] for q in (m.path.q0, m.path.q1))
+        u = (p1 - p0) / np.linalg.norm(p1 - p0)
+        w = (new - p0) @ u / np.linalg.norm(p1 - p0)
+        off = np.linalg.norm((new - p0) - np.outer((new - p0) @ u, u), axis=1)
+        on = (off < 1e-7) & (w > 0.0) & (w < 1.0)  # on its line (the blends leave it)
+        assert on.sum() > 20 and speed[on].max() <= m.step.speed.v_tcp / 1000 * (1 + 1e-4)
+    # every limit holds on the streamed cycle (its 2.5 ms steps, shorter at the pieces' joins)
+    for piece in result.paths.values():
+        report = check_limits(
+            robot,
+            piece.fine,
+            friction=NOMINAL_FRICTION,
+            acceleration_limit=acceleration_limit(robot, CycleSettings().accel_time),
+        )
+        assert report.ok, [x.describe() for x in report.worst]
+    assert result.limits_ok
+
+
+def test_rapid_follows_the_plan_before_its_paths_were_re_timed(blended, solved, tmp_path):
+    """RAPID's own MoveL runs at its speeddata: the module is written from the plan before the
+    segments were re-timed along their paths, and says so; the stream plays the re-timed plan."""
+    result, _ = solved
+    files = write_cycle_run(tmp_path, result, pareto=None, write_rapid=True, egm="always")
+    data = json.loads(files["cycle.json"].read_text())
+    assert data["breakdown"]["saved_by_path_retiming_pct"] > 0
+    check = data["written_program_check"]
+    assert check is not None  # the module was written and run by the controller emulation
+    assert check["planned_energy_J"] == pytest.approx(result.unretimed.optimized_energy_J)
+    if "optimized.mod" in files:
+        assert data["rapid_follows"].startswith("the plan before its MoveL segments were re-timed")
+    np.testing.assert_allclose(
+        np.loadtxt(files["cycle_path.csv"], delimiter=",", skiprows=1)[:, 1:7], result.planned.q, atol=1e-8
+    )

@@ -242,8 +242,13 @@ def cycle(
     if any(e.measure == "electrical" for e in result.energies):
         console.print(f"  drive data: {r.drivetrain.drives_source}", markup=False)
     waits = "" if b.by_waits_pct is None else f", idle waits {b.by_waits_pct:.1f} %"
+    along = (
+        ""
+        if b.by_path_retiming_pct is None
+        else f", MoveL segments re-timed along their path {b.by_path_retiming_pct:.1f} %"
+    )
     console.print(
-        f"breakdown: shape {b.by_shape_pct:.1f} %, time allocation {b.by_allocation_pct:.1f} %{waits}"
+        f"breakdown: shape {b.by_shape_pct:.1f} %, time allocation {b.by_allocation_pct:.1f} %{waits}{along}"
     )
     for choice in spec.choices:
         console.print(f"read: {choice}")

@@ -62,7 +62,9 @@ FINE_DT = 0.0025
 SAMPLE_DT = 0.025
 """s, the longest step of :attr:`Retimed.samples` (the logs' 40 Hz)."""
 N_COEFFICIENTS = 12
-"""Free control points of the timing spline ``s(t)``."""
+"""Free control points of the timing spline ``s(t)`` (at least, with ``start="identity"``)."""
+IDENTITY_KNOT_S = 0.2
+"""s per free control point, at most, of the timing of a long path with ``start="identity"``."""
 DEGREE = 5
 """Degree of the timing spline (quintic: continuous jerk)."""
 TABLE_POINTS = 513
@@ -76,6 +78,7 @@ MAX_STRETCHES = 8
 _EPS_POWER = 1e-3  # W: smoothing of |P| in the search's objective only
 _MARGIN = 1e-3  # the search keeps its limits this fraction below the checked ones
 _TCP_TOLERANCE = 1e-7  # relative excess of the TCP speed that still counts as held
+_BOUND_STEP = 1e-6  # step along s of the central difference of a TCP speed bound per point
 
 
 class JointPath(Protocol):
@@ -85,6 +88,11 @@ class JointPath(Protocol):
 
 
 PathLike = JointPath | Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]
+SpeedBound = float | Callable[[FloatArray], FloatArray]
+"""A TCP speed bound (m/s): one number, or one per path point (``s`` (n,) -> (n,); ``inf`` where none)."""
+STARTS = ("controller", "identity")
+"""Where the search starts: the controller's sin² profile stretched to the duration, or ``s = t / T``
+(the path's own timing, for a path that is itself a motion in ``T``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -109,9 +117,10 @@ class Retimed:
     limit_excess : tuple of str
         The worst excess of each violated kind of limit, in words (empty when feasible).
     optimized : bool
-        Whether the optimized timing was kept (False: the sin² start was better).
+        Whether the optimized timing was kept (False: the start was better).
     start_energy_J : float
-        The energy of the start, the controller's sin² profile stretched to ``duration``.
+        The energy of the start (``start``: the controller's sin² profile stretched to
+        ``duration``, or the path's own timing).
     """
 
     duration: float
@@ -196,10 +205,17 @@ class _Limits:
     friction: Friction | None
     amax: FloatArray
     jmax: FloatArray | None
-    tcp_speed: float | None
+    tcp_speed: SpeedBound | None
     tcp: FloatArray | None
     measure: str = DEFAULT_MEASURE
     drivetrain: Drivetrain = field(default_factory=Drivetrain)
+
+
+def _bound_at(bound: SpeedBound, s: FloatArray) -> FloatArray:
+    """The TCP speed bound (m/s) at the path points ``s``."""
+    if callable(bound):
+        return np.broadcast_to(np.asarray(bound(s), dtype=float), s.shape)
+    return np.full(s.shape, float(bound))
 
 
 def _motion(
@@ -280,15 +296,31 @@ class _Timing:
 
     knots: FloatArray
     n_ctrl: int
-    fixed_lo: int  # control points 0..fixed_lo-1 are 0
-    fixed_hi: int  # the last fixed_hi are 1
+    lo_values: FloatArray  # the first control points (0 for a start at rest)
+    hi_values: FloatArray  # the last ones (1 for an end at rest)
+
+    @property
+    def fixed_lo(self) -> int:
+        return self.lo_values.size
+
+    @property
+    def fixed_hi(self) -> int:
+        return self.hi_values.size
 
     @property
     def n_free(self) -> int:
         return self.n_ctrl - self.fixed_lo - self.fixed_hi
 
     def control(self, x: FloatArray) -> FloatArray:
-        return np.concatenate([np.zeros(self.fixed_lo), x, np.ones(self.fixed_hi)])
+        return np.concatenate([self.lo_values, x, self.hi_values])
+
+    def fixed_part(self, basis: FloatArray) -> FloatArray:
+        """The fixed control points' contribution to ``basis @ control`` (n_t,)."""
+        out: FloatArray = (
+            basis[:, : self.fixed_lo] @ self.lo_values
+            + basis[:, self.n_ctrl - self.fixed_hi :] @ self.hi_values
+        )
+        return out
 
     def basis(self, t: FloatArray, nu: int) -> FloatArray:
         out: FloatArray = BSpline(self.knots, np.eye(self.n_ctrl), DEGREE)(t, nu)
@@ -299,21 +331,34 @@ class _Timing:
         return spl(t), spl(t, 1), spl(t, 2)
 
 
-def _timing(duration: float, start_at_rest: bool, end_at_rest: bool) -> _Timing:
-    n_ctrl = N_COEFFICIENTS + (3 if start_at_rest else 1) + (3 if end_at_rest else 1)
+def _knots(duration: float, n_ctrl: int) -> FloatArray:
     n_inner = n_ctrl - DEGREE - 1
     inner = np.linspace(0.0, duration, n_inner + 2)[1:-1]
-    knots = np.concatenate([np.zeros(DEGREE + 1), inner, np.full(DEGREE + 1, duration)])
-    return _Timing(knots, n_ctrl, 3 if start_at_rest else 1, 3 if end_at_rest else 1)
+    return np.concatenate([np.zeros(DEGREE + 1), inner, np.full(DEGREE + 1, duration)])
+
+
+def _timing(duration: float, start_at_rest: bool, end_at_rest: bool) -> _Timing:
+    lo, hi = (3 if start_at_rest else 1), (3 if end_at_rest else 1)
+    n_ctrl = N_COEFFICIENTS + lo + hi
+    return _Timing(_knots(duration, n_ctrl), n_ctrl, np.zeros(lo), np.ones(hi))
+
+
+def _identity_timing(duration: float, n_free: int) -> _Timing:
+    """``s(t)`` whose first and last three control points are those of ``s = t / duration`` (its
+    Greville abscissae over ``duration``): ``s``, ``ṡ`` and ``s̈`` at both ends are the identity's."""
+    n_ctrl = n_free + 6
+    knots = _knots(duration, n_ctrl)
+    greville = np.array([knots[k + 1 : k + DEGREE + 1].mean() for k in range(n_ctrl)]) / duration
+    return _Timing(knots, n_ctrl, greville[:3], greville[-3:])
 
 
 def _fit_start(timing: _Timing, t: FloatArray, s: FloatArray) -> FloatArray:
     """Least-squares control points of a given ``s(t)``, made non-decreasing within [0, 1]."""
     basis = timing.basis(t, 0)
     free = basis[:, timing.fixed_lo : timing.n_ctrl - timing.fixed_hi]
-    rhs = s - basis[:, timing.n_ctrl - timing.fixed_hi :].sum(axis=1)
+    rhs = s - timing.fixed_part(basis)
     x, *_ = np.linalg.lstsq(free, rhs, rcond=None)
-    out: FloatArray = np.clip(np.maximum.accumulate(x), 0.0, 1.0)
+    out: FloatArray = np.clip(np.maximum.accumulate(x), timing.lo_values[-1], timing.hi_values[0])
     return out
 
 
@@ -334,7 +379,7 @@ class _Search:
     vmax: FloatArray
     amax: FloatArray
     jmax: FloatArray | None
-    tcp_speed: float | None
+    tcp_speed: SpeedBound | None
     measure: str = DEFAULT_MEASURE
     drivetrain: Drivetrain = field(default_factory=Drivetrain)
 
@@ -406,10 +451,17 @@ class _Search:
             jj = np.diff(self._chain(d_s, d_sd, d_sdd), axis=0) / self.dt / self.jmax[None, :, None]
             rows += [lim - jerk, lim + jerk]
             jacs += [-jj, jj]
-        if self.tcp_speed is not None:
-            v = p["p1"][:, None] / self.tcp_speed
+        if self.tcp_speed is not None:  # |dp/ds| ṡ <= bound(s)
+            s = np.clip(p["s"], 0.0, 1.0)
+            bound = _bound_at(self.tcp_speed, s)[:, None]
+            v = p["p1"][:, None] / bound
+            dv = p["dp1"][:, None] / bound
+            if callable(self.tcp_speed):  # a bound per point: its slope along s by central differences
+                lo, hi = np.clip(s - _BOUND_STEP, 0.0, 1.0), np.clip(s + _BOUND_STEP, 0.0, 1.0)
+                slope = (_bound_at(self.tcp_speed, hi) - _bound_at(self.tcp_speed, lo)) / (hi - lo)
+                dv = dv - v / bound * slope[:, None]
             rows.append(lim - v * sd)
-            jacs.append(-self._chain(p["dp1"][:, None] / self.tcp_speed * sd, v, np.zeros_like(v)))
+            jacs.append(-self._chain(dv * sd, v, np.zeros_like(v)))
         g = np.concatenate([r.ravel() for r in rows])
         jac = np.concatenate([j.reshape(-1, j.shape[-1]) for j in jacs])
         return g, jac
@@ -433,9 +485,9 @@ def _search(
         b0=bases[0][:, lo:hi],
         b1=bases[1][:, lo:hi],
         b2=bases[2][:, lo:hi],
-        off0=bases[0][:, hi:].sum(axis=1),
-        off1=bases[1][:, hi:].sum(axis=1),
-        off2=bases[2][:, hi:].sum(axis=1),
+        off0=timing.fixed_part(bases[0]),
+        off1=timing.fixed_part(bases[1]),
+        off2=timing.fixed_part(bases[2]),
         vmax=np.asarray(robot.velocity_limit, dtype=float),
         amax=limits.amax,
         jmax=limits.jmax,
@@ -444,13 +496,14 @@ def _search(
         drivetrain=limits.drivetrain,
     )
     n = x0.size
-    order = np.zeros((n + 1, n))  # x_0 >= 0, x_{i+1} - x_i >= 0, 1 - x_{n-1} >= 0
+    order = np.zeros((n + 1, n))  # x_0 >= lo, x_{i+1} - x_i >= 0, hi - x_{n-1} >= 0 (the fixed neighbours)
     order[0, 0] = 1.0
     order[np.arange(1, n), np.arange(1, n)] = 1.0
     order[np.arange(1, n), np.arange(0, n - 1)] = -1.0
     order[n, n - 1] = -1.0
     shift = np.zeros(n + 1)
-    shift[n] = 1.0
+    shift[0] = -float(timing.lo_values[-1])
+    shift[n] = float(timing.hi_values[0])
     scale = max(problem.energy(x0)[0], 1e-6)
     last: dict[bytes, tuple[FloatArray, FloatArray]] = {}  # SLSQP asks for g and its Jacobian apart
 
@@ -499,11 +552,12 @@ def _measure(
         excess.append(f"the path parameter goes back by {float(-np.diff(s).min()):.2e}")
     if tcp_speed_limit is not None:
         speed = np.linalg.norm(tcp_velocity(robot, fine.q, fine.qd, tcp), axis=1)
-        k = int(np.argmax(speed))
-        if speed[k] > tcp_speed_limit * (1.0 + _TCP_TOLERANCE):
+        bound = _bound_at(tcp_speed_limit, np.clip(s, 0.0, 1.0))
+        k = int(np.argmax(speed / bound))
+        if speed[k] > bound[k] * (1.0 + _TCP_TOLERANCE):
             excess.append(
                 f"TCP speed {1000 * speed[k]:.1f} mm/s at t = {t[k]:.3f} s against its limit "
-                f"{1000 * tcp_speed_limit:.1f} mm/s ({100 * (speed[k] / tcp_speed_limit - 1):.1f} % over)"
+                f"{1000 * bound[k]:.1f} mm/s ({100 * (speed[k] / bound[k] - 1):.1f} % over)"
             )
     return energy, fine, s, tuple(excess)
 
@@ -515,12 +569,13 @@ def retime_on_path(
     *,
     acceleration_limit: FloatArray,
     jerk_limit: FloatArray | None = None,
-    tcp_speed_limit: float | None = None,
+    tcp_speed_limit: SpeedBound | None = None,
     tcp: FloatArray | None = None,
     friction: Friction | None = NOMINAL_FRICTION,
     start_at_rest: bool = True,
     end_at_rest: bool = True,
     energy_measure: str = DEFAULT_MEASURE,
+    start: str = "controller",
 ) -> Retimed:
     """The least-energy timing ``s(t)`` of a fixed joint path in exactly ``duration`` s.
 
@@ -536,8 +591,10 @@ def retime_on_path(
         rad/s² (:func:`joulepath.sim.acceleration_limit`).
     jerk_limit : ndarray of shape (n_joints,), optional
         rad/s³, checked as the fine grid's difference of accelerations.
-    tcp_speed_limit : float, optional
-        m/s, the move's speeddata ``v_tcp`` (a bound, not a target).
+    tcp_speed_limit : float or callable, optional
+        m/s, the move's speeddata ``v_tcp`` (a bound, not a target); or a function of ``s`` (n,)
+        -> (n,), a bound per path point (``inf`` where there is none), e.g. for a path through
+        lines and joint moves.
     tcp : ndarray of shape (4, 4), optional
         Flange-to-TCP transform (m) for the TCP speed; tool0 if None.
     friction : Friction or None
@@ -547,6 +604,15 @@ def retime_on_path(
     energy_measure : str
         The energy minimized and reported (:data:`joulepath.energy.MEASURES`; its motion energy,
         standby excluded: at a fixed duration the standby is the same for every timing).
+    start : str
+        Where the search starts (:data:`STARTS`), and the timing kept where the search finds
+        nothing better: ``"controller"``, the controller's sin² profile stretched to
+        ``duration``; ``"identity"``, ``s = t / duration``: the path's own timing, for a path
+        that is a motion of this duration, whose position, speed and acceleration at both ends
+        the new timing keeps (``s``, ``ṡ``, ``s̈`` there are the identity's; ``start_at_rest``
+        and ``end_at_rest`` are then ignored), so that it fits between the motion's neighbours.
+        The result is never worse than this start on the measure, and feasible whenever the start
+        is.
 
     Returns
     -------
@@ -572,25 +638,41 @@ def retime_on_path(
     """
     if not (np.isfinite(duration) and duration > 0):
         raise InvalidInput(f"duration must be a positive number of seconds, got {duration}")
-    if tcp_speed_limit is not None and not tcp_speed_limit > 0:
+    if start not in STARTS:
+        raise InvalidInput(f"start must be one of {', '.join(STARTS)}, got {start!r}")
+    if tcp_speed_limit is not None and not callable(tcp_speed_limit) and not tcp_speed_limit > 0:
         raise InvalidInput(f"tcp_speed_limit must be positive (m/s), got {tcp_speed_limit}")
     at = _path_function(path)
     n = robot.n_joints
     amax = _check_limits_arg("acceleration_limit", acceleration_limit, n, required=True)
     assert amax is not None
     jmax = _check_limits_arg("jerk_limit", jerk_limit, n, required=False)
-    fastest = controller_profile(
-        robot, path, acceleration_limit=amax, jerk_limit=jmax, tcp_speed_limit=tcp_speed_limit, tcp=tcp
-    )
-    start = _stretched(fastest, duration)
     check_measure(energy_measure, robot.drivetrain)
     limits = _Limits(friction, amax, jmax, tcp_speed_limit, tcp, energy_measure, robot.drivetrain)
-    timing = _timing(duration, start_at_rest, end_at_rest)
+    timing = (
+        _identity_timing(duration, max(N_COEFFICIENTS, int(np.ceil(duration / IDENTITY_KNOT_S))))
+        if start == "identity"
+        else _timing(duration, start_at_rest, end_at_rest)
+    )
     t = _grid(duration, FINE_DT)
-    x = _search(robot, at, timing, t, _fit_start(timing, t, evaluate_profile(start, t)[0]), limits)
+    controller: Law
+    if start == "identity":
 
-    def controller(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        return evaluate_profile(start, tt)
+        def controller(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+            return tt / duration, np.full(tt.shape, 1.0 / duration), np.zeros(tt.shape)
+
+    else:
+        if callable(tcp_speed_limit):
+            raise InvalidInput("a TCP speed bound per path point needs start='identity'")
+        fastest = controller_profile(
+            robot, path, acceleration_limit=amax, jerk_limit=jmax, tcp_speed_limit=tcp_speed_limit, tcp=tcp
+        )
+        profile = _stretched(fastest, duration)
+
+        def controller(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+            return evaluate_profile(profile, tt)
+
+    x = _search(robot, at, timing, t, _fit_start(timing, t, controller(t)[0]), limits)
 
     def optimized(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         return timing.evaluate(x, tt)

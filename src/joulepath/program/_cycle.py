@@ -36,6 +36,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+from scipy.interpolate import BPoly
 
 from joulepath._typing import FloatArray
 from joulepath._work import check_work
@@ -51,7 +52,7 @@ from joulepath.optimize import (
     jerk_limit,
 )
 from joulepath.optimize._gradient import SplineProblem, optimize_spline, solve_move
-from joulepath.optimize._retime import retime_on_path, shortest_on_path
+from joulepath.optimize._retime import retime_on_path, shortest_on_path, tcp_velocity
 from joulepath.optimize._verify import shortest_feasible_duration, tcp_deviation_mm
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._resolve import CycleSpec, Step, check_moves_arm
@@ -115,6 +116,9 @@ class CycleSettings:
     bundled examples the finer grid there saved less, e.g. payload_tool 3.8 % against 4.2 %). ``pass_search``:
     solves per inner target, at most, of the search for when a chain passes its targets
     (:meth:`CycleOptimizer.tune_passes`; 0: in proportion to each move's shortest duration).
+    ``retime_segments``: with ``"samples"``, every segment with a ``MoveL`` is at last re-timed
+    along its own joint path in the chosen cycle (:meth:`CycleOptimizer.retime_segments`: the
+    lines, blends and zones as they are, the speeddata a bound, the segment's duration kept).
     """
 
     cycle_time: float | None = None
@@ -134,6 +138,7 @@ class CycleSettings:
     rapid_plan: bool = True
     energy_every: int = 2
     pass_search: int = 3
+    retime_segments: bool = True
     gradient: GradientSettings = field(default_factory=GradientSettings)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     seed: int = 0
@@ -168,6 +173,48 @@ class CycleSettings:
 
 class TimeBudgetSpent(Exception):
     """Internal: the wall-time bound was reached before a solve (never leaves this module)."""
+
+
+def _window_energy(robot: Robot, plant: Plant, traj: Trajectory, measure: str) -> tuple[float, float]:
+    """Physics (on ``measure``) and lab J of a window of a cycle's motion, summed as
+    :meth:`CycleOptimizer.move_energies` sums them: each sample's power times the step to the next
+    (the last sample's weight 0)."""
+    w = np.append(np.diff(traj.t), 0.0)
+    p, p_lab = sample_power(robot, plant, traj, measure)
+    return float((p * w).sum()), float((p_lab * w).sum())
+
+
+def _hermite_path(
+    t: FloatArray, q: FloatArray, qd: FloatArray, qdd: FloatArray
+) -> Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]:
+    """A motion's samples as a joint path ``q(s)``, ``s = (t - t0) / T`` in [0, 1]: the quintic Hermite
+    interpolation of position, speed and acceleration (C², exact at the samples)."""
+    span = float(t[-1] - t[0])
+    poly = BPoly.from_derivatives((t - t[0]) / span, np.stack([q, qd * span, qdd * span * span], axis=1))
+    d1, d2 = poly.derivative(1), poly.derivative(2)
+
+    def at(s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        return poly(s), d1(s), d2(s)
+
+    return at
+
+
+def _interpolated(x: FloatArray, y: FloatArray) -> Callable[[FloatArray], FloatArray]:
+    """``y`` at ``x`` as a function, linear between them."""
+
+    def at(s: FloatArray) -> FloatArray:
+        out: FloatArray = np.interp(s, x, y)
+        return out
+
+    return at
+
+
+RETIME_GAIN = 1e-3
+"""A segment re-timed along its path is kept where it saves at least this share of its energy (else
+its plan stays as it is, and RAPID's own moves can follow it)."""
+
+NO_SPEED_BOUND = 1e3
+"""m/s: the TCP speed "bound" at a joint move's samples in a segment re-timed along its path (none)."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -230,12 +277,14 @@ class Allocation:
 @dataclass(frozen=True, slots=True)
 class Breakdown:
     """Where the saving comes from (J on physics): E0 default, E1 shapes at the default's
-    proportions of time, E2 re-allocated durations, E3 with the waits spent."""
+    proportions of time, E2 re-allocated durations, E3 with the waits spent, E4 with the segments
+    that have a ``MoveL`` re-timed along their path (:meth:`CycleOptimizer.retime_segments`)."""
 
     default_J: float
     shape_J: float
     allocation_J: float
     waits_J: float | None
+    path_retimed_J: float | None = None
 
     @property
     def by_shape_pct(self) -> float:
@@ -248,6 +297,13 @@ class Breakdown:
     @property
     def by_waits_pct(self) -> float | None:
         return None if self.waits_J is None else 100 * (self.allocation_J - self.waits_J) / self.default_J
+
+    @property
+    def by_path_retiming_pct(self) -> float | None:
+        if self.path_retimed_J is None:
+            return None
+        before = self.allocation_J if self.waits_J is None else self.waits_J
+        return 100 * (before - self.path_retimed_J) / self.default_J
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -281,6 +337,8 @@ class CycleResult:
     zone_miss_mm: float = 0.0  # largest TCP distance beyond a fly-by target's zone (0: within all)
     open_ends: frozenset[int] = frozenset()  # optimized moves whose piece ends blended into a kept move
     rapid_plan: CycleResult | None = None  # the same with the units inside MoveL segments as taught
+    path_retimed: tuple[int, ...] = ()  # step indices re-timed along their segment's path (retime_segments)
+    unretimed: CycleResult | None = None  # the same plan before that (what RAPID's own moves can follow)
     energy_measure: str = DEFAULT_MEASURE  # the measure of the *_energy_J figures (motion, no standby)
     energies: tuple[MeasureSummary, ...] = ()  # every measure the robot has data for, whole cycle
     energies_unavailable: dict[str, str] = field(default_factory=dict)  # why not, for the others
@@ -1417,6 +1475,172 @@ class CycleOptimizer:
         mono = np.maximum.accumulate([starts.get(j, 0.0) for j in order]) if order else np.zeros(0)
         return CycleMotion(traj, {j: float(v) for j, v in zip(order, mono, strict=True)}, off)
 
+    def retime_segments(self, motion: CycleMotion) -> tuple[CycleMotion, dict[int, Solved]]:
+        """``motion`` with every segment that has a ``MoveL`` re-timed along its own joint path in it.
+
+        Each such segment of ``motion`` (its units' chosen entries and the taught moves between
+        them) is one path ``q(s)``, a quintic Hermite interpolation of its samples (position, speed
+        and acceleration), re-timed by :func:`joulepath.optimize.retime_on_path` from its own
+        timing (``start="identity"``): the same joint path, so every ``MoveL`` keeps its line
+        and its tool orientation, every zone and blend its geometry, and the segment its
+        duration and its speed and acceleration at both ends; only when the robot is where
+        along it changes, so that time moves between the lines, the blends and the joint moves.
+        Samples of a ``MoveL`` keep its speeddata: a TCP speed within ``v_tcp`` and the
+        reorientation within ``v_ori`` (their bound on the TCP speed along the line), or the
+        controller's own speed there where that is higher (a blend). A segment's new timing is
+        kept only where it holds every limit and its energy on the cycle's measure is lower.
+
+        Returns
+        -------
+        tuple
+            The new motion (the same cycle time) and, by step index, each re-timed move's piece of
+            it (a :class:`Solved` whose samples start at 0).
+        """
+        st = self.settings
+        if not st.retime_segments or st.follow != "samples":
+            return motion, {}
+        traj = motion.trajectory
+        order = [m.index for m in self.plan.moves]
+        starts = dict(motion.starts)
+        ts, qs, qds, qdds = [traj.t], [traj.q], [traj.qd], [traj.qdd]
+        done: list[tuple[Segment, tuple[int, ...]]] = []
+        for seg in self.segments:
+            moving = tuple(j for j in seg.moves if self.by_index[j].profile.duration > 0)
+            if not moving or not any(self.by_index[j].step.linear for j in moving):
+                continue
+            if len(moving) == 1 and moving[0] in self.linear:
+                continue  # a MoveL from rest to rest: its own unit re-times it along its line
+            first = self.by_index[moving[0]].step
+            robot, tcp = self._robot(self.by_index[moving[0]]), first.tcp
+            if tcp is None or any(
+                self.by_index[j].step.robot is not robot
+                or not np.array_equal(np.asarray(self.by_index[j].step.tcp), tcp)
+                for j in moving
+            ):
+                continue  # a tool change inside the segment: left as it is
+            if self.deadline is not None and time.perf_counter() > self.deadline:
+                self.timed_out = True
+                break
+            t = ts[-1]
+            a = motion.starts[moving[0]]
+            i0 = int(np.searchsorted(t, a + 1e-9)) - 1  # the last sample at or before its start
+            i1 = int(np.searchsorted(t, a + seg.span - 1e-9))  # the first at or after its end
+            if i0 < 0 or i1 >= t.size or i1 - i0 < 8:
+                continue
+            sel = slice(i0, i1 + 1)
+            tt, q, qd, qdd = t[sel], qs[-1][sel], qds[-1][sel], qdds[-1][sel]
+            span = float(tt[-1] - tt[0])
+            bound = self._line_bounds(robot, tcp, seg, tt, q, qd)
+            self.progress(f"re-timing the segment of line {first.line} along its path")
+            self.n_solves += 1
+            try:
+                r = retime_on_path(
+                    robot,
+                    _hermite_path(tt, q, qd, qdd),
+                    span,
+                    acceleration_limit=self._amax_array(robot),
+                    jerk_limit=self._jmax(robot),
+                    tcp_speed_limit=_interpolated((tt - tt[0]) / span, bound),
+                    tcp=tcp,
+                    energy_measure=st.energy,
+                    start="identity",
+                )
+            except InvalidInput:
+                continue  # a segment that does not move
+            if not r.feasible:
+                continue
+            plant = self.plant(robot)
+            old = Trajectory(t=tt, q=q, qd=qd, qdd=qdd)
+            new = replace(r.fine, t=r.fine.t + tt[0])
+            e_new, e_old = (_window_energy(robot, plant, x, st.energy)[0] for x in (new, old))
+            if e_new >= e_old * (1.0 - RETIME_GAIN):
+                continue
+            s_new = np.maximum.accumulate(r.s) + np.arange(r.s.size) * 1e-15
+            for j in seg.moves:
+                if tt[0] - 1e-9 <= starts[j] <= tt[-1] + 1e-9:
+                    starts[j] = float(tt[0] + np.interp((starts[j] - tt[0]) / span, s_new, r.fine.t))
+            ts.append(np.concatenate([t[:i0], new.t, t[i1 + 1 :]]))
+            qs.append(np.concatenate([qs[-1][:i0], new.q, qs[-1][i1 + 1 :]]))
+            qds.append(np.concatenate([qds[-1][:i0], new.qd, qds[-1][i1 + 1 :]]))
+            qdds.append(np.concatenate([qdds[-1][:i0], new.qdd, qdds[-1][i1 + 1 :]]))
+            done.append((seg, moving))
+        if not done:
+            return motion, {}
+        out = CycleMotion(
+            Trajectory(t=ts[-1], q=qs[-1], qd=qds[-1], qdd=qdds[-1]),
+            {j: starts[j] for j in order},
+            motion.cycle_time,
+        )
+        return out, self._pieces_of(out, done)
+
+    def _line_bounds(
+        self, robot: Robot, tcp: FloatArray, seg: Segment, t: FloatArray, q: FloatArray, qd: FloatArray
+    ) -> FloatArray:
+        """The TCP speed bound (m/s) at each sample of a segment that starts at ``t[0]`` (its samples
+        before it is re-timed): on a ``MoveL``'s line, between the blends at its ends, its speeddata's
+        (``v_tcp``, and ``v_ori`` over its turn as a TCP speed along its line; the controller's own
+        speed there where that is higher); elsewhere, in the zones' blends and the joint moves, none
+        (a large number: the joints' limits bound them)."""
+        speed = np.linalg.norm(tcp_velocity(robot, q, qd, tcp), axis=1)
+        out = np.full(t.size, NO_SPEED_BOUND)
+        moving = [self.by_index[j] for j in seg.moves if self.by_index[j].profile.duration > 0]
+        for k, m in enumerate(moving):
+            if not m.step.linear or m.step.speed is None:
+                continue
+            a = max(m.t0, moving[k - 1].t_end) if k > 0 else m.t0  # after the blend into it
+            b = min(m.t_end, moving[k + 1].t0) if k + 1 < len(moving) else m.t_end  # before the next
+            on = (t >= t[0] + a - seg.t0 - 1e-9) & (t <= t[0] + b - seg.t0 + 1e-9)
+            v = m.step.speed.v_tcp
+            if m.path.angle_deg > 1e-6 and m.path.length_mm > 1e-6:
+                v = min(v, m.step.speed.v_ori * m.path.length_mm / m.path.angle_deg)
+            out[on] = v / 1000.0
+        # one sample wider on each side (the bound is interpolated between samples), never below the
+        # speed the motion already has there
+        wide = np.minimum(out, np.minimum(np.roll(out, 1), np.roll(out, -1)))
+        wide[[0, -1]] = out[[0, -1]]
+        return np.maximum(wide, speed * (1.0 + 1e-6))
+
+    def _pieces_of(
+        self, motion: CycleMotion, done: list[tuple[Segment, tuple[int, ...]]]
+    ) -> dict[int, Solved]:
+        """Each move of the re-timed segments as its own piece of ``motion``: its samples from its
+        start to the next move's (times from 0), its energies over the same half-open window as
+        :meth:`move_energies`, and its samples every 25 ms (interpolated)."""
+        traj = motion.trajectory
+        order = [m.index for m in self.plan.moves]
+        nxt = dict(zip(order, [*order[1:], None], strict=True))
+        out: dict[int, Solved] = {}
+        for _, moving in done:
+            robot = self._robot(self.by_index[moving[0]])
+            plant = self.plant(robot)
+            for j in moving:
+                k = nxt[j]
+                a, b = motion.starts[j], (motion.cycle_time if k is None else motion.starts[k])
+                sel = (traj.t >= a - 1e-9) & (traj.t <= b + 1e-9)
+                if np.count_nonzero(sel) < 2:
+                    continue
+                tt = traj.t[sel]
+                fine = Trajectory(t=tt - tt[0], q=traj.q[sel], qd=traj.qd[sel], qdd=traj.qdd[sel])
+                e, e_lab = _window_energy(robot, plant, fine, self.settings.energy)
+                grid = np.append(np.arange(0.0, fine.t[-1] - 1e-9, STEP), fine.t[-1])
+
+                def at(x: FloatArray, f: Trajectory = fine, g: FloatArray = grid) -> FloatArray:
+                    return np.column_stack([np.interp(g, f.t, x[:, c]) for c in range(x.shape[1])])
+
+                samples = Trajectory(t=grid, q=at(fine.q), qd=at(fine.qd), qdd=at(fine.qdd))
+                out[j] = Solved(
+                    round(float(fine.t[-1]), 9),
+                    e,
+                    e_lab,
+                    True,
+                    (),
+                    samples,
+                    fine,
+                    0.0,
+                    self.default_clearance.get(j),
+                )
+        return out
+
     def move_energies(self, motion: CycleMotion) -> dict[int, tuple[float, float]]:
         """Physics and lab J per move over its slot of ``motion`` (its start to the next move's
         start, the last to the cycle's end): ``Σ_k |tau_k · qd_k| (t_{k+1} - t_k)``."""
@@ -1606,13 +1830,19 @@ def _assemble(
     target: float,
     shortest: float,
     t_start: float,
+    along_paths: bool = True,
 ) -> CycleResult:
-    """The verified result of one allocation: per-move outcomes, pieces, via points, the motion."""
+    """The verified result of one allocation: per-move outcomes, pieces, via points, the motion
+    (``along_paths``: with :meth:`CycleOptimizer.retime_segments`, and the result without it as its
+    :attr:`CycleResult.unretimed`)."""
     spec, settings, plan = opt.spec, opt.settings, opt.plan
     default = opt.default_energies()
     e0 = breakdown.default_J
     e0_lab = sum(v[2] for v in default.values())
     motion = opt.motion(final.choice, settings.use_waits)
+    retimed: dict[int, Solved] = {}
+    if along_paths:
+        motion, retimed = opt.retime_segments(motion)
     spent = opt.move_energies(motion)  # the reported energies: per move, on the cycle's motion
     energies, unavailable = opt.measures(opt.default_motion(), motion)
     outcomes: list[MoveOutcome] = []
@@ -1634,6 +1864,11 @@ def _assemble(
             continue
         ok = ok and whole.usable
         pieces.update(opt.split(i, whole))
+        for j in opt.chains[i]:  # the unit's pieces as re-timed along their segment's path
+            if j in retimed:
+                pieces[j] = replace(
+                    retimed[j], corridor_dev_mm=pieces[j].corridor_dev_mm, clearance_mm=pieces[j].clearance_mm
+                )
         for j in members:
             zones = any(opt.zone_mm(k) > 0 for k in members[:-1])
             notes[j] = (
@@ -1649,6 +1884,17 @@ def _assemble(
                     else " (passes the zone targets exactly, without stopping)"
                 )
             )
+    for j, piece in retimed.items():  # the moves of the segments re-timed along their path
+        if j in notes:
+            notes[j] += "; then re-timed along its segment's path with the segment's MoveL"
+            continue
+        pieces[j] = piece
+        notes[j] = (
+            "MoveL re-timed along its segment's path: its line and tool orientation kept, its speeddata "
+            "a bound"
+            if spec.steps[j].linear
+            else "its taught path kept, re-timed along its segment's path with the segment's MoveL"
+        )
     vias: dict[int, tuple[int, ...]] = {}
     for i, whole in final.choice.items():
         if whole.taught:
@@ -1671,7 +1917,9 @@ def _assemble(
         if m.index in pieces:
             s = pieces[m.index]
             paths[m.index] = s
-            n_via, dev_q, dev_mm = via_deviation(m.step, s, vias[m.index])
+            n_via, dev_q, dev_mm = (
+                via_deviation(m.step, s, vias[m.index]) if m.index in vias else (0, 0.0, 0.0)
+            )
             outcomes.append(
                 MoveOutcome(
                     m.step.line,
@@ -1775,7 +2023,18 @@ def _assemble(
         energy_measure=settings.energy,
         energies=energies,
         energies_unavailable=unavailable,
+        path_retimed=tuple(sorted(retimed)),
     )
+    if retimed:
+        before = _assemble(
+            opt, final, table, breakdown, target=target, shortest=shortest, t_start=t_start, along_paths=False
+        )
+        result = replace(
+            result,
+            breakdown=replace(breakdown, path_retimed_J=result.optimized_energy_J),
+            unretimed=before,
+            wall_s=time.perf_counter() - t_start,
+        )
     return result
 
 

@@ -279,9 +279,11 @@ def cycle_json(
             "shapes_at_default_proportions_J": b.shape_J,
             "reallocated_durations_J": b.allocation_J,
             "waits_spent_J": b.waits_J,
+            "segments_retimed_along_their_path_J": b.path_retimed_J,
             "saved_by_shape_pct": b.by_shape_pct,
             "saved_by_time_allocation_pct": b.by_allocation_pct,
             "saved_by_waits_pct": b.by_waits_pct,
+            "saved_by_path_retiming_pct": b.by_path_retiming_pct,
         },
         "limits_ok": result.limits_ok,
         "corridor_mm": result.corridor_mm,
@@ -378,7 +380,10 @@ def reads_back(result: CycleResult, text: str) -> str | None:
 def _rapid_attempt(
     result: CycleResult, cell: Cell | None, write_anyway: bool
 ) -> tuple[str | None, dict[str, Any] | None, str | None, WrittenModule | None]:
-    """The module of ``result``, its check and its structure, or None and why it is not written."""
+    """The module of ``result`` (of :attr:`CycleResult.unretimed` where the plan re-times segments with
+    a MoveL along their path, which RAPID's own MoveL at its speeddata does not follow), its check and
+    its structure, or None and why it is not written."""
+    result = result.unretimed or result
     try:
         first = written_rapid(result)
     except LimitViolation as err:
@@ -435,7 +440,14 @@ def write_cycle_run(
     text = refused = check = layout = None
     follows = None
     if write_rapid:
-        plans = [("the plan", result)]
+        plans = [
+            (
+                "the plan"
+                if result.unretimed is None
+                else "the plan before its MoveL segments were re-timed along their path",
+                result,
+            )
+        ]
         if result.rapid_plan is not None and result.limits_ok:
             plans.append(
                 (

@@ -260,8 +260,11 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
 
     ``LimitViolation`` with one line when it cannot be written this way (a via point out
     of a range, a segment over a joint speed limit, a call or procedure line it cannot
-    extend).
+    extend). A plan that re-times segments with a MoveL along their path is written as it was
+    before that (:attr:`~joulepath.program.CycleResult.unretimed`): RAPID's own MoveL runs at its
+    speeddata.
     """
+    result = result.unretimed or result
     spec = result.spec
     module = spec.module
     assert module is not None
@@ -736,6 +739,7 @@ def planned_model(result: Any) -> list[tuple[Any, ...]]:
     """The motion model the written module of ``result`` must read back as (:func:`motion_model`)."""
     from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES
 
+    result = result.unretimed or result
     spec = result.spec
     through = {j for chain in result.chains.values() for j in chain[:-1]} | set(result.open_ends)
     waits = {w[0]: w[2] for w in result.waits}

@@ -750,12 +750,14 @@ def _cycle(run: _Run) -> str:
         "program was written and no saving is claimed.</p>"
     )
     waits = b.get("saved_by_waits_pct")
+    along = b.get("saved_by_path_retiming_pct")
     out += (
         f"<p>Breakdown of the saving: shape {_fmt(b.get('saved_by_shape_pct'), 3)} %, time allocation "
         f"{_fmt(b.get('saved_by_time_allocation_pct'), 3)} %"
         + ("" if waits is None else f", waits spent {_fmt(waits, 3)} %")
-        + ". The default is the program as the emulated controller runs it; MoveL moves are kept as "
-        "written (path and timing).</p>"
+        + ("" if along is None else f", segments with MoveL re-timed along their path {_fmt(along, 3)} %")
+        + ". The default is the program as the emulated controller runs it; MoveL moves keep their line "
+        "and tool orientation (re-timed along it within their speeddata).</p>"
     )
     measures = data.get("energies") or {}
     if measures:
