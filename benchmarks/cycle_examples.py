@@ -13,7 +13,8 @@ pick_and_place, the segments also share the taught cycle's movable time: each so
 and 105 % of its span, the best combination within the sum (``SHARED=0`` skips it).
 
 Run: ``.venv/bin/python benchmarks/cycle_examples.py [PROGRAM ...]`` (one BLAS thread; about 25
-minutes on a shared 2-core machine, 16 of them the optimum's 13 segments of palletizing).
+minutes on a shared 2-core machine, 16 of them the optimum's 13 segments of palletizing;
+``OPTIMUM=0``: the plans only, about 2 minutes).
 Writes the table to stdout; BENCHMARKS.md holds a copy with the machine.
 """
 
@@ -159,12 +160,20 @@ def main(argv: list[str] | None = None) -> None:
             written = f"RAPID, emulated {data['executed_saved_pct']:.1f} %"
         else:
             written = f"EGM, {result.saved_pct:.1f} %"
-        print(f"{name}: {result.saved_pct:.1f} %, {wall:.1f} s", flush=True)
+        along = result.breakdown.by_path_retiming_pct
+        print(
+            f"{name}: {result.saved_pct:.1f} %, {wall:.1f} s"
+            + ("" if along is None else f" (of it, segments re-timed along their path: {along:.1f} points)"),
+            flush=True,
+        )
+        n_moves = sum(1 for s in spec.steps if s.kind == "move")
+        if os.environ.get("OPTIMUM", "1") == "0":  # the plan only (the optimum does not depend on it)
+            rows.append((name, n_moves, result, written, None, None, None, None, [], wall, cpu, None))
+            continue
         taught_J, best_J, notes, opt_wall = cycle_optimum_of(CycleOptimizer(spec, CycleSettings()))
         opt_pct = 100 * (taught_J - best_J) / taught_J
         plan_saved = result.default_energy_J - result.optimized_energy_J
         share = 100 * plan_saved / (result.default_energy_J * opt_pct / 100) if opt_pct > 0 else None
-        n_moves = sum(1 for s in spec.steps if s.kind == "move")
         rows.append(
             (name, n_moves, result, written, taught_J, best_J, opt_pct, share, notes, wall, cpu, opt_wall)
         )
@@ -188,10 +197,12 @@ def main(argv: list[str] | None = None) -> None:
     print("|---|---|---|---|---|---|---|---|---|---|")
     for name, n_moves, r, written, _, best_J, opt_pct, share, _, wall, cpu, opt_wall in rows:
         share_txt = "—" if share is None else f"{share:.0f} %"
+        best_txt = "not run" if best_J is None else f"{best_J:.2f}, {opt_pct:.1f} %"
+        wall_txt = "—" if opt_wall is None else f"{opt_wall:.0f}"
         print(
             f"| {name} | {n_moves} | {r.default_cycle_s:.3f} → {r.optimized_cycle_s:.3f} | "
             f"{r.default_energy_J:.2f} → {r.optimized_energy_J:.2f} | {r.saved_pct:.1f} % | {written} | "
-            f"{best_J:.2f}, {opt_pct:.1f} % | {share_txt} | {wall:.1f} / {cpu:.1f} | {opt_wall:.0f} |"
+            f"{best_txt} | {share_txt} | {wall:.1f} / {cpu:.1f} | {wall_txt} |"
         )
     print()
     for name, *_, notes, _, _, _ in rows:

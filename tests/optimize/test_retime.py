@@ -19,7 +19,7 @@ from joulepath.optimize import (
     shortest_on_path,
     tcp_velocity,
 )
-from joulepath.optimize._retime import _Search, _table, _timing
+from joulepath.optimize._retime import _Limits, _problem, _timing
 from joulepath.optimize._verify import energy_on_samples
 from joulepath.sim import ControllerConfig, SpeedData, Step, acceleration_limit, jerk_limit
 from joulepath.sim._timing import PlannedMove, SegmentPath, fastest_profile, segment_path, standalone
@@ -217,25 +217,8 @@ def test_search_gradients_match_finite_differences(irb120, lines, limits, measur
     duration = 0.8
     timing = _timing(duration, True, True)
     t = np.linspace(0.0, duration, 81)
-    bases = [timing.basis(t, nu) for nu in range(3)]
-    lo, hi = timing.fixed_lo, timing.n_ctrl - timing.fixed_hi
-    problem = _Search(
-        table=_table(irb120, line.path.at, TOOL),
-        friction=NOMINAL_FRICTION,
-        dt=float(t[1] - t[0]),
-        b0=bases[0][:, lo:hi],
-        b1=bases[1][:, lo:hi],
-        b2=bases[2][:, lo:hi],
-        off0=bases[0][:, hi:].sum(axis=1),
-        off1=bases[1][:, hi:].sum(axis=1),
-        off2=bases[2][:, hi:].sum(axis=1),
-        vmax=np.asarray(irb120.velocity_limit, dtype=float),
-        amax=limits[0],
-        jmax=limits[1],
-        tcp_speed=line.v_tcp,
-        measure=measure,
-        drivetrain=irb120.drivetrain,
-    )
+    limits_ = _Limits(NOMINAL_FRICTION, limits[0], limits[1], line.v_tcp, TOOL, measure, irb120.drivetrain)
+    problem = _problem(irb120, line.path.at, timing, t, limits_)
     x = np.sort(np.random.default_rng(3).uniform(0.05, 0.95, timing.n_free))
     h = 1e-6
     _, grad = problem.energy(x)
@@ -393,24 +376,9 @@ def test_identity_timing_gradients_with_a_bound_per_point_match_finite_differenc
     duration = 0.8
     timing = _identity_timing(duration, 12)
     t = np.linspace(0.0, duration, 81)
-    bases = [timing.basis(t, nu) for nu in range(3)]
-    lo, hi = timing.fixed_lo, timing.n_ctrl - timing.fixed_hi
-    problem = _Search(
-        table=_table(irb120, line.path.at, TOOL),
-        friction=NOMINAL_FRICTION,
-        dt=float(t[1] - t[0]),
-        b0=bases[0][:, lo:hi],
-        b1=bases[1][:, lo:hi],
-        b2=bases[2][:, lo:hi],
-        off0=timing.fixed_part(bases[0]),
-        off1=timing.fixed_part(bases[1]),
-        off2=timing.fixed_part(bases[2]),
-        vmax=np.asarray(irb120.velocity_limit, dtype=float),
-        amax=limits[0],
-        jmax=limits[1],
-        tcp_speed=lambda s: line.v_tcp * (1.0 + 0.5 * s**2),  # smooth, so that its slope counts
-        drivetrain=irb120.drivetrain,
-    )
+    bound = lambda s: line.v_tcp * (1.0 + 0.5 * s**2)  # noqa: E731  (smooth, so that its slope counts)
+    limits_ = _Limits(NOMINAL_FRICTION, limits[0], limits[1], bound, TOOL, "thesis", irb120.drivetrain)
+    problem = _problem(irb120, line.path.at, timing, t, limits_)
     x = np.sort(np.random.default_rng(4).uniform(timing.lo_values[-1], timing.hi_values[0], timing.n_free))
     h = 1e-6
     _, jac = problem.constraints(x)
@@ -439,3 +407,18 @@ def test_retime_on_path_refuses_an_unknown_start_and_a_bound_per_point_from_the_
         retime_on_path(irb120, lines["fast"].path, 1.0, start="zero", **kwargs)
     with pytest.raises(InvalidInput, match="needs start='identity'"):
         retime_on_path(irb120, lines["fast"].path, 1.0, tcp_speed_limit=lambda s: s + 1.0, **kwargs)
+
+
+def test_identity_start_with_free_ends_keeps_a_path_at_rest_at_rest(irb120, lines, limits):
+    """A motion from rest to rest re-timed with its ends free (only ``s`` kept there): still at rest at
+    both ends, on the same path, within the limits, never above its own timing's energy."""
+    line = lines["fast"]
+    shortest, _ = _controller(line, None, 0.125)
+    T, path = _as_motion_path(line, 1.3 * shortest, 0.125)
+    kwargs = dict(acceleration_limit=limits[0], jerk_limit=limits[1], tcp=TOOL, start="identity")
+    free = retime_on_path(irb120, path, T, free_ends=(True, True), **kwargs)
+    assert free.feasible, free.limit_excess
+    assert free.energy_J <= free.start_energy_J
+    np.testing.assert_allclose(free.fine.qd[[0, -1]], 0.0, atol=1e-9)
+    np.testing.assert_allclose(free.fine.q, path(free.s)[0], atol=1e-12)
+    assert free.s[0] == pytest.approx(0.0, abs=1e-12) and free.s[-1] == pytest.approx(1.0, abs=1e-12)

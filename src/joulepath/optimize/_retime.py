@@ -41,7 +41,7 @@ a bound on ``ṡ``.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -63,8 +63,16 @@ SAMPLE_DT = 0.025
 """s, the longest step of :attr:`Retimed.samples` (the logs' 40 Hz)."""
 N_COEFFICIENTS = 12
 """Free control points of the timing spline ``s(t)`` (at least, with ``start="identity"``)."""
-IDENTITY_KNOT_S = 0.2
+IDENTITY_KNOT_S = 0.05
 """s per free control point, at most, of the timing of a long path with ``start="identity"``."""
+COARSE_FACTOR = 4
+"""With ``start="identity"``: the first search's grid is this many times coarser than the fine one."""
+COARSE_MARGIN = 0.01
+"""... and keeps its limits this fraction below the checked ones (between its points they may rise)."""
+POLISH_ITERATIONS = 30
+"""SLSQP iterations, at most, of the polish of that search on the fine grid."""
+RESCUE_KNOT_S = 0.1
+"""s per free control point of the fine-grid search that follows an infeasible polish."""
 DEGREE = 5
 """Degree of the timing spline (quintic: continuous jerk)."""
 TABLE_POINTS = 513
@@ -343,13 +351,15 @@ def _timing(duration: float, start_at_rest: bool, end_at_rest: bool) -> _Timing:
     return _Timing(_knots(duration, n_ctrl), n_ctrl, np.zeros(lo), np.ones(hi))
 
 
-def _identity_timing(duration: float, n_free: int) -> _Timing:
+def _identity_timing(duration: float, n_free: int, free: tuple[bool, bool] = (False, False)) -> _Timing:
     """``s(t)`` whose first and last three control points are those of ``s = t / duration`` (its
-    Greville abscissae over ``duration``): ``s``, ``ṡ`` and ``s̈`` at both ends are the identity's."""
-    n_ctrl = n_free + 6
+    Greville abscissae over ``duration``): ``s``, ``ṡ`` and ``s̈`` at both ends are the identity's.
+    ``free``: at that end only ``s`` is fixed (a path at rest there stays at rest at any ``ṡ``)."""
+    lo, hi = (1 if free[0] else 3), (1 if free[1] else 3)
+    n_ctrl = n_free + lo + hi
     knots = _knots(duration, n_ctrl)
     greville = np.array([knots[k + 1 : k + DEGREE + 1].mean() for k in range(n_ctrl)]) / duration
-    return _Timing(knots, n_ctrl, greville[:3], greville[-3:])
+    return _Timing(knots, n_ctrl, greville[:lo], greville[n_ctrl - hi :])
 
 
 def _fit_start(timing: _Timing, t: FloatArray, s: FloatArray) -> FloatArray:
@@ -382,6 +392,7 @@ class _Search:
     tcp_speed: SpeedBound | None
     measure: str = DEFAULT_MEASURE
     drivetrain: Drivetrain = field(default_factory=Drivetrain)
+    margin: float = _MARGIN  # the limits are kept this fraction below the checked ones
 
     def state(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         return self.b0 @ x + self.off0, self.b1 @ x + self.off1, self.b2 @ x + self.off2
@@ -431,7 +442,7 @@ class _Search:
         """``g(x) >= 0`` (relative margins to each limit) and its Jacobian."""
         p = self._parts(x)
         sd, sdd = p["sd"][:, None], p["sdd"][:, None]
-        lim = 1.0 - _MARGIN
+        lim = 1.0 - self.margin
         rows: list[FloatArray] = []
         jacs: list[FloatArray] = []
         # joint speed: |q'| ṡ <= vmax (ṡ >= 0 by the monotone control points)
@@ -467,19 +478,19 @@ class _Search:
         return g, jac
 
 
-def _search(
+def _problem(
     robot: Robot,
     at: Callable[..., Any],
     timing: _Timing,
     t: FloatArray,
-    x0: FloatArray,
     limits: _Limits,
-) -> FloatArray:
-    table = _table(robot, at, limits.tcp)
+    margin: float = _MARGIN,
+) -> _Search:
+    """The search's functions for ``timing`` on the grid ``t``."""
     lo, hi = timing.fixed_lo, timing.n_ctrl - timing.fixed_hi
     bases = [timing.basis(t, nu) for nu in range(3)]
-    problem = _Search(
-        table=table,
+    return _Search(
+        table=_table(robot, at, limits.tcp),
         friction=limits.friction,
         dt=float(t[1] - t[0]),
         b0=bases[0][:, lo:hi],
@@ -494,7 +505,22 @@ def _search(
         tcp_speed=limits.tcp_speed,
         measure=limits.measure,
         drivetrain=limits.drivetrain,
+        margin=margin,
     )
+
+
+def _search(
+    robot: Robot,
+    at: Callable[..., Any],
+    timing: _Timing,
+    t: FloatArray,
+    x0: FloatArray,
+    limits: _Limits,
+    *,
+    margin: float = _MARGIN,
+    maxiter: int = MAX_ITERATIONS,
+) -> FloatArray:
+    problem = _problem(robot, at, timing, t, limits, margin)
     n = x0.size
     order = np.zeros((n + 1, n))  # x_0 >= lo, x_{i+1} - x_i >= 0, hi - x_{n-1} >= 0 (the fixed neighbours)
     order[0, 0] = 1.0
@@ -524,7 +550,7 @@ def _search(
             {"type": "ineq", "fun": lambda x: order @ x + shift, "jac": lambda x: order},
             {"type": "ineq", "fun": lambda x: limits_at(x)[0], "jac": lambda x: limits_at(x)[1]},
         ],
-        options={"maxiter": MAX_ITERATIONS, "ftol": 1e-9},
+        options={"maxiter": maxiter, "ftol": 1e-9},
     )
     out: FloatArray = np.clip(np.asarray(result.x, dtype=float), 0.0, 1.0)
     return np.maximum.accumulate(out)
@@ -576,6 +602,7 @@ def retime_on_path(
     end_at_rest: bool = True,
     energy_measure: str = DEFAULT_MEASURE,
     start: str = "controller",
+    free_ends: tuple[bool, bool] = (False, False),
 ) -> Retimed:
     """The least-energy timing ``s(t)`` of a fixed joint path in exactly ``duration`` s.
 
@@ -613,6 +640,9 @@ def retime_on_path(
         and ``end_at_rest`` are then ignored), so that it fits between the motion's neighbours.
         The result is never worse than this start on the measure, and feasible whenever the start
         is.
+    free_ends : (bool, bool)
+        With ``start="identity"``: at that end only ``s`` is kept, ``ṡ`` and ``s̈`` are free (for
+        a path at rest there, ``dq/ds = d²q/ds² = 0``, which then stays at rest).
 
     Returns
     -------
@@ -649,11 +679,6 @@ def retime_on_path(
     jmax = _check_limits_arg("jerk_limit", jerk_limit, n, required=False)
     check_measure(energy_measure, robot.drivetrain)
     limits = _Limits(friction, amax, jmax, tcp_speed_limit, tcp, energy_measure, robot.drivetrain)
-    timing = (
-        _identity_timing(duration, max(N_COEFFICIENTS, int(np.ceil(duration / IDENTITY_KNOT_S))))
-        if start == "identity"
-        else _timing(duration, start_at_rest, end_at_rest)
-    )
     t = _grid(duration, FINE_DT)
     controller: Law
     if start == "identity":
@@ -672,16 +697,24 @@ def retime_on_path(
         def controller(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
             return evaluate_profile(profile, tt)
 
-    x = _search(robot, at, timing, t, _fit_start(timing, t, controller(t)[0]), limits)
-
-    def optimized(tt: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        return timing.evaluate(x, tt)
-
     e0, fine0, s0, excess0 = _measure(robot, at, controller, duration, limits)
-    e1, fine1, s1, excess1 = _measure(robot, at, optimized, duration, limits)
-    take_new = (not excess1, -e1) > (not excess0, -e0)
-    law = optimized if take_new else controller
-    energy, fine, s, excess = (e1, fine1, s1, excess1) if take_new else (e0, fine0, s0, excess0)
+    best: tuple[Law, float, Trajectory, FloatArray, tuple[str, ...]] = (controller, e0, fine0, s0, excess0)
+    for timing, x in _searched(
+        robot, at, duration, t, controller, limits, start, free_ends, (start_at_rest, end_at_rest)
+    ):
+
+        def optimized(
+            tt: FloatArray, timing: _Timing = timing, x: FloatArray = x
+        ) -> tuple[FloatArray, FloatArray, FloatArray]:
+            return timing.evaluate(x, tt)
+
+        e1, fine1, s1, excess1 = _measure(robot, at, optimized, duration, limits)
+        if (not excess1, -e1) > (not best[4], -best[1]):
+            best = (optimized, e1, fine1, s1, excess1)
+        if not excess1:
+            break  # (the next is a rescue of an infeasible search)
+    law, energy, fine, s, excess = best
+    take_new = law is not controller
     ts = _grid(duration, SAMPLE_DT)
     ss, sds, sdds = law(ts)
     samples = _motion(at, np.clip(ss, 0.0, 1.0), sds, sdds, ts)
@@ -696,6 +729,43 @@ def retime_on_path(
         optimized=take_new,
         start_energy_J=e0,
     )
+
+
+def _searched(
+    robot: Robot,
+    at: Callable[..., Any],
+    duration: float,
+    t: FloatArray,
+    start: Law,
+    limits: _Limits,
+    kind: str,
+    free_ends: tuple[bool, bool],
+    rest: tuple[bool, bool],
+) -> Iterator[tuple[_Timing, FloatArray]]:
+    """The searches' timings, in turn, each to be measured (the caller stops at a feasible one).
+
+    From the controller's profile: one search on the fine grid. From a motion's own timing
+    (``"identity"``): a control point per :data:`IDENTITY_KNOT_S`, searched on a grid
+    :data:`COARSE_FACTOR` times coarser within :data:`COARSE_MARGIN` of the limits, then polished
+    on the fine grid (:data:`POLISH_ITERATIONS`); where that is not feasible, a control point per
+    :data:`RESCUE_KNOT_S` searched on the fine grid (SLSQP's dense QP grows with the rows times
+    the variables squared, so the fine grid takes the coarser spline)."""
+    if kind != "identity":
+        timing = _timing(duration, *rest)
+        yield timing, _search(robot, at, timing, t, _fit_start(timing, t, start(t)[0]), limits)
+        return
+    timing = _identity_timing(
+        duration, max(N_COEFFICIENTS, int(np.ceil(duration / IDENTITY_KNOT_S))), free_ends
+    )
+    coarse = _grid(duration, COARSE_FACTOR * FINE_DT)
+    x = _search(
+        robot, at, timing, coarse, _fit_start(timing, coarse, start(coarse)[0]), limits, margin=COARSE_MARGIN
+    )
+    yield timing, _search(robot, at, timing, t, x, limits, maxiter=POLISH_ITERATIONS)
+    timing = _identity_timing(
+        duration, max(N_COEFFICIENTS, int(np.ceil(duration / RESCUE_KNOT_S))), free_ends
+    )
+    yield timing, _search(robot, at, timing, t, _fit_start(timing, t, start(t)[0]), limits)
 
 
 # --------------------------------------------------------------------------- time-optimal bound

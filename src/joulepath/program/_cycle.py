@@ -209,6 +209,15 @@ def _interpolated(x: FloatArray, y: FloatArray) -> Callable[[FloatArray], FloatA
     return at
 
 
+def _at_rest(qd: FloatArray, qdd: FloatArray) -> bool:
+    """A sample of a standstill (no speed, no acceleration)."""
+    return bool(np.abs(qd).max() < 1e-9 and np.abs(qdd).max() < 1e-6)
+
+
+RETIME_MAX_SPAN_S = 4.0
+"""s: a segment longer than this keeps its plan's timing (its re-timing along its path, at a control
+point per 0.1 s on the 2.5 ms grid, would take minutes)."""
+
 RETIME_GAIN = 1e-3
 """A segment re-timed along its path is kept where it saves at least this share of its energy (else
 its plan stays as it is, and RAPID's own moves can follow it)."""
@@ -1510,6 +1519,10 @@ class CycleOptimizer:
                 continue
             if len(moving) == 1 and moving[0] in self.linear:
                 continue  # a MoveL from rest to rest: its own unit re-times it along its line
+            if any(self.default_clearance.get(j, np.inf) < 0.0 for j in moving):
+                continue  # a taught move within the cell's margin: reported, left as it is
+            if seg.span > RETIME_MAX_SPAN_S:
+                continue  # SLSQP's dense QP grows with the rows (2.5 ms samples) times variables squared
             first = self.by_index[moving[0]].step
             robot, tcp = self._robot(self.by_index[moving[0]]), first.tcp
             if tcp is None or any(
@@ -1544,6 +1557,7 @@ class CycleOptimizer:
                     tcp=tcp,
                     energy_measure=st.energy,
                     start="identity",
+                    free_ends=(_at_rest(qd[0], qdd[0]), _at_rest(qd[-1], qdd[-1])),
                 )
             except InvalidInput:
                 continue  # a segment that does not move
@@ -1598,7 +1612,8 @@ class CycleOptimizer:
         # speed the motion already has there
         wide = np.minimum(out, np.minimum(np.roll(out, 1), np.roll(out, -1)))
         wide[[0, -1]] = out[[0, -1]]
-        return np.maximum(wide, speed * (1.0 + 1e-6))
+        bound: FloatArray = np.maximum(wide, speed * (1.0 + 1e-6))
+        return bound
 
     def _pieces_of(
         self, motion: CycleMotion, done: list[tuple[Segment, tuple[int, ...]]]
