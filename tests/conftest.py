@@ -139,6 +139,21 @@ def egm_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+@pytest.fixture(scope="session")
+def via_points_run(irb120: joulepath.Robot, tmp_path_factory: pytest.TempPathFactory) -> tuple[Any, Path]:
+    """The same task optimized for RAPID via points (``follow="via-points"``) and written with the
+    robot's own export (path.mod): its result and folder (tests/optimize/test_execute.py,
+    tests/measure/test_measure.py). Copy the folder before writing into it."""
+    from joulepath.optimize import OptimizeConfig, optimize_move, write_run
+
+    result = optimize_move(
+        irb120, np.array(EGM_START), np.array(EGM_END), EGM_DURATION, OptimizeConfig(follow="via-points")
+    )
+    out = tmp_path_factory.mktemp("via_points_run")
+    write_run(result, irb120, out)
+    return result, out
+
+
 class Background:
     """Run ``target`` in a thread; ``address`` is set once it listens, ``result``/``error`` when it ends."""
 

@@ -12,7 +12,8 @@ TASK = ["--start", "0.3,0.2,-0.4,0.5,-0.6,1.0", "--end", "-0.9,0.6,0.3,-1.2,0.8,
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     out = tmp_path_factory.mktemp("cli") / "run"
-    assert main(["optimize", *TASK, "--out", str(out)]) == 0
+    # fewer knots than the default 0.05 s: a shorter search, still a saving the measurement finds
+    assert main(["optimize", *TASK, "--knot-spacing", "0.1", "--out", str(out)]) == 0
     return out
 
 

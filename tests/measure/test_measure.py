@@ -10,7 +10,6 @@ from joulepath import load_robot
 from joulepath.energy import total_energy
 from joulepath.errors import InvalidInput
 from joulepath.measure import find_moves, measure_run, read_plan, saving_interval, write_measure
-from joulepath.optimize import OptimizeConfig, optimize_move, write_run
 from joulepath.program import program_motion, read_module, resolve_module, simulate_program
 from joulepath.sim import ControllerConfig, make_plant, simulate
 
@@ -24,9 +23,13 @@ def robot():
 
 
 @pytest.fixture(scope="module")
-def run_folder(tmp_path_factory, robot):
-    out = tmp_path_factory.mktemp("run")
-    write_run(optimize_move(robot, START, END, 1.6, OptimizeConfig(follow="via-points")), robot, out)
+def run_folder(tmp_path_factory, via_points_run):
+    """START -> END in 1.6 s optimized with ``follow="via-points"``, written (tests/conftest.py); a copy."""
+    result, shared = via_points_run
+    s = result.summary
+    assert (s.start_rad, s.end_rad, s.duration_s) == (tuple(START), tuple(END), 1.6)
+    out = tmp_path_factory.mktemp("run") / "run"
+    shutil.copytree(shared, out)
     return out
 
 

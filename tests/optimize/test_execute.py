@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from joulepath.energy import path_energy
-from joulepath.optimize import OptimizeConfig, optimize_move, rapid_execution, write_run
+from joulepath.optimize import OptimizeConfig, rapid_execution
 from joulepath.program._parse import parse_module
 from joulepath.program._resolve import resolve_module
 from joulepath.sim import RAPID_ACCEL_SHARE, ControllerConfig, acceleration_limit, evaluate_cycle, plan_cycle
@@ -18,10 +18,11 @@ QF = np.array([-0.9, 0.6, 0.3, -1.2, 0.8, -1.5])
 
 
 @pytest.fixture(scope="module")
-def rapid_run(irb120, tmp_path_factory):
-    result = optimize_move(irb120, Q0, QF, 1.6, OptimizeConfig(follow="via-points"))
-    folder = tmp_path_factory.mktemp("run")
-    write_run(result, irb120, folder)
+def rapid_run(via_points_run):
+    """Q0 -> QF in 1.6 s optimized with ``follow="via-points"``, written (tests/conftest.py)."""
+    result, folder = via_points_run
+    s = result.summary
+    assert (s.start_rad, s.end_rad, s.duration_s) == (tuple(Q0), tuple(QF), 1.6)
     return result, folder, json.loads((folder / "result.json").read_text())
 
 

@@ -60,6 +60,14 @@ def spec(robot):
     return resolve_module(parse_module(SMALL, path="small.mod"), robot)
 
 
+@pytest.fixture(scope="module")
+def reachable(spec):
+    """SMALL optimized at REACHABLE with its waits spent (zones and fly-by on): (result, optimizer)."""
+    return optimize_cycle(
+        spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, cycle_time=REACHABLE)
+    )
+
+
 def test_fine_moves_superposed_equal_standalone(spec, robot):
     """With stop points only, the superposed cycle is the standalone moves one after another."""
     plan = plan_cycle(spec, ControllerConfig())
@@ -327,15 +335,12 @@ def test_timed_fly_by_chain_keeps_speed(robot):
     assert traj.q[-1, 0] == pytest.approx(np.radians(3.0 * n), abs=1e-12)
 
 
-def test_written_program_check_is_reported(tmp_path, robot):
+def test_written_program_check_is_reported(tmp_path, robot, reachable):
     """cycle.json carries the written program run by the emulation beside the plan, with a verdict
     consistent with its numbers and tolerances."""
     from joulepath.program._output import check_written, optimized_module
 
-    spec = resolve_module(parse_module(SMALL, path="small.mod"), robot)
-    r, _ = optimize_cycle(
-        spec, CycleSettings(gradient=FAST, table_points=2, use_waits=True, cycle_time=REACHABLE)
-    )
+    r, _ = reachable
     check = check_written(r, optimized_module(r))
     tol = check["tolerances"]
     expected = (
@@ -362,7 +367,7 @@ def test_written_program_check_is_reported(tmp_path, robot):
     resolve_module(parse_module(text, path="w.mod"), robot)  # the warning is a comment: it reads back
 
 
-def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):
+def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot, reachable):
     """MoveAbsJ jA (z20) then MoveJ pUp: one chain that passes jA exactly (--exact-targets), at
     speed; written with the target as a timed fly-by point; with --stop-at-targets the chain is
     kept as taught; within its zone by default."""
@@ -401,7 +406,8 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot):
     assert rest.chains == {}
     assert opt.shortest_cycle <= opt_rest.shortest_cycle + 1e-9
     # within its zone: the TCP passes within the zone of jA (reduced as the controller reduces it)
-    zoned, opt_z = optimize_cycle(spec, replace(settings, zones=True))
+    zoned, opt_z = reachable
+    assert opt_z.settings == replace(settings, zones=True)
     assert opt_z.zone_mm(first) > 0.0
     assert zoned.zone_miss_mm <= 1e-3
     assert zoned.optimized_energy_J <= result.optimized_energy_J * 1.02  # more freedom, not much worse

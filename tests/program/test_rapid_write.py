@@ -16,6 +16,12 @@ from joulepath.program._output import check_written, reads_back, written_rapid
 from joulepath.program._rapid_write import motion_model, planned_model, restore_program, same_model
 
 FAST = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), max_iter=60, coarse_factor=1)
+# The module is written from the plan before its MoveL segments are re-timed along their path
+# (CycleResult.unretimed), which retime_segments=False gives as the result itself (measured: the same
+# palletizing module but its header's planned energy, in 1/9 of the time); the module of a re-timed
+# result is checked in test_cycle_units.py. The plan for via points (rapid_plan) is not written by
+# written_rapid, and the modules written here had none (write_cycle_run tries it; test_cycle.py).
+WRITE = CycleSettings(gradient=FAST, table_points=2, retime_segments=False, rapid_plan=False)
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 TWICE = """MODULE Twice
@@ -42,23 +48,17 @@ def robot():
     return joulepath.load_robot("irb120")
 
 
-# The written module follows the plan before its MoveL segments are re-timed along their paths
-# (CycleResult.unretimed; tests/program/test_cycle_units.py), so these plans leave that stage out.
-
-
 @pytest.fixture(scope="module")
 def palletizing(robot):
     spec, _ = read_cycle_program(EXAMPLES / "palletizing.mod", robot)
-    result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, retime_segments=False))
+    result, _ = optimize_cycle(spec, WRITE)
     return result
 
 
 @pytest.fixture(scope="module")
 def twice(robot):
     spec = resolve_module(parse_module(TWICE, path="twice.mod"), robot)
-    result, _ = optimize_cycle(
-        spec, CycleSettings(gradient=FAST, table_points=2, retime_segments=False, cycle_time=4.5)
-    )
+    result, _ = optimize_cycle(spec, replace(WRITE, cycle_time=4.5))
     return result
 
 
@@ -262,7 +262,7 @@ def test_payload_tool_procedure_with_arguments_reads_back(robot):
     written module keeps the procedure and its arguments, ends the stops at the program's own targets
     (with their work object), shows only optimized moves and additions in a diff, and reads back."""
     spec, _ = read_cycle_program(EXAMPLES / "payload_tool.mod", robot)
-    result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, retime_segments=False))
+    result, _ = optimize_cycle(spec, WRITE)
     source = (EXAMPLES / "payload_tool.mod").read_text()
     layout = written_rapid(result)
     assert "PROC Transfer(robtarget pFrom, robtarget pTo" in layout.text
@@ -355,7 +355,7 @@ def test_move_inside_a_for_loop_gets_its_runs_by_the_loop_variable(robot):
     """A move directly inside a FOR loop: its optimized procedure receives the loop variable (for its
     Offs target) and the run number computed from it; it reads back and restores to the program."""
     spec = resolve_module(parse_module(LOOP, path="loop.mod"), robot)
-    result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, retime_segments=False))
+    result, _ = optimize_cycle(spec, WRITE)
     layout = written_rapid(result)
     assert reads_back(result, layout.text) is None
     assert restore_program(layout.text) == LOOP
