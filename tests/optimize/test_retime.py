@@ -422,3 +422,18 @@ def test_identity_start_with_free_ends_keeps_a_path_at_rest_at_rest(irb120, line
     np.testing.assert_allclose(free.fine.qd[[0, -1]], 0.0, atol=1e-9)
     np.testing.assert_allclose(free.fine.q, path(free.s)[0], atol=1e-12)
     assert free.s[0] == pytest.approx(0.0, abs=1e-12) and free.s[-1] == pytest.approx(1.0, abs=1e-12)
+
+
+def test_a_deadline_already_past_keeps_what_the_search_has(irb120, lines, limits):
+    """Past its deadline the search stops at its iterate: the result is still measured, and never
+    worse than the start it would otherwise improve (the motion's own timing, feasible)."""
+    import time
+
+    line = lines["fast"]
+    shortest, _ = _controller(line, None, 0.125)
+    T, path = _as_motion_path(line, 1.3 * shortest, 0.125)
+    kwargs = dict(acceleration_limit=limits[0], jerk_limit=limits[1], tcp=TOOL, start="identity")
+    late = retime_on_path(irb120, path, T, deadline=time.perf_counter() - 1.0, **kwargs)
+    assert late.feasible and late.energy_J <= late.start_energy_J
+    full = retime_on_path(irb120, path, T, **kwargs)
+    assert full.energy_J <= late.energy_J * (1 + 1e-9)

@@ -41,6 +41,7 @@ a bound on ``ṡ``.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, Protocol
@@ -478,6 +479,12 @@ class _Search:
         return g, jac
 
 
+def _stop_past(deadline: float) -> None:
+    """SLSQP's callback: stop at the current iterate once ``deadline`` has passed."""
+    if time.perf_counter() > deadline:
+        raise StopIteration
+
+
 def _problem(
     robot: Robot,
     at: Callable[..., Any],
@@ -519,7 +526,9 @@ def _search(
     *,
     margin: float = _MARGIN,
     maxiter: int = MAX_ITERATIONS,
+    deadline: float | None = None,
 ) -> FloatArray:
+    """SLSQP from ``x0`` (past ``deadline``, a ``time.perf_counter()``, it stops at its iterate)."""
     problem = _problem(robot, at, timing, t, limits, margin)
     n = x0.size
     order = np.zeros((n + 1, n))  # x_0 >= lo, x_{i+1} - x_i >= 0, hi - x_{n-1} >= 0 (the fixed neighbours)
@@ -551,6 +560,7 @@ def _search(
             {"type": "ineq", "fun": lambda x: limits_at(x)[0], "jac": lambda x: limits_at(x)[1]},
         ],
         options={"maxiter": maxiter, "ftol": 1e-9},
+        callback=None if deadline is None else lambda _: _stop_past(deadline),
     )
     out: FloatArray = np.clip(np.asarray(result.x, dtype=float), 0.0, 1.0)
     return np.maximum.accumulate(out)
@@ -603,6 +613,7 @@ def retime_on_path(
     energy_measure: str = DEFAULT_MEASURE,
     start: str = "controller",
     free_ends: tuple[bool, bool] = (False, False),
+    deadline: float | None = None,
 ) -> Retimed:
     """The least-energy timing ``s(t)`` of a fixed joint path in exactly ``duration`` s.
 
@@ -643,6 +654,9 @@ def retime_on_path(
     free_ends : (bool, bool)
         With ``start="identity"``: at that end only ``s`` is kept, ``ṡ`` and ``s̈`` are free (for
         a path at rest there, ``dq/ds = d²q/ds² = 0``, which then stays at rest).
+    deadline : float, optional
+        ``time.perf_counter()`` past which the search stops at its current iterate (what it has
+        is measured as always; no further search starts).
 
     Returns
     -------
@@ -700,7 +714,7 @@ def retime_on_path(
     e0, fine0, s0, excess0 = _measure(robot, at, controller, duration, limits)
     best: tuple[Law, float, Trajectory, FloatArray, tuple[str, ...]] = (controller, e0, fine0, s0, excess0)
     for timing, x in _searched(
-        robot, at, duration, t, controller, limits, start, free_ends, (start_at_rest, end_at_rest)
+        robot, at, duration, t, controller, limits, start, free_ends, (start_at_rest, end_at_rest), deadline
     ):
 
         def optimized(
@@ -741,6 +755,7 @@ def _searched(
     kind: str,
     free_ends: tuple[bool, bool],
     rest: tuple[bool, bool],
+    deadline: float | None = None,
 ) -> Iterator[tuple[_Timing, FloatArray]]:
     """The searches' timings, in turn, each to be measured (the caller stops at a feasible one).
 
@@ -752,20 +767,32 @@ def _searched(
     the variables squared, so the fine grid takes the coarser spline)."""
     if kind != "identity":
         timing = _timing(duration, *rest)
-        yield timing, _search(robot, at, timing, t, _fit_start(timing, t, start(t)[0]), limits)
+        yield (
+            timing,
+            _search(robot, at, timing, t, _fit_start(timing, t, start(t)[0]), limits, deadline=deadline),
+        )
         return
     timing = _identity_timing(
         duration, max(N_COEFFICIENTS, int(np.ceil(duration / IDENTITY_KNOT_S))), free_ends
     )
     coarse = _grid(duration, COARSE_FACTOR * FINE_DT)
     x = _search(
-        robot, at, timing, coarse, _fit_start(timing, coarse, start(coarse)[0]), limits, margin=COARSE_MARGIN
+        robot,
+        at,
+        timing,
+        coarse,
+        _fit_start(timing, coarse, start(coarse)[0]),
+        limits,
+        margin=COARSE_MARGIN,
+        deadline=deadline,
     )
-    yield timing, _search(robot, at, timing, t, x, limits, maxiter=POLISH_ITERATIONS)
+    yield timing, _search(robot, at, timing, t, x, limits, maxiter=POLISH_ITERATIONS, deadline=deadline)
+    if deadline is not None and time.perf_counter() > deadline:
+        return
     timing = _identity_timing(
         duration, max(N_COEFFICIENTS, int(np.ceil(duration / RESCUE_KNOT_S))), free_ends
     )
-    yield timing, _search(robot, at, timing, t, _fit_start(timing, t, start(t)[0]), limits)
+    yield timing, _search(robot, at, timing, t, _fit_start(timing, t, start(t)[0]), limits, deadline=deadline)
 
 
 # --------------------------------------------------------------------------- time-optimal bound

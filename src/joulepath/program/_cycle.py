@@ -1558,6 +1558,7 @@ class CycleOptimizer:
                     energy_measure=st.energy,
                     start="identity",
                     free_ends=(_at_rest(qd[0], qdd[0]), _at_rest(qd[-1], qdd[-1])),
+                    deadline=self.deadline,
                 )
             except InvalidInput:
                 continue  # a segment that does not move
