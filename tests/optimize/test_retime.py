@@ -23,6 +23,7 @@ from joulepath.optimize._retime import _Limits, _problem, _timing
 from joulepath.optimize._verify import energy_on_samples
 from joulepath.sim import ControllerConfig, SpeedData, Step, acceleration_limit, jerk_limit
 from joulepath.sim._timing import PlannedMove, SegmentPath, fastest_profile, segment_path, standalone
+from joulepath.trajectory import quintic_hermite
 
 needs_toppra = pytest.mark.skipif(
     importlib.util.find_spec("toppra") is None, reason="toppra (the motion extra) is not installed"
@@ -309,10 +310,8 @@ def _as_motion_path(line, duration, jerk_time):
     """The controller's move along ``line`` at ``duration`` as a joint path ``q(s)``, ``s = t / T``
     (a path that is itself a motion of this duration, as a cycle's segment is)."""
     _, ref = _controller(line, duration, jerk_time)
-    from scipy.interpolate import BPoly
-
     T = float(ref.t[-1])
-    poly = BPoly.from_derivatives(ref.t / T, np.stack([ref.q, ref.qd * T, ref.qdd * T * T], axis=1))
+    poly = quintic_hermite(ref.t / T, ref.q, ref.qd * T, ref.qdd * T * T)
     d1, d2 = poly.derivative(1), poly.derivative(2)
     return T, lambda s: (poly(s), d1(s), d2(s))
 

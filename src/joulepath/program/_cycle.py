@@ -36,7 +36,6 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import BPoly
 
 from joulepath._typing import FloatArray
 from joulepath._work import check_work
@@ -68,7 +67,7 @@ from joulepath.sim._timing import (
 )
 from joulepath.sim._via import RAPID_ACCEL_SHARE
 from joulepath.sim._via import layout as via_layout
-from joulepath.trajectory import SplineBasis, Trajectory
+from joulepath.trajectory import SplineBasis, Trajectory, quintic_hermite
 from joulepath.units import SAMPLE_PERIOD
 
 STEP = SAMPLE_PERIOD
@@ -190,7 +189,7 @@ def _hermite_path(
     """A motion's samples as a joint path ``q(s)``, ``s = (t - t0) / T`` in [0, 1]: the quintic Hermite
     interpolation of position, speed and acceleration (C², exact at the samples)."""
     span = float(t[-1] - t[0])
-    poly = BPoly.from_derivatives((t - t[0]) / span, np.stack([q, qd * span, qdd * span * span], axis=1))
+    poly = quintic_hermite((t - t[0]) / span, q, qd * span, qdd * span * span)
     d1, d2 = poly.derivative(1), poly.derivative(2)
 
     def at(s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -827,9 +826,7 @@ class CycleOptimizer:
             )
         else:
             fine = window
-        w = np.append(np.diff(fine.t), 0.0)
-        p, p_lab = sample_power(robot, self.plant(robot), fine, self.settings.energy)
-        e, e_lab = float((p * w).sum()), float((p_lab * w).sum())
+        e, e_lab = _window_energy(robot, self.plant(robot), fine, self.settings.energy)
         samples = problem.path(x)
         samples = Trajectory(
             t=np.append(samples.t, win.span),

@@ -281,10 +281,7 @@ def follow_path(
 
 def _interpolate(path: Trajectory, t: FloatArray) -> FloatArray:
     """The path's positions at ``t``: quintic Hermite through its samples (q, qd, qdd)."""
-    from scipy.interpolate import BPoly
+    from joulepath.trajectory import quintic_hermite
 
-    x = np.asarray(path.t, dtype=float)
-    y = np.stack([path.q, path.qd, path.qdd], axis=1)  # (n, 3, joints)
-    poly = BPoly.from_derivatives(x, y)
-    out: FloatArray = poly(t)
+    out: FloatArray = quintic_hermite(path.t, path.q, path.qd, path.qdd)(t)
     return out

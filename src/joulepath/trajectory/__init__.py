@@ -2,7 +2,14 @@
 
 from joulepath.trajectory._bspline import DEFAULT_KNOT_SPACING, GridBasis, SplineBasis
 from joulepath.trajectory._minimum_jerk import Trajectory, minimum_jerk, sample_times
-from joulepath.trajectory._polynomial import GRID_HIGH, GRID_LOW, GRID_STEP, rest_to_rest, thesis_quintic
+from joulepath.trajectory._polynomial import (
+    GRID_HIGH,
+    GRID_LOW,
+    GRID_STEP,
+    quintic_hermite,
+    rest_to_rest,
+    thesis_quintic,
+)
 
 __all__ = [
     "DEFAULT_KNOT_SPACING",
@@ -13,6 +20,7 @@ __all__ = [
     "SplineBasis",
     "Trajectory",
     "minimum_jerk",
+    "quintic_hermite",
     "rest_to_rest",
     "sample_times",
     "thesis_quintic",

@@ -22,6 +22,7 @@ Both are vectorized over the population: one call returns ``q, qd, qdd`` of shap
 from __future__ import annotations
 
 import numpy as np
+from scipy.interpolate import BPoly
 
 from joulepath._typing import ArrayLike, FloatArray
 from joulepath.errors import InvalidInput
@@ -311,3 +312,9 @@ def _trajectory(t: FloatArray, q: FloatArray, qd: FloatArray, qdd: FloatArray, s
     if single:
         return Trajectory(t=t, q=q[0], qd=qd[0], qdd=qdd[0])
     return Trajectory(t=t, q=q, qd=qd, qdd=qdd)
+
+
+def quintic_hermite(t: FloatArray, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> BPoly:
+    """The quintic Hermite interpolation of samples' positions, speeds and accelerations over ``t``
+    (C², exact at the samples; its derivatives are the speeds and accelerations)."""
+    return BPoly.from_derivatives(np.asarray(t, dtype=float), np.stack([q, qd, qdd], axis=1))
