@@ -111,7 +111,12 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
     result, opt = optimize_cycle(spec, settings)
     assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
     assert result.limits_ok
-    assert {m.label for m in result.moves if m.optimized} == {"MoveAbsJ jA", "MoveJ pUp", "MoveAbsJ jB"}
+    units = {"MoveAbsJ jA", "MoveJ pUp", "MoveAbsJ jB"}
+    assert units <= {m.label for m in result.moves if m.optimized}
+    # any other move changed is a MoveL re-timed along its segment's path (its line kept)
+    assert all(
+        m.note.startswith("MoveL re-timed") for m in result.moves if m.optimized and m.label not in units
+    )
     # the default corridor holds: tool0 within 100 mm of the joint-interpolated taught move
     assert result.corridor_mm == 100.0
     assert all(m.corridor_dev_mm <= 100.0 + 1e-6 for m in result.moves if m.optimized)
@@ -122,9 +127,11 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
     in_chain = {j for c in result.chains.values() for j in c}
     i, s = next((j, p) for j, p in result.paths.items() if j not in in_chain)
     r = spec.steps[i].robot
+    # (each sample's power times the step to the next: a piece the cycle continues from ends in motion)
+    w = np.append(np.diff(s.fine.t), 0.0)[:, None]
     tau = r.inverse_dynamics(s.fine.q, s.fine.qd, s.fine.qdd, friction=NOMINAL_FRICTION)
-    assert s.energy_J == pytest.approx(float(path_energy(tau, s.fine.qd, s.fine.dt).total))
-    assert s.fine.dt == pytest.approx(FINE_DT)
+    assert s.energy_J == pytest.approx(float((np.abs(tau * s.fine.qd) * w).sum()))
+    assert s.fine.dt == pytest.approx(FINE_DT, rel=1e-3)  # a re-timed piece: its segment on its own grid
     # every optimized move keeps the jerk limit (the controller's default) on the 2.5 ms grid
     from joulepath.optimize import jerk_limit, path_jerk
 

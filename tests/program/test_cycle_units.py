@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 
 import joulepath
+from joulepath.dynamics import NOMINAL_FRICTION
 from joulepath.optimize import GradientSettings
 from joulepath.program import CycleSettings, optimize_cycle, parse_module, read_cycle_program, resolve_module
 from joulepath.program._cycle import CycleOptimizer, segments
 from joulepath.program._output import cycle_path_csv, write_cycle_run
-from joulepath.sim._timing import _tcp
+from joulepath.sim._timing import _tcp, evaluate_cycle
 
 FAST = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), max_iter=60, coarse_factor=1)
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "pick_and_place.mod"
@@ -77,8 +78,8 @@ def test_segments_partition_the_default_cycle(blended):
 
 
 def test_units_inside_moveL_segments_keep_the_taught_ends(blended, solved):
-    """The MoveJ between two blended MoveL is a unit over the time only it moves the robot; its
-    optimized motion starts and ends in the taught motion's states, so the cycle stays continuous."""
+    """The MoveJ between two blended MoveL is a unit over its own motion and the blends at its ends;
+    its optimized motion starts and ends in the taught motion's states, so the cycle stays continuous."""
     result, opt = solved
     inner = [i for i in opt.within]
     assert inner, "the MoveJ between the MoveL moves is a unit"
@@ -98,6 +99,42 @@ def test_units_inside_moveL_segments_keep_the_taught_ends(blended, solved):
     assert np.all(step <= robot.velocity_limit * dt * 1.01)  # no jump anywhere in the cycle
 
 
+def test_units_inside_moveL_segments_reshape_their_blends_within_the_zones(blended, solved):
+    """A run of joint moves inside a MoveL segment is reshaped over the blends at its ends: its window
+    starts where the controller starts its first move (not where the blend ends) and ends where it
+    ends its last, and the TCP at both ends is within the zone of the target that blend rounds (the
+    radius reduced to half of either move); before and after the window the MoveL runs on its line
+    as taught. A run that ends at a stop has its last piece end at the target, at rest."""
+    result, opt = solved
+    robot = blended.robot
+    covered = 0
+    for i in opt.within:
+        win = opt.segment_of[i]
+        seg = next(g for g in opt.segments if i in g.moves)
+        moving = [j for j in seg.moves if opt.by_index[j].profile.duration > 0]
+        run = opt.chains[i]
+        k0, k1 = moving.index(run[0]), moving.index(run[-1])
+        ends = []
+        if k0 > 0:
+            ends.append((win.t0, opt.by_index[moving[k0 - 1]], opt.by_index[run[0]]))
+            covered += win.t0 < opt.by_index[moving[k0 - 1]].t_end - 1e-9
+        if k1 + 1 < len(moving):
+            ends.append((win.t1, opt.by_index[run[-1]], opt.by_index[moving[k1 + 1]]))
+            covered += win.t1 > opt.by_index[moving[k1 + 1]].t0 + 1e-9
+        for t, into, out in ends:
+            step = into.step
+            p, _ = _tcp(robot, evaluate_cycle(opt.plan, np.array([t])).q, step.tcp)
+            corner, _ = _tcp(robot, into.path.q1[None, :], step.tcp)
+            radius = min(step.zone_mm, 0.5 * into.path.length_mm, 0.5 * out.path.length_mm)
+            assert 1000 * np.linalg.norm(p - corner) <= radius + 1e-6
+        last = opt.by_index[run[-1]]
+        if last.stops and run[-1] in (result.unretimed or result).paths:
+            piece = (result.unretimed or result).paths[run[-1]].fine
+            np.testing.assert_allclose(piece.q[-1], last.path.q1, atol=1e-9)
+            assert np.abs(piece.qd[-1]).max() < 1e-9
+    assert covered >= 2  # the blends into and out of the MoveJ between the MoveL moves
+
+
 def test_same_cycle_time_is_never_refused_nor_slower(blended, solved):
     result, _ = solved
     assert result.target_cycle_s == result.default_cycle_s
@@ -112,6 +149,12 @@ def test_reported_energies_are_the_planned_motion_s(blended, solved):
     assert sum(m.optimized_energy_J for m in result.moves) == pytest.approx(result.optimized_energy_J)
     assert sum(m.default_energy_J for m in result.moves) == pytest.approx(result.default_energy_J)
     assert result.planned.t[-1] == pytest.approx(result.optimized_cycle_s)
+    # ... and the whole planned motion's energy, recomputed from its samples, is the total
+    tr = result.planned
+    robot = blended.robot
+    tau = robot.inverse_dynamics(tr.q, tr.qd, tr.qdd, friction=NOMINAL_FRICTION)
+    step = np.append(np.diff(tr.t), 0.0)[:, None]
+    assert float((np.abs(tau * tr.qd) * step).sum()) == pytest.approx(result.optimized_energy_J, rel=1e-9)
     # the allocation's sum of entries agrees with the motion's energy
     alloc = opt.evaluate(opt.at_taught_durations(opt.table(opt.budget(result.target_cycle_s, False))), 0.0)
     assert alloc.energy_J > 0

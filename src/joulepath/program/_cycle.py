@@ -565,20 +565,75 @@ class CycleOptimizer:
             return []
         out: list[tuple[tuple[int, ...], Segment, bool]] = []
         run: list[int] = []
+        done = seg.t0  # where the last window ends
         for k, i in enumerate([*moving, -1]):
             if i >= 0 and self._can_optimize(by[i]):
                 run.append(i)
                 continue
             if run:
                 first, last = moving.index(run[0]), moving.index(run[-1])
-                a = by[moving[first - 1]].t_end if first > 0 else seg.t0
-                b = by[moving[last + 1]].t0 if last + 1 < len(moving) else seg.t1
+                a, b = self._blend_window(seg, moving, first, last, done)
                 n = int(np.floor((b - a) / STEP + 1e-9))
                 if n >= 6:  # at least 0.15 s to reshape
                     out.append((tuple(run), Segment(tuple(run), a, a + n * STEP), True))
+                    done = a + n * STEP
             run = []
             del k
         return out
+
+    def _blend_window(
+        self, seg: Segment, moving: list[int], first: int, last: int, done: float
+    ) -> tuple[float, float]:
+        """The window (default-cycle times) of the run of joint moves ``moving[first..last]`` inside
+        a segment with a ``MoveL``: over the blends at its ends, from where the controller starts the
+        run's first move to where it ends its last, as far as the TCP there is within the zone of
+        the target the blend rounds (:meth:`_within_zone`); where it is not, or the window before
+        (ending at ``done``) reaches into the blend, from the blend's end and to its start, as
+        before. Its ends are the controller's states; between them only the run's own targets
+        bind, so the blends are reshaped with the run."""
+        by = self.by_index
+        run0, run1 = by[moving[first]], by[moving[last]]
+        if first == 0:
+            a = seg.t0
+        else:
+            prev = by[moving[first - 1]]
+            if done <= run0.t0:
+                a = self._within_zone(run0.t0, max(run0.t0, prev.t_end), prev, run0, earliest=True)
+            else:
+                a = max(prev.t_end, done)
+        if last + 1 == len(moving):
+            b = seg.t1
+        else:
+            nxt = by[moving[last + 1]]
+            b = self._within_zone(min(nxt.t0, run1.t_end), run1.t_end, run1, nxt, earliest=False)
+        return a, b
+
+    def _within_zone(
+        self, lo: float, hi: float, into: PlannedMove, out: PlannedMove, *, earliest: bool
+    ) -> float:
+        """The earliest (``earliest``: on the 2.5 ms grid from ``lo``) or the latest (from ``hi``) time
+        in ``[lo, hi]`` at which the taught TCP is within the zone of ``into``'s target (its radius
+        reduced to half of ``into``'s and ``out``'s TCP length, as for a chain's targets); where it
+        never is, the other end of the range (the blend then stays the controller's own)."""
+        if into.step.zone_mm is None:
+            return lo if earliest else hi
+        k = np.arange(int(np.floor(max(hi - lo, 0.0) / FINE_DT + 1e-9)) + 1, dtype=float)
+        t: FloatArray = lo + FINE_DT * k if earliest else hi - FINE_DT * k
+        inside = np.flatnonzero(self._tcp_within(t, into, out))
+        if inside.size == 0:
+            return hi if earliest else lo
+        return float(t[inside[0]])
+
+    def _tcp_within(self, t: FloatArray, into: PlannedMove, out: PlannedMove) -> FloatArray:
+        """Whether the taught TCP at times ``t`` is within the zone of ``into``'s target, its radius
+        reduced to half of ``into``'s and ``out``'s TCP length (as for a chain's targets)."""
+        step = into.step
+        assert step.robot is not None and step.tcp is not None and step.zone_mm is not None
+        R = min(step.zone_mm, 0.5 * into.path.length_mm, 0.5 * out.path.length_mm) / 1000.0
+        p, _ = _tcp(step.robot, evaluate_cycle(self.plan, t).q, step.tcp)
+        corner, _ = _tcp(step.robot, into.path.q1[None, :], step.tcp)
+        inside: FloatArray = np.linalg.norm(p - corner, axis=1) <= R + 1e-9
+        return inside
 
     def _before_solve(self) -> None:
         """Raise :class:`TimeBudgetSpent` once ``max_time_s`` is reached (no new solve starts)."""
@@ -849,6 +904,37 @@ class CycleOptimizer:
         )
         self.cache[key] = out
         return out
+
+    def to_stop(self, i: int, piece: Solved) -> Solved:
+        """The last move's ``piece`` of unit ``i`` (inside a ``MoveL`` segment, its run ending at a
+        stop) with the taught motion after its window, less than one 25 ms sample, to the stop: so
+        that it ends at its target, at rest (its energy with it)."""
+        win = self.segment_of[i]
+        m = self.by_index[self.chains[i][-1]]
+        if m.t_end - win.t1 <= 1e-9:
+            return piece
+        f = piece.fine
+        tail_t = np.append(np.arange(win.t1 + FINE_DT, m.t_end - 1e-9, FINE_DT), m.t_end)
+        tail = evaluate_cycle(self.plan, tail_t)
+        t = f.t[-1] + tail_t - win.t1
+        fine = Trajectory(
+            t=np.concatenate([f.t, t]),
+            q=np.vstack([f.q, tail.q]),
+            qd=np.vstack([f.qd, tail.qd]),
+            qdd=np.vstack([f.qdd, tail.qdd]),
+        )
+        sm = piece.samples
+        samples = Trajectory(
+            t=np.append(sm.t, t[-1]),
+            q=np.vstack([sm.q, tail.q[-1:]]),
+            qd=np.vstack([sm.qd, tail.qd[-1:]]),
+            qdd=np.vstack([sm.qdd, tail.qdd[-1:]]),
+        )
+        robot = self._robot(m)
+        e, e_lab = _window_energy(robot, self.plant(robot), fine, self.settings.energy)
+        return replace(
+            piece, duration=round(float(t[-1]), 9), energy_J=e, energy_lab_J=e_lab, samples=samples, fine=fine
+        )
 
     def zone_mm(self, j: int) -> float:
         """The zone (mm) the controller keeps at move ``j``'s target inside a chain: its zone radius,
@@ -1471,6 +1557,9 @@ class CycleOptimizer:
             for j in self.segment_of[i].moves:  # moves without motion inside the window
                 starts.setdefault(j, off)
             off += s.duration
+            for m in plan.moves:  # a move the window's blend starts (a MoveL after it): from its end
+                if a + 1e-12 < m.t0 < b - 1e-12:
+                    starts.setdefault(m.index, off)
         end = evaluate_cycle(plan, np.array([plan.cycle_time]))
         ts.append(np.array([off]))
         qs.append(end.q)
@@ -1877,6 +1966,9 @@ def _assemble(
             continue
         ok = ok and whole.usable
         pieces.update(opt.split(i, whole))
+        last = opt.chains[i][-1]
+        if i in opt.within and opt.by_index[last].stops:
+            pieces[last] = opt.to_stop(i, pieces[last])
         for j in opt.chains[i]:  # the unit's pieces as re-timed along their segment's path
             if j in retimed:
                 pieces[j] = replace(
