@@ -538,3 +538,46 @@ def test_rapid_follows_the_plan_before_its_paths_were_re_timed(blended, solved, 
     np.testing.assert_allclose(
         np.loadtxt(files["cycle_path.csv"], delimiter=",", skiprows=1)[:, 1:7], result.planned.q, atol=1e-8
     )
+
+
+TRANSFER = (
+    """MODULE Transfer
+"""
+    + TARGETS
+    + """    PROC main()
+        MoveJ pA, v1000, fine, tool0;
+        MoveL pAUp, v300, z20, tool0;
+        MoveAbsJ jHome, v1000, z50, tool0;
+        MoveJ pBUp, v1000, z20, tool0;
+        MoveL pB, v300, fine, tool0;
+    ENDPROC
+ENDMODULE
+"""
+)
+
+
+def test_pass_times_of_a_run_between_moveL_are_searched_never_to_its_loss(robot):
+    """A run of two joint moves between MoveL is one unit with an inner fly-by target. Its pass time
+    is searched by probes on wider knots; the result kept for the unit is a full solve, verified, as
+    good as the solve at the pass time it started from or better, and it passes the target within
+    its zone. Started 0.1 s off the taught pass time, the search finds a better one."""
+    spec = resolve_module(parse_module(TRANSFER, path="transfer.mod"), robot)
+    for shift in (0.0, 0.1):
+        opt = CycleOptimizer(spec, CycleSettings(gradient=FAST, pass_search=4))
+        (i,) = [u for u in opt.within if len(opt.chains[u]) == 2]
+        taught = opt._taught_passes(i)
+        opt._taught_passes = lambda *_, w=taught, d=shift: tuple((t + d, q) for t, q in w)  # type: ignore[method-assign]
+        units = int(round(opt.span[i] / 0.025))
+        T = units * 0.025
+        m = opt.by_index[i]
+        untuned = opt._solve_once(m, T, units, opt.settings.corridor_mm)
+        opt.tune_passes(i, T)
+        tuned = opt.cache[(i, units)]
+        assert tuned.usable
+        assert tuned.energy_J <= untuned.energy_J * (1 + 1e-12)
+        assert opt.zone_miss_mm(i, tuned) <= 1e-6
+        if shift:
+            assert i in opt.shares and tuned.energy_J < untuned.energy_J
+        if i in opt.shares:  # a better pass time was found: the kept result is solved at it
+            (t_pass,) = [t for t, _ in opt.waypoints(i, T)]
+            assert tuned.passes == (pytest.approx(t_pass),)
