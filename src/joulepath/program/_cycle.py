@@ -183,6 +183,12 @@ def _window_energy(robot: Robot, plant: Plant, traj: Trajectory, measure: str) -
     return float((p * w).sum()), float((p_lab * w).sum())
 
 
+def _reduced_zone_mm(zone_mm: float, into: PlannedMove, out: PlannedMove) -> float:
+    """The zone (mm) the controller keeps at ``into``'s target before ``out``: its radius, reduced to
+    half the TCP length of either move."""
+    return float(max(0.0, min(zone_mm, 0.5 * into.path.length_mm, 0.5 * out.path.length_mm)))
+
+
 def _hermite_path(
     t: FloatArray, q: FloatArray, qd: FloatArray, qdd: FloatArray
 ) -> Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]:
@@ -634,7 +640,7 @@ class CycleOptimizer:
         reduced to half of ``into``'s and ``out``'s TCP length (as for a chain's targets)."""
         step = into.step
         assert step.robot is not None and step.tcp is not None and step.zone_mm is not None
-        R = min(step.zone_mm, 0.5 * into.path.length_mm, 0.5 * out.path.length_mm) / 1000.0
+        R = _reduced_zone_mm(step.zone_mm, into, out) / 1000.0
         p, _ = _tcp(step.robot, evaluate_cycle(self.plan, t).q, step.tcp)
         corner, _ = _tcp(step.robot, into.path.q1[None, :], step.tcp)
         inside: FloatArray = np.linalg.norm(p - corner, axis=1) <= R + 1e-9
@@ -736,13 +742,12 @@ class CycleOptimizer:
         untuned = [t for t, _ in self.waypoints(i, units * STEP)]
         start = tuple(int(round(t / STEP)) for t in untuned)
         seen: dict[tuple[int, ...], Solved] = {}
-        if all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
-            seen[start] = first
         probe = replace(self.gradient, give_up=True, max_rounds=min(self.gradient.max_rounds, PROBE_ROUNDS))
         coarse = i in self.within  # probes on wider knots, compared among themselves; then one solve
         if coarse:
             probe = replace(probe, knot_spacing=max(probe.knot_spacing, ON_TAUGHT_KNOTS))
-            seen.clear()
+        elif all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
+            seen[start] = first
 
         def energy(edges: tuple[int, ...]) -> float:
             if not self._passes_reachable(i, edges, units):
@@ -889,14 +894,7 @@ class CycleOptimizer:
             robot, window, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=jmax
         )
         if win.span - n * STEP > 1e-9:  # the rest of the taught motion, to the stop
-            tail_t = np.append(np.arange(n * STEP + FINE_DT, win.span - 1e-9, FINE_DT), win.span)
-            tail = evaluate_cycle(self.plan, win.t0 + tail_t)
-            fine = Trajectory(
-                t=np.concatenate([window.t, tail_t]),
-                q=np.vstack([window.q, tail.q]),
-                qd=np.vstack([window.qd, tail.qd]),
-                qdd=np.vstack([window.qdd, tail.qdd]),
-            )
+            fine = self._taught_after(window, win.t0, win.span)
         else:
             fine = window
         e, e_lab = _window_energy(robot, self.plant(robot), fine, self.settings.energy)
@@ -932,26 +930,35 @@ class CycleOptimizer:
         if m.t_end - win.t1 <= 1e-9:
             return piece
         f = piece.fine
-        tail_t = np.append(np.arange(win.t1 + FINE_DT, m.t_end - 1e-9, FINE_DT), m.t_end)
-        tail = evaluate_cycle(self.plan, tail_t)
-        t = f.t[-1] + tail_t - win.t1
-        fine = Trajectory(
-            t=np.concatenate([f.t, t]),
-            q=np.vstack([f.q, tail.q]),
-            qd=np.vstack([f.qd, tail.qd]),
-            qdd=np.vstack([f.qdd, tail.qdd]),
-        )
+        fine = self._taught_after(f, win.t1 - f.t[-1], f.t[-1] + m.t_end - win.t1)
         sm = piece.samples
         samples = Trajectory(
-            t=np.append(sm.t, t[-1]),
-            q=np.vstack([sm.q, tail.q[-1:]]),
-            qd=np.vstack([sm.qd, tail.qd[-1:]]),
-            qdd=np.vstack([sm.qdd, tail.qdd[-1:]]),
+            t=np.append(sm.t, fine.t[-1]),
+            q=np.vstack([sm.q, fine.q[-1:]]),
+            qd=np.vstack([sm.qd, fine.qd[-1:]]),
+            qdd=np.vstack([sm.qdd, fine.qdd[-1:]]),
         )
         robot = self._robot(m)
         e, e_lab = _window_energy(robot, self.plant(robot), fine, self.settings.energy)
         return replace(
-            piece, duration=round(float(t[-1]), 9), energy_J=e, energy_lab_J=e_lab, samples=samples, fine=fine
+            piece,
+            duration=round(float(fine.t[-1]), 9),
+            energy_J=e,
+            energy_lab_J=e_lab,
+            samples=samples,
+            fine=fine,
+        )
+
+    def _taught_after(self, traj: Trajectory, origin: float, end: float) -> Trajectory:
+        """``traj`` (its times from ``origin`` in the default cycle) continued to ``end`` (from
+        ``origin`` too) with the taught motion, every 2.5 ms and at ``end``."""
+        tail_t = np.append(np.arange(traj.t[-1] + FINE_DT, end - 1e-9, FINE_DT), end)
+        tail = evaluate_cycle(self.plan, origin + tail_t)
+        return Trajectory(
+            t=np.concatenate([traj.t, tail_t]),
+            q=np.vstack([traj.q, tail.q]),
+            qd=np.vstack([traj.qd, tail.qd]),
+            qdd=np.vstack([traj.qdd, tail.qdd]),
         )
 
     def zone_mm(self, j: int) -> float:
@@ -964,8 +971,7 @@ class CycleOptimizer:
         z = self.by_index[j].step.zone_mm
         if z is None or k + 1 >= len(members):
             return 0.0
-        here, nxt = self.by_index[j].path, self.by_index[members[k + 1]].path
-        return float(max(0.0, min(z, 0.5 * here.length_mm, 0.5 * nxt.length_mm)))
+        return _reduced_zone_mm(z, self.by_index[j], self.by_index[members[k + 1]])
 
     def zone_radius(self, i: int) -> tuple[FloatArray, ...]:
         """Per inner target of chain ``i``, the joint box (rad, the same for every joint) whose
