@@ -71,7 +71,8 @@ ALLOWED = {
         "sim",
         "energy",
     },
-    "program": {"kinematics", "dynamics", "trajectory", "optimize", "sim", "energy", "export"},
+    "program": {"kinematics", "dynamics", "trajectory", "optimize", "sim", "energy", "export", "rapid"},
+    "rapid": set(),  # the language alone: grammar, tree, interpreter (kinematics come through a protocol)
     "measure": {"data", "energy"},  # a log and a run folder's files in, measure.json out
     "energy": set(),
     "units": set(),

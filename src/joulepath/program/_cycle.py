@@ -654,7 +654,8 @@ class CycleOptimizer:
 
     def _can_retime(self, m: PlannedMove) -> bool:
         return (
-            m.step.linear
+            not m.step.kept
+            and m.step.linear
             and self._once_or_streamed(m)
             and self.settings.retime_linear
             and self.default_clearance.get(m.index, np.inf) >= 0.0
@@ -662,7 +663,8 @@ class CycleOptimizer:
 
     def _can_optimize(self, m: PlannedMove) -> bool:
         return (
-            not m.step.linear
+            not m.step.kept
+            and not m.step.linear
             and self._once_or_streamed(m)
             and self.default_clearance.get(m.index, np.inf) >= 0.0
         )

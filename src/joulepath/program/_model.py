@@ -14,8 +14,9 @@ from joulepath.errors import InvalidInput
 from joulepath.sim._steps import SpeedData
 
 
-class RapidError(InvalidInput):
-    """A RAPID program joulepath cannot read: the message starts with ``file:line:``."""
+from joulepath.rapid import RapidError  # noqa: E402  (one definition: the RAPID language's)
+
+__all__ = ["RapidError"]
 
 
 @dataclass(frozen=True, slots=True)

@@ -12,13 +12,13 @@ are taken into account (targets are TCP poses, the load is carried in the dynami
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from joulepath._io import finite_number, load_toml
+from joulepath._io import finite_number, load_toml, read_capped
 from joulepath._typing import FloatArray
 from joulepath._work import check_work
 from joulepath.dynamics import Robot
@@ -43,7 +43,15 @@ from joulepath.program._model import (
     WObjData,
     ZoneData,
 )
-from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES, TOOL0, WOBJ0, read_module
+from joulepath.program._parse import (
+    MAX_MODULE_BYTES,
+    PREDEFINED_SPEEDS,
+    PREDEFINED_ZONES,
+    TOOL0,
+    WOBJ0,
+    parse_module,
+    read_module,
+)
 from joulepath.sim._steps import SpeedData, Step
 
 
@@ -51,8 +59,9 @@ from joulepath.sim._steps import SpeedData, Step
 class CycleSpec:
     """The cycle: its steps, where it starts (rad), and where it came from.
 
-    ``choices``: for each IF / TEST with moves inside, which branch the cycle runs and
-    why (e.g. ``"line 12: IF bDoubleGrip (FALSE) -> ELSE branch"``), in program order.
+    ``choices``: what the reader decided or assumed, a line each (a branch decided by the
+    scenario or assumed, an input read with no value given), in program order. ``kept``: the
+    moves kept as taught (their target, speed or branch known only at run time ...) and why.
     """
 
     steps: tuple[Step, ...]
@@ -62,6 +71,8 @@ class CycleSpec:
     fixed_lines: tuple[int, ...]
     robot: Robot
     choices: tuple[str, ...] = field(default=())
+    kept: tuple[tuple[str, str], ...] = field(default=())  # (move, why it runs as taught)
+    task: object | None = None  # the RAPID task's cycle (joulepath.program._task.TaskCycle)
 
 
 def tool_transform(tool: ToolData) -> FloatArray:
@@ -542,13 +553,21 @@ def check_moves_arm(spec: CycleSpec) -> None:
 
 
 def read_cycle_program(
-    path: str | Path,
+    path: str | Path | Sequence[str | Path],
     robot: Robot,
     *,
     idle_waits: Collection[int] = (),
     progress: Callable[[str], None] | None = None,
+    io: Mapping[str, float | str | bool] | None = None,
+    routine: str | None = None,
+    seed: int = 0,
 ) -> tuple[CycleSpec, bool]:
-    """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID module.
+    """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID task.
+
+    ``path``: a ``.toml`` cycle file, or a RAPID task: one module, several modules, or a folder
+    (the task's modules). The task is run by the RAPID interpreter
+    (:func:`joulepath.program._task.read_task_cycle`): ``io`` is the I/O scenario, ``routine``
+    the routine to run instead of ``main``, ``seed`` the seed of its random numbers.
 
     ``idle_waits``: lines of ``WaitTime`` instructions that are idle time (see
     :func:`resolve_module`); for a ``.toml`` file, numbers of ``wait_s`` steps. A module
@@ -557,20 +576,131 @@ def read_cycle_program(
     ``progress`` (optional) is told each move (or step) read once the cycle is within the
     moves limit.
     """
-    p = Path(path)
-    rapid = p.suffix.lower() != ".toml"
-    if rapid:
-        module = read_module(p)
-        from joulepath.program._parse import parse_module
-        from joulepath.program._rapid_write import restore_program
+    paths = [Path(path)] if isinstance(path, (str, Path)) else [Path(p) for p in path]
+    if not paths:
+        raise InvalidInput("no program given: name a RAPID module, a task's folder or a .toml cycle file")
+    if len(paths) == 1 and paths[0].suffix.lower() == ".toml":
+        return _read_toml_with_waits(paths[0], robot, idle_waits, progress), False
+    if any(p.suffix.lower() == ".toml" for p in paths):
+        raise InvalidInput(
+            f"{', '.join(map(str, paths))}: a .toml cycle file is a whole program on its own; give it alone"
+        )
+    from joulepath.program._task import read_task_cycle
 
-        original = restore_program("\n".join(module.source))
-        if original is not None:  # written by joulepath: optimize the program it was written from
-            module = parse_module(original, path=f"{p} (the program it was optimized from)")
-        return resolve_module(module, robot, idle_waits=idle_waits, progress=progress), True
+    restored = _restored(paths)
+    if restored is not None:
+        paths = [restored]
+    tc = read_task_cycle(paths, robot, io=io, routine=routine, seed=seed, progress=progress)
+    steps = _mark_idle(tc, idle_waits)
+    module = _static_view(tc, steps, robot, routine, io)
+    if module is not None:
+        steps = module[1]
+    moves = [st for st in steps if st.kind == "move"]
+    assert moves[-1].q is not None
+    source = tc.task.source if restored is None else f"{path} (the program it was optimized from)"
+    fixed = tuple(st.line for st in steps if st.kind == "fixed")
+    return (
+        CycleSpec(
+            steps,
+            moves[-1].q.copy(),
+            source,
+            None if module is None else module[0],
+            fixed,
+            robot,
+            tc.trace.notes,
+            kept=tc.kept,
+            task=tc,
+        ),
+        True,
+    )
+
+
+def _restored(paths: Sequence[Path]) -> Path | None:
+    """A module joulepath wrote, restored as the program it was written from (in a private temp file)."""
+    if len(paths) != 1 or not paths[0].is_file():
+        return None
+    from joulepath.program._rapid_write import restore_program
+    from joulepath.rapid._parse import decode
+
+    raw = read_capped(paths[0], max_bytes=MAX_MODULE_BYTES, what="a RAPID module", error=RapidError)
+    text, _, _ = decode(raw)
+    original = restore_program(text)
+    if original is None:
+        return None
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="joulepath-restored-"))
+    out = folder / paths[0].name
+    out.write_text(original, encoding="utf-8")
+    return out
+
+
+def _mark_idle(tc: object, idle_waits: Collection[int]) -> tuple[Step, ...]:
+    from joulepath.program._task import TaskCycle
+    from joulepath.rapid.interpreter import Wait
+
+    assert isinstance(tc, TaskCycle)
+    lines = set(idle_waits)
+    waits = {st.line for st in tc.steps if st.kind == "wait" and isinstance(st.statement, Wait) and not st.statement.io}
+    for line in sorted(lines):
+        if line not in waits:
+            raise RapidError(
+                f"{tc.task.source}:{line}: idle_waits names line {line}, which is not a WaitTime the cycle runs; "
+                "name the line of a WaitTime (or mark it '! joulepath: idle')"
+            )
+    out = []
+    for st in tc.steps:
+        if st.kind == "wait" and isinstance(st.statement, Wait) and not st.statement.io:
+            module = tc.task.module_of(st.statement.pos.file)
+            text = "" if module is None else module.text.split("\n")[st.line - 1]
+            marked = "joulepath: idle" in text.lower()
+            if marked or st.line in lines:
+                st = replace(st, idle=True)
+        out.append(st)
+    return tuple(out)
+
+
+def _static_view(
+    tc: object,
+    steps: tuple[Step, ...],
+    robot: Robot,
+    routine: str | None,
+    io: Mapping[str, float | str | bool] | None,
+) -> tuple[Module, tuple[Step, ...]] | None:
+    """The static module view the via-point RAPID writer edits, where the task is one module that the
+    static subset reader also reads to the same cycle (same statements, same targets to 1e-9 rad);
+    the steps then carry its statements. None otherwise (the task is written as EGM)."""
+    from joulepath.program._task import TaskCycle
+
+    assert isinstance(tc, TaskCycle)
+    if len(tc.task.modules) != 1 or routine is not None or io or tc.kept:
+        return None
+    m = tc.task.modules[0]
+    try:
+        module = parse_module(m.text, path=m.path)
+        old = resolve_module(module, robot)
+    except (RapidError, InvalidInput, AssertionError):
+        return None
+    if len(old.steps) != len(steps):
+        return None
+    out = []
+    for a, b in zip(old.steps, steps, strict=True):
+        if a.kind != b.kind or a.line != b.line:
+            return None
+        if a.kind == "move":
+            assert a.q is not None and b.q is not None
+            if np.abs(a.q - b.q).max() > 1e-9:
+                return None
+        out.append(replace(b, statement=a.statement))
+    return module, tuple(out)
+
+
+def _read_toml_with_waits(
+    p: Path, robot: Robot, idle_waits: Collection[int], progress: Callable[[str], None] | None
+) -> CycleSpec:
     spec = read_cycle_toml(p, robot, progress=progress)
     if not idle_waits:
-        return spec, False
+        return spec
     steps = list(spec.steps)
     for k in sorted(set(idle_waits)):
         if not 1 <= k <= len(steps) or steps[k - 1].kind != "wait":
@@ -578,4 +708,4 @@ def read_cycle_program(
                 f"{p}: idle_waits names step {k}, which is not a wait_s step; name a wait step"
             )
         steps[k - 1] = replace(steps[k - 1], idle=True)
-    return replace(spec, steps=tuple(steps)), False
+    return replace(spec, steps=tuple(steps))

@@ -32,6 +32,10 @@ class Step:
     (``MoveL``), the speed, ``\\T`` (s), the zone radius (mm; None: a stop point), the
     tool (TCP in m as a 4x4 flange-to-TCP transform) and the robot carrying its load.
     ``idle``: a wait the user declared idle time that an optimizer may spend on the moves.
+    ``kept``: why the move must run as taught (its target, speed or branch known only at run
+    time ...; empty: an optimizer may reshape it). ``circle_q``: a ``MoveC``'s circle point
+    (joint values, rad): the TCP moves on the circle through it. ``file``: the module the
+    statement stands in (a task has several).
     """
 
     kind: str
@@ -48,6 +52,9 @@ class Step:
     seconds: float = 0.0
     repeated: bool = False
     idle: bool = False
+    kept: tuple[str, ...] = ()
+    circle_q: FloatArray | None = None
+    file: str = ""
 
 
 class StepSequence(Protocol):

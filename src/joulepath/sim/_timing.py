@@ -175,13 +175,17 @@ def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:
     p1, r1 = _tcp(robot, q1, step.tcp)
     s = np.linspace(0.0, 1.0, LINE_POINTS)
     rots = _slerp(r0, r1, s)
+    points = p0 + s[:, None] * (p1 - p0)
+    if step.circle_q is not None:
+        pv, _ = _tcp(robot, step.circle_q, step.tcp)
+        points = arc_points(p0, pv, p1, s, f"{where}:{step.line}: {step.label}")
     inv_tcp = np.linalg.inv(step.tcp)
     lo, hi = robot.joint_ranges()
     qs = [q0]
     for k in range(1, LINE_POINTS):
         pose = np.eye(4)
         pose[:3, :3] = rots[k]
-        pose[:3, 3] = p0 + s[k] * (p1 - p0)
+        pose[:3, 3] = points[k]
         q = solve_ik(robot.chain, pose @ inv_tcp, None, lower=lo, upper=hi, near=qs[-1])
         if q is None or np.abs(q - qs[-1]).max() > 0.5:
             raise InvalidInput(
@@ -195,7 +199,36 @@ def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:
             "target's confdata; use MoveJ or fix the confdata"
         )
     spline = CubicSpline(s, np.stack(qs), axis=0)
-    return SegmentPath(q0, q1, spline, float(np.linalg.norm(p1 - p0)) * 1000.0, _angle_deg(r0, r1))
+    length = float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()) * 1000.0
+    return SegmentPath(q0, q1, spline, length, _angle_deg(r0, r1))
+
+
+def arc_points(p0: FloatArray, pv: FloatArray, p1: FloatArray, s: FloatArray, where: str) -> FloatArray:
+    """Points (m) at fractions ``s`` of the circular arc from ``p0`` through ``pv`` to ``p1`` (``MoveC``)."""
+    a, b = pv - p0, p1 - p0
+    normal = np.cross(a, b)
+    nn = float(normal @ normal)
+    if nn < 1e-14 or min(np.linalg.norm(a), np.linalg.norm(b), np.linalg.norm(p1 - pv)) < 1e-4:
+        raise InvalidInput(
+            f"{where}: the start, circle point and target lie on one line or too close (< 0.1 mm): no circle; "
+            "move the circle point"
+        )
+    center = p0 + (np.cross(normal, a) * float(b @ b) + np.cross(b, normal) * float(a @ a)) / (2.0 * nn)
+    u = p0 - center
+    radius = float(np.linalg.norm(u))
+    e1 = u / radius
+    e2 = np.cross(normal / np.sqrt(nn), e1)
+
+    def angle(p: FloatArray) -> float:
+        d = p - center
+        return float(np.arctan2(d @ e2, d @ e1)) % (2 * np.pi)
+
+    total = angle(p1)
+    if angle(pv) > total:  # the circle point lies past the target the short way: go the long way
+        total -= 2 * np.pi
+    th = s * total
+    out: FloatArray = center + radius * (np.cos(th)[:, None] * e1 + np.sin(th)[:, None] * e2)
+    return out
 
 
 def fastest_profile(step: Step, path: SegmentPath, config: ControllerConfig) -> Profile:

@@ -1,0 +1,203 @@
+"""From a RAPID task to the cycle the optimizer and the controller emulation run.
+
+The interpreter (:mod:`joulepath.rapid.interpreter`) runs the task's program on the
+robot's kinematics and gives one cycle's events; here each becomes a
+:class:`~joulepath.sim._steps.Step`: a move with its joint target (rad), its path kind
+(``MoveL`` and ``MoveC`` move the TCP on a line or circle), speed, ``\\T``, zone, tool
+(TCP and load, ``GripLoad`` included) and the motion settings in force; a wait; or an
+instruction kept as written. A move the interpreter marked (its target, speed, zone or
+branch known only at run time, a process instruction, ``\\Conc``) is kept as taught,
+with its reasons in ``Step.kept``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath._work import check_work
+from joulepath.dynamics import Robot
+from joulepath.errors import InvalidInput
+from joulepath.kinematics._ik import check_layout, confdata, solve_ik
+from joulepath.rapid import RapidError
+from joulepath.rapid import _geometry as geo
+from joulepath.rapid.interpreter import Action, Interpreter, Motion, Trace, Wait
+from joulepath.rapid.task import Task, load_task
+from joulepath.rapid.values import Record, num, pos_values
+from joulepath.sim._steps import SpeedData, Step
+
+RAPID_AXES = 6
+
+
+class RobotKinematics:
+    """:class:`joulepath.rapid.interpreter.Kinematics` of a robot: closed-form IK, FK of the flange."""
+
+    def __init__(self, robot: Robot) -> None:
+        self.robot = robot
+        self.lo, self.hi = robot.joint_ranges()
+
+    def joints(
+        self, flange: FloatArray, conf: tuple[int, int, int, int] | None, near: FloatArray | None
+    ) -> FloatArray | None:
+        if conf is not None:
+            return solve_ik(self.robot.chain, flange, conf, lower=self.lo, upper=self.hi)
+        start = near if near is not None else np.zeros(self.robot.n_joints)
+        return solve_ik(self.robot.chain, flange, None, lower=self.lo, upper=self.hi, near=start)
+
+    def flange(self, q: FloatArray) -> FloatArray:
+        pose = self.robot.fk(q)
+        out = np.eye(4)
+        out[:3, :3] = pose.rotation
+        out[:3, 3] = pose.position_m
+        return out
+
+    def confdata(self, q: FloatArray) -> tuple[int, int, int, int]:
+        c = confdata(self.robot.chain, q)
+        return (int(c[0]), int(c[1]), int(c[2]), int(c[3]))
+
+    def in_range(self, q: FloatArray) -> int | None:
+        bad = np.nonzero((q < self.lo - 1e-9) | (q > self.hi + 1e-9))[0]
+        return int(bad[0]) if bad.size else None
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class TaskCycle:
+    """A task's cycle: the steps, the trace they came from, and what was kept or assumed."""
+
+    task: Task
+    trace: Trace
+    steps: tuple[Step, ...]
+    kept: tuple[tuple[str, str], ...] = field(default=())  # (move "file:line instruction", reason)
+
+
+def tool_transform(tool: Record) -> FloatArray:
+    """Flange to TCP (m) of a ``tooldata``."""
+    tframe = tool.get("tframe")
+    assert isinstance(tframe, Record)
+    return geo.pose_matrix(tframe)
+
+
+def _load(rec: object) -> tuple[float, FloatArray]:
+    assert isinstance(rec, Record)
+    return float(num(rec.get("mass"))), np.asarray(pos_values(rec.get("cog"))) / 1000.0
+
+
+def _robot_for(robot: Robot, m: Motion, cache: dict[tuple[float, ...], Robot]) -> Robot:
+    """The robot carrying the tool's load and the ``GripLoad`` in force (their centre of mass combined)."""
+    mass, cog = _load(m.tool.get("tload")) if bool(m.tool.get("robhold")) else (0.0, np.zeros(3))
+    if m.settings.grip_load is not None:
+        gm, gc = _load(m.settings.grip_load)
+        if gm > 0:
+            tcp = tool_transform(m.tool) if bool(m.tool.get("robhold")) else np.eye(4)
+            gc_flange = tcp[:3, :3] @ gc + tcp[:3, 3]
+            cog = (mass * cog + gm * gc_flange) / (mass + gm)
+            mass += gm
+    key = (round(mass, 9), *(round(float(v), 9) for v in cog))
+    if key not in cache:
+        try:
+            cache[key] = robot.with_payload(mass, com=cog, what="the tool's load") if mass > 0 else robot
+        except InvalidInput as err:
+            raise RapidError(f"{m.pos}: {err}") from err
+    return cache[key]
+
+
+def _speed(rec: Record) -> SpeedData:
+    return SpeedData(*(float(num(v)) for v in rec.values))
+
+
+def steps_of(trace: Trace, robot: Robot) -> tuple[tuple[Step, ...], tuple[tuple[str, str], ...]]:
+    """The cycle's steps from a trace run on ``robot``'s kinematics, and the kept moves with a reason."""
+    cycle = trace.cycle
+    counts: dict[tuple[str, int], int] = {}
+    for e in cycle:
+        key = (e.pos.file, e.pos.start)
+        counts[key] = counts.get(key, 0) + 1
+    robots: dict[tuple[float, ...], Robot] = {}
+    steps: list[Step] = []
+    kept: list[tuple[str, str]] = []
+    for e in cycle:
+        if isinstance(e, Motion):
+            assert e.joints is not None
+            label = f"{e.instruction} {e.target_text}"
+            tcp = tool_transform(e.tool) if bool(e.tool.get("robhold")) else np.eye(4)
+            zone_mm = None if e.fine else e.zone_mm
+            reasons = tuple(sorted(e.kept))
+            if reasons:
+                kept.append((f"{e.pos} {label}", reasons[0]))
+            steps.append(
+                Step(
+                    "move",
+                    e.pos.line,
+                    label,
+                    e,
+                    q=e.joints.copy(),
+                    linear=e.kind in ("linear", "circular"),
+                    speed=_speed(e.speed),
+                    time_s=e.time_s,
+                    zone_mm=zone_mm,
+                    tcp=tcp,
+                    robot=_robot_for(robot, e, robots),
+                    repeated=counts[(e.pos.file, e.pos.start)] > 1,
+                    kept=reasons,
+                    circle_q=None if e.circle_joints is None else e.circle_joints.copy(),
+                    file=e.pos.file,
+                )
+            )
+        elif isinstance(e, Wait):
+            text = e.stmt.name + (" \\InPos" if e.inpos else "") + (f" {e.seconds:g}" if not e.io else "")
+            steps.append(Step("wait", e.pos.line, text, e, seconds=e.seconds, file=e.pos.file))
+        elif isinstance(e, Action):
+            steps.append(Step("fixed", e.pos.line, e.name, e, file=e.pos.file))
+    return tuple(steps), tuple(kept)
+
+
+def read_task_cycle(
+    paths: Sequence[str | Path],
+    robot: Robot,
+    *,
+    io: Mapping[str, float | str | bool] | None = None,
+    routine: str | None = None,
+    seed: int = 0,
+    progress: Callable[[str], None] | None = None,
+) -> TaskCycle:
+    """Run a task's program (modules and folders) on ``robot`` and give its cycle's steps.
+
+    ``io``: the scenario (values of inputs and run-time data by name). ``routine``: the routine
+    to run instead of ``main``. :class:`RapidError` (one line) for what the issue's refusals
+    name: text that is not RAPID, a name declared nowhere, no ``main`` and no routine, an
+    unreachable target, a program that never finishes its cycle.
+    """
+    if robot.n_joints != RAPID_AXES:
+        raise RapidError(
+            f"{', '.join(map(str, paths))}: a RAPID program drives a {RAPID_AXES}-axis ABB arm, but this robot "
+            f"has {robot.n_joints} joints; give a {RAPID_AXES}-joint robot, or write the cycle as a plain cycle "
+            "file (.toml)"
+        )
+    try:
+        check_layout(robot.chain)
+    except InvalidInput as err:
+        raise RapidError(f"{', '.join(map(str, paths))}: {err}") from err
+    task = load_task(paths)
+    interp = Interpreter(task, io=io, seed=seed, kinematics=RobotKinematics(robot), progress=progress)
+    trace = interp.run(routine)
+    moves = [e for e in trace.cycle if isinstance(e, Motion)]
+    if not moves:
+        where = f"{trace.loop}" if trace.loop is not None else task.source
+        raise RapidError(f"{where}: the cycle ({trace.routine}) holds no move; nothing to optimize")
+    check_work(
+        "moves",
+        len(moves),
+        task.source,
+        "the cycle (calls and loops run) has that many moves; split it into shorter programs",
+    )
+    steps, kept = steps_of(trace, robot)
+    unused = sorted(set(k.lower() for k in (io or {})) - interp.io_used)
+    notes = list(trace.notes)
+    for k in unused:
+        notes.append(f"--io {k}: the cycle never read it")
+    trace = Trace(trace.events, trace.cycle_start, trace.cycle_end, tuple(notes), trace.routine, trace.loop, trace.steps)
+    return TaskCycle(task, trace, steps, kept)
