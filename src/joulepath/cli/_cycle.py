@@ -26,8 +26,46 @@ def _cycle_time(text: str) -> float | None:
     return value
 
 
+def _scenario(pairs: list[str], path: Path | None) -> dict[str, float | str | bool]:
+    """The I/O scenario: ``--scenario`` file values, then ``--io NAME=VALUE`` pairs over them."""
+    out: dict[str, float | str | bool] = {}
+    if path is not None:
+        from joulepath._io import load_toml
+
+        data = load_toml(path, max_bytes=1 << 20, what="an I/O scenario (TOML)")
+        table = data.get("io", data)
+        if not isinstance(table, dict):
+            raise typer.BadParameter(f"{path}: [io] must be a table of NAME = VALUE", param_hint="--scenario")
+        for k, v in table.items():
+            if not isinstance(v, (int, float, str, bool)):
+                raise typer.BadParameter(
+                    f"{path}: {k} = {v!r}: give a number, a string or a bool", param_hint="--scenario"
+                )
+            out[str(k)] = float(v) if isinstance(v, int) and not isinstance(v, bool) else v
+    for pair in pairs:
+        name, sep, value = pair.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise typer.BadParameter(f"{pair!r}: give NAME=VALUE, e.g. diPartReady=1", param_hint="--io")
+        text = value.strip()
+        parsed: float | str | bool
+        if text.upper() in ("TRUE", "FALSE"):
+            parsed = text.upper() == "TRUE"
+        else:
+            try:
+                parsed = float(text)
+            except ValueError:
+                parsed = text.strip('"')
+        out[name.strip()] = parsed
+    return out
+
+
 def cycle(
-    program: Path = typer.Argument(..., help="RAPID module (.mod) or plain cycle file (.toml)."),
+    program: list[Path] = typer.Argument(
+        ...,
+        help="The program: a RAPID task (one module, several modules such as main.mod user.sys, or a "
+        "folder of a task's modules, e.g. a backup's RAPID/TASK1; an EIO.cfg names the I/O signals), or a "
+        "plain cycle file (.toml).",
+    ),
     robot: str = typer.Option("irb120", help="Robot name or .irml/.urdf path."),
     out: Path = typer.Option(..., "--out", help="Run folder."),
     cycle_time: str = typer.Option("same", "--cycle-time", help="'same' (the default program's) or seconds."),
@@ -114,6 +152,18 @@ def cycle(
         help="Energy measure to minimize: thesis, mechanical or electrical (needs the robot's drive data); "
         "every measure the robot has the data for is reported, electrical with the standby over the cycle.",
     ),
+    io: list[str] = typer.Option(
+        [],
+        "--io",
+        help="NAME=VALUE: what the program reads while it runs (an input signal, a variable a socket or "
+        "the operator fills); repeatable. Moves decided by what is not given are kept as taught.",
+    ),
+    scenario: Path = typer.Option(
+        None, "--scenario", help="TOML file of NAME = VALUE pairs (an [io] table or top-level keys): as --io."
+    ),
+    routine: str = typer.Option(
+        None, "--routine", help="Run this routine instead of main (a library of paths, or one routine)."
+    ),
     unchecked: bool = unchecked_option(),
 ) -> int:
     """Optimize a program's cycle for energy at the same (or a given) cycle time; verify; write RAPID.
@@ -136,9 +186,11 @@ def cycle(
     target = _cycle_time(cycle_time)
     if export not in ("auto", "rapid", "egm"):
         raise typer.BadParameter(f"{export!r}: give auto, rapid or egm", param_hint="--export")
-    check_out_folder(out, files=CYCLE_FILES, inputs=[program, *([cell] if cell else [])])
-    if not program.exists():  # anything else but a regular file is refused by name when read
-        raise typer.BadParameter(f"{program}: no such file", param_hint="PROGRAM")
+    check_out_folder(out, files=CYCLE_FILES, inputs=[*program, *([cell] if cell else [])])
+    for p in program:
+        if not p.exists():  # anything else but a regular file or folder is refused by name when read
+            raise typer.BadParameter(f"{p}: no such file or folder", param_hint="PROGRAM")
+    scenario_values = _scenario(io, scenario)
     r = load_robot_for_cli(robot, unchecked=unchecked)
     check_measure(energy, r.drivetrain)  # one line saying what to provide
     from joulepath.program._cell import read_cell
@@ -159,7 +211,9 @@ def cycle(
     if jerk_time is not None:  # else the controller's default (CycleSettings')
         settings = replace(settings, jerk_time=jerk_time)
     with progress_lines("optimizing the cycle...") as say:  # on stderr only: stdout keeps the results
-        spec, rapid = read_cycle_program(program, r, idle_waits=idle_wait, progress=say)
+        spec, rapid = read_cycle_program(
+            program, r, idle_waits=idle_wait, progress=say, io=scenario_values, routine=routine, seed=seed
+        )
         cell_data = read_cell(cell, progress=say) if cell is not None else None
         result, opt = optimize_cycle(spec, replace(settings, cell=cell_data), progress=say)
         front = None
@@ -251,7 +305,15 @@ def cycle(
         f"breakdown: shape {b.by_shape_pct:.1f} %, time allocation {b.by_allocation_pct:.1f} %{waits}{along}"
     )
     for choice in spec.choices:
-        console.print(f"read: {choice}")
+        console.print(f"read: {choice}", markup=False)
+    if spec.kept:
+        console.print(
+            f"kept as taught: {len(spec.kept)} of {sum(st.kind == 'move' for st in spec.steps)} moves "
+            f"(their motion is known only at run time); {saved['open_to_optimization_pct']:.1f} % of the "
+            "cycle's motion energy was open to optimization"
+        )
+        for move, why in spec.kept:
+            console.print(f"  {move}: {why}", markup=False)
     if result.timed_out:
         console.print("--max-time reached: the best verified result of the moves solved by then")
     if cell_data is not None:

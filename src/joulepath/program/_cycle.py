@@ -2080,6 +2080,8 @@ def _assemble(
             note = "no motion"
         elif opt.default_clearance.get(m.index, np.inf) < 0.0:
             note = "the default move comes closer to the cell than the margin: reported, not optimized"
+        elif m.step.kept:
+            note = "kept as taught: " + m.step.kept[0]
         elif m.step.repeated:
             note = "occurs more than once in the cycle: kept as taught"
         elif any(opt.by_index[j].step.linear for j in _segment_with(opt, m.index).moves):

@@ -121,15 +121,14 @@ def check_written(result: CycleResult, text: str, cell: Cell | None = None) -> d
     from scipy.spatial import cKDTree
 
     from joulepath.program._cycle import _energy
-    from joulepath.program._parse import parse_module
-    from joulepath.program._resolve import resolve_module
+    from joulepath.program._task import as_sequence, read_written
     from joulepath.sim import ControllerConfig, make_plant
     from joulepath.sim._timing import FINE_DT, _tcp, evaluate_cycle, plan_cycle
 
     spec = result.spec
     config = ControllerConfig()
-    written = parse_module(text, path=f"{spec.source} (optimized)")
-    plan = plan_cycle(resolve_module(written, spec.robot), config)
+    written = read_written(text, f"{spec.source} (optimized)", spec.robot)
+    plan = plan_cycle(as_sequence(written), config)
     n = int(np.ceil(plan.cycle_time / FINE_DT)) + 1
     traj = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
     first = plan.moves[0].step
@@ -245,6 +244,12 @@ def cycle_json(
         "source": result.spec.source,
         "robot": result.spec.robot.name,
         "choices": list(result.spec.choices),
+        "read_notes": list(result.spec.choices),
+        "kept_moves": [{"move": m, "why": why} for m, why in result.spec.kept],
+        "open_to_optimization_pct": _open_share(result),
+        "open_to_optimization_note": "share of the taught cycle's motion energy (energy_default_J) in moves "
+        "the optimizer may change: every move but those kept as taught (kept_moves: their target, speed, "
+        "zone or branch is known only at run time, a process instruction, \\Conc)",
         "taught_units": list(result.taught_units),
         "timed_out": result.timed_out,
         "zone_miss_mm": result.zone_miss_mm,
@@ -304,6 +309,14 @@ def cycle_json(
         "rapid": rapid,
         "rapid_refused": refused,
     }
+
+
+def _open_share(result: CycleResult) -> float:
+    """% of the taught cycle's motion energy in moves not kept as taught."""
+    moves = [st for st in result.spec.steps if st.kind == "move"]
+    total = sum(m.default_energy_J for m in result.moves)
+    closed = sum(m.default_energy_J for m, st in zip(result.moves, moves, strict=True) if st.kept)
+    return 100.0 * (1.0 - closed / total) if total > 0 else 100.0
 
 
 def optimized_cycle_csv(result: CycleResult) -> str:
@@ -369,11 +382,10 @@ def pareto_plot(points: list[ParetoPoint], default: tuple[float, float, float], 
 def reads_back(result: CycleResult, text: str) -> str | None:
     """None when the written module, parsed and resolved again, runs the motion it was written
     for (:func:`joulepath.program._rapid_write.planned_model`); else what differs."""
-    from joulepath.program._parse import parse_module
-    from joulepath.program._resolve import resolve_module
+    from joulepath.program._task import read_written
 
     spec = result.spec
-    again = resolve_module(parse_module(text, path=f"{spec.source} (optimized)"), spec.robot)
+    again = read_written(text, f"{spec.source} (optimized)", spec.robot)
     return same_model(motion_model(again), planned_model(result))
 
 
@@ -439,6 +451,13 @@ def write_cycle_run(
     files: dict[str, Path] = {}
     text = refused = check = layout = None
     follows = None
+    if write_rapid and result.spec.module is None:
+        refused = (
+            "the via-point RAPID writer edits a program of one module whose cycle is fully known "
+            "(this one spans several modules, runs a routine other than main, reads a scenario or keeps "
+            "moves as taught); the planned cycle is written for EGM instead"
+        )
+        write_rapid = False
     if write_rapid:
         plans = [
             (

@@ -201,3 +201,30 @@ def read_task_cycle(
         notes.append(f"--io {k}: the cycle never read it")
     trace = Trace(trace.events, trace.cycle_start, trace.cycle_end, tuple(notes), trace.routine, trace.loop, trace.steps)
     return TaskCycle(task, trace, steps, kept)
+
+
+def read_written(text: str, source: str, robot: Robot) -> TaskCycle:
+    """A module joulepath wrote (its text), run by the interpreter as the controller would run it."""
+    from joulepath.rapid import parse_module
+
+    module = parse_module(text.replace("\r\n", "\n"), path=source)
+    task = Task((module,), frozenset(), source)
+    trace = Interpreter(task, kinematics=RobotKinematics(robot)).run(None)
+    steps, kept = steps_of(trace, robot)
+    return TaskCycle(task, trace, steps, kept)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class StepsView:
+    """Steps from a start configuration (:class:`joulepath.sim._steps.StepSequence`)."""
+
+    steps: tuple[Step, ...]
+    start: FloatArray
+    source: str
+
+
+def as_sequence(tc: TaskCycle) -> StepsView:
+    """A task's cycle as what :func:`joulepath.sim.plan_cycle` runs (it starts where it ends)."""
+    moves = [st for st in tc.steps if st.kind == "move"]
+    assert moves and moves[-1].q is not None
+    return StepsView(tc.steps, moves[-1].q.copy(), tc.task.source)

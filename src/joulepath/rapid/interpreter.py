@@ -30,6 +30,7 @@ such a loop the cycle is one run of the routine. ``TRAP`` routines and ``ERROR``
 from __future__ import annotations
 
 import math
+import sys
 import time
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
@@ -67,7 +68,7 @@ MAX_STEPS = 2_000_000
 """Statements and expression calls one run may take before it is stopped as never ending."""
 MAX_SECONDS = 60.0
 """Wall time one run may take (s)."""
-MAX_DEPTH = 256
+MAX_DEPTH = 100
 """Deepest routine call (recursion) one run may take."""
 MAX_LOOP_TURNS = 200_000
 """Turns one loop may take."""
@@ -594,7 +595,7 @@ class Interpreter:
             self.notes.append(text)
 
     def _context(self) -> tuple[str, ...]:
-        out = [f"{f.label}" for f in self.stack[1:]]
+        out = [f"{f.label}" for f in self.stack[2:]]
         return tuple(out + self.loops)
 
     # ---- names
@@ -820,13 +821,24 @@ class Interpreter:
         raise RapidError(f"{e.pos}: this expression cannot be assigned to; assign to a variable")
 
     # ---- functions
-    def _args(self, args: tuple[n.Arg, ...]) -> tuple[list[tuple[Value, Taint]], dict[str, tuple[Value, Taint]]]:
+    def ev_raw(self, e: n.Expr) -> tuple[Value, Taint]:
+        """As :meth:`ev`, but a signal named is the signal, not its value (``SetDO do1, 1``)."""
+        if isinstance(e, (n.Name, n.Index, n.Field)):
+            ref = self.ref(e)
+            value = ref.get() if isinstance(ref, _Ref) else ref.value
+            if isinstance(value, Signal):
+                return value, CLEAN
+        return self.ev(e)
+
+    def _args(
+        self, args: tuple[n.Arg, ...], *, raw_first: bool = False
+    ) -> tuple[list[tuple[Value, Taint]], dict[str, tuple[Value, Taint]]]:
         pos: list[tuple[Value, Taint]] = []
         opt: dict[str, tuple[Value, Taint]] = {}
         for a in args:
             if a.kind == "pos":
                 assert a.value is not None
-                pos.append(self.ev(a.value))
+                pos.append(self.ev_raw(a.value) if raw_first and not pos else self.ev(a.value))
             else:
                 assert a.name is not None
                 opt[a.name.lower()] = self.ev(a.value) if a.value is not None else (True, CLEAN)
@@ -857,7 +869,7 @@ class Interpreter:
             if not 1 <= k <= len(arr.dims):
                 raise RapidError(f"{e.pos}: Dim asks for dimension {k} of an array of {len(arr.dims)}")
             return float(arr.dims[k - 1]), t
-        pos, opt = self._args(e.args)
+        pos, opt = self._args(e.args, raw_first=key in _SIGNAL_FUNCS)
         taint = CLEAN
         for _, t in pos:
             taint |= t
@@ -1388,7 +1400,7 @@ class Interpreter:
             self.io_wait(s, key, ctx)
             return
         if key in IO_SETTERS:
-            args, _ = self._args(s.args)
+            args, _ = self._args(s.args, raw_first=True)
             if args and isinstance(args[0][0], Signal):
                 sig = args[0][0]
                 value: Value = 1.0 if key in ("set", "pulsedo") else 0.0 if key == "reset" else (
@@ -1462,6 +1474,7 @@ class Interpreter:
             known = not t
             met = cond is True
         else:
+            args, opt = self._args(s.args, raw_first=True)
             sig, t0 = args[0]
             v, t1 = self.read_signal(sig, s.pos) if isinstance(sig, Signal) else (sig, CLEAN)
             want = args[1][0] if len(args) > 1 else 1.0
@@ -1551,6 +1564,7 @@ class Interpreter:
         else:
             kind = "joint"
         taint = self.ctx_taint | self.after_branch
+        start_taint = self.current_taint  # the move starts where the last one ended
         self.after_branch = CLEAN
         targets: list[tuple[Record, Taint, str]] = []
         speed = zone = tool = None
@@ -1612,7 +1626,7 @@ class Interpreter:
         assert isinstance(wobj, Record)
         circle = targets[0][0] if kind == "circular" else None
         target, target_t, target_text = targets[-1]
-        kept = set(taint | target_t | speed_t | zone_t | tool_t | wobj_t)
+        kept = set(taint | start_taint | target_t | speed_t | zone_t | tool_t | wobj_t)
         if circle is not None:
             kept |= targets[0][1]
         if key in PROCESS_LINEAR or key in PROCESS_CIRCULAR:
@@ -1669,7 +1683,7 @@ class Interpreter:
         self.events.append(m)
         if joints is not None:
             self.current_q = joints
-        self.current_taint = target_t | taint
+        self.current_taint = target_t | self.ctx_taint | wobj_t | tool_t
         if self.progress is not None and len(self.events) % 50 == 0:
             self.progress(f"reading the program: {self._moves()} moves")
 
@@ -1704,6 +1718,8 @@ class Interpreter:
                     f"--io {k}: the program reads no signal or data of that name; give a name the program uses"
                 )
         self.stack = [_Frame(None, m, {}, set(), m.name)]
+        limit = sys.getrecursionlimit()
+        sys.setrecursionlimit(max(limit, 20 * MAX_DEPTH + 2000))
         try:
             self.invoke(r, m, (), r.pos)
         except _Stop as stop:
@@ -1713,6 +1729,8 @@ class Interpreter:
             raise RapidError(f"{g.pos}: GOTO {g.label}: no such label in the routine; add the label") from None
         except _Return:
             pass
+        finally:
+            sys.setrecursionlimit(limit)
         end = self.cycle_end if self.cycle_end is not None else len(self.events)
         return Trace(tuple(self.events), self.cycle_start, end, tuple(self.notes), r.name, self.loop, self.steps)
 

@@ -1,0 +1,246 @@
+"""The interpreter on trees: RAPID's semantics, the known/unknown marking, the bounds, the refusals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from joulepath.rapid import RapidError, parse_module
+from joulepath.rapid.interpreter import Action, Interpreter, Motion, Wait
+from joulepath.rapid.task import Task
+from joulepath.rapid.values import Array, Record
+
+HEAD = """MODULE T
+  CONST robtarget p10 := [[400,0,300],[0,0,1,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  PERS tooldata tG := [TRUE,[[0,0,100],[1,0,0,0]],[1,[0,0,50],[1,0,0,0],0,0,0]];
+"""
+
+
+def run(body: str, *, decl: str = "", extra: str = "", io=None, routine=None, modules=()):
+    text = HEAD + decl + "  PROC main()\n" + body + "\n  ENDPROC\n" + extra + "ENDMODULE\n"
+    m = parse_module(text, path="t.mod")
+    task = Task((m, *modules), frozenset(), "t.mod")
+    interp = Interpreter(task, io=io)
+    return interp, interp.run(routine)
+
+
+def value(interp: Interpreter, name: str):
+    return interp.lookup(name, interp.task.modules[0].pos).value  # type: ignore[union-attr]
+
+
+def test_arithmetic_strings_and_precedence():
+    interp, _ = run(
+        "    x := 1 + 2 * 3 - -4 / 2;\n    y := 17 DIV 5 + 17 MOD 5;\n    s := \"a\" + NumToStr(2.5, 1);\n"
+        "    b := 1 < 2 AND NOT (3 <= 2) OR FALSE;\n    r := Round(2.345\\Dec:=2) + Trunc(-1.7);",
+        decl="  VAR num x; VAR num y; VAR string s; VAR bool b; VAR num r;\n",
+    )
+    assert value(interp, "x") == 9.0
+    assert value(interp, "y") == 3.0 + 2.0
+    assert value(interp, "s") == "a2.5"
+    assert value(interp, "b") is True
+    assert value(interp, "r") == pytest.approx(2.35 - 1.0)
+
+
+def test_records_arrays_and_user_record_types():
+    interp, _ = run(
+        "    parts{2}.w := 4;\n    parts{1} := [1, p10];\n    grid{2,3} := grid{1,1} + 10;\n"
+        "    q := p10;\n    q.trans.z := q.trans.z + 50;",
+        decl="  VAR part parts{2};\n  VAR num grid{2,3} := [[1,2,3],[4,5,6]];\n  VAR robtarget q;\n",
+        extra="  RECORD part\n    num w;\n    robtarget p;\n  ENDRECORD\n",
+    )
+    parts = value(interp, "parts")
+    assert isinstance(parts, Array) and parts.dims == (2,)
+    assert parts.items[1].get("w") == 4.0 and parts.items[0].get("w") == 1.0
+    assert value(interp, "grid").items == (1.0, 2.0, 3.0, 4.0, 5.0, 11.0)
+    q = value(interp, "q")
+    assert isinstance(q, Record) and q.get("trans").get("z") == 350.0
+    # the constant itself is untouched: values, not references
+    assert value(interp, "p10").get("trans").get("z") == 300.0
+
+
+def test_loops_test_goto_compact_if_and_incr():
+    interp, _ = run(
+        "    FOR i FROM 1 TO 4 DO\n      n := n + i;\n    ENDFOR\n"
+        "    FOR i FROM 10 TO 1 STEP -3 DO\n      Incr m;\n    ENDFOR\n"
+        "    WHILE k < 5 DO\n      k := k + 2;\n    ENDWHILE\n"
+        "    TEST k\n    CASE 1, 6:\n      c := 1;\n    DEFAULT:\n      c := 2;\n    ENDTEST\n"
+        "    IF k > 5 c := c + 10;\n"
+        "    again:\n    Decr k;\n    IF k > 0 GOTO again;",
+        decl="  VAR num n; VAR num m; VAR num k; VAR num c;\n",
+    )
+    assert value(interp, "n") == 10.0
+    assert value(interp, "m") == 4.0  # 10, 7, 4, 1
+    assert value(interp, "c") == 11.0
+    assert value(interp, "k") == 0.0
+
+
+def test_routines_by_value_by_reference_optional_and_recursion():
+    interp, _ = run(
+        "    Bump n, 5;\n    Bump n, 5 \\Twice;\n    Stack 4, depth;\n    f := Half(9);",
+        decl="  VAR num n; VAR num depth; VAR num f;\n",
+        extra=(
+            "  PROC Bump(INOUT num x, num by \\switch Twice)\n    x := x + by;\n"
+            "    IF Present(Twice) x := x + by;\n    by := 0;\n  ENDPROC\n"
+            "  PROC Stack(num k, VAR num d)\n    IF k > 0 THEN\n      d := d + 1;\n      Stack k - 1, d;\n"
+            "    ENDIF\n  ENDPROC\n"
+            "  FUNC num Half(num v)\n    RETURN v / 2;\n  ENDFUNC\n"
+        ),
+    )
+    assert value(interp, "n") == 15.0
+    assert value(interp, "depth") == 4.0
+    assert value(interp, "f") == 4.5
+
+
+def test_offs_and_reltool_agree_with_an_independent_rotation():
+    interp, trace = run(
+        "    a := Offs(p10, 10, -20, 30);\n    b := RelTool(p10, 5, 6, 7 \\Rx:=10 \\Ry:=-20 \\Rz:=30);",
+        decl="  VAR robtarget a; VAR robtarget b;\n",
+    )
+    a, b = value(interp, "a"), value(interp, "b")
+    assert [a.get("trans").get(k) for k in "xyz"] == [410.0, -20.0, 330.0]
+    rot = Rotation.from_quat([0, 1, 0, 0])  # p10's orient [0,0,1,0] is (w,x,y,z): a half turn about y
+    shift = rot.apply([5.0, 6.0, 7.0])
+    assert [b.get("trans").get(k) for k in "xyz"] == pytest.approx(np.array([400.0, 0.0, 300.0]) + shift)
+    expect = rot * Rotation.from_euler("XYZ", [10, -20, 30], degrees=True)
+    w, x, y, z = (b.get("rot").get(k) for k in ("q1", "q2", "q3", "q4"))
+    got = Rotation.from_quat([x, y, z, w])
+    assert (got.inv() * expect).magnitude() < 1e-9
+
+
+def test_motion_events_carry_their_settings_and_context():
+    _, trace = run(
+        "    AccSet 50, 30;\n    VelSet 80, 800;\n    ConfL \\Off;\n"
+        "    FOR i FROM 1 TO 2 DO\n      Go Offs(p10, 0, 0, i * 10);\n    ENDFOR\n"
+        "    MoveC Offs(p10,20,20,0), Offs(p10,40,0,0), v200 \\V:=250, z5 \\Z:=7, tG;\n"
+        "    MoveL p10, v100 \\T:=2, fine \\Inpos, tG;\n    WaitTime \\InPos, 0.5;\n    SetDO do1, 1;",
+        extra="  PROC Go(robtarget p)\n    MoveJ p, v1000, z10, tG;\n  ENDPROC\n",
+    )
+    moves = trace.motions
+    assert [m.kind for m in moves] == ["joint", "joint", "circular", "linear"]
+    first = moves[0]
+    assert first.settings.acc_pct == 50.0 and first.settings.ramp_pct == 30.0
+    assert first.settings.vel_override_pct == 80.0 and not first.settings.conf_l
+    assert first.context[0].startswith("Go (t.mod:") and first.context[-1] == "i=1"
+    assert moves[1].target.get("trans").get("z") == 320.0
+    circ = moves[2]
+    assert circ.circle is not None and circ.circle.get("trans").get("x") == 420.0
+    assert circ.speed.get("v_tcp") == 250.0 and circ.zone_mm == 7.0
+    lin = moves[3]
+    assert lin.time_s == 2.0 and lin.fine and lin.inpos
+    kinds = [type(e).__name__ for e in trace.cycle]
+    assert kinds[-2:] == ["Wait", "Action"]
+    assert all(not m.kept for m in moves)
+
+
+def test_an_input_without_a_value_marks_what_it_decides():
+    body = (
+        "    MoveJ p10, v1000, z10, tG;\n"
+        "    IF DInput(diBig) = 1 THEN\n      MoveJ Offs(p10, 0, 50, 0), v1000, z10, tG;\n"
+        "    ELSE\n      MoveJ Offs(p10, 0, -50, 0), v1000, z10, tG;\n    ENDIF\n"
+        "    MoveJ Offs(p10, 50, 0, 0), v1000, z10, tG;\n    MoveJ p10, v1000, fine, tG;"
+    )
+    _, trace = run(body)
+    kept = [bool(m.kept) for m in trace.motions]
+    # the branch's move and the move after it (its start depends on the branch); the others known
+    assert kept == [False, True, True, False]
+    assert trace.motions[1].target.get("trans").get("y") == -50.0  # the stand-in: the input reads 0
+    assert any("diBig" in n and "ELSE" in n for n in trace.notes)
+    _, given = run(body, io={"diBig": 1})
+    assert [bool(m.kept) for m in given.motions] == [False, False, False, False]
+    assert given.motions[1].target.get("trans").get("y") == 50.0
+
+
+def test_marks_flow_through_data_and_calls():
+    _, trace = run(
+        "    n := GInput(giLayer);\n    k := n * 2 + 1;\n    MoveL Offs(p10, 0, 0, k), v100, fine, tG;\n"
+        "    MoveL Offs(p10, 0, 0, 1), v100, fine, tG;\n    MoveL p10, v100, fine, tG;",
+        decl="  VAR num n; VAR num k;\n",
+    )
+    kept = [bool(m.kept) for m in trace.motions]
+    assert kept == [True, True, False]  # the second starts where the first (unknown) ended
+
+
+def test_the_production_loop_is_the_cycle():
+    _, trace = run(
+        "    MoveJ Offs(p10,0,0,100), v1000, fine, tG;\n    WHILE TRUE DO\n      MoveJ p10, v1000, z10, tG;\n"
+        "      MoveL Offs(p10,0,0,-50), v100, fine, tG;\n    ENDWHILE"
+    )
+    assert trace.loop is not None and trace.loop.line == 6
+    assert len(trace.motions) == 2 and len(trace.events) == 3
+
+
+def test_a_loop_in_another_routine_is_the_cycle_too():
+    _, trace = run(
+        "    Production;",
+        decl="  PERS bool bRun := TRUE;\n",
+        extra="  PROC Production()\n    WHILE bRun DO\n      MoveJ p10, v1000, fine, tG;\n    ENDWHILE\n  ENDPROC\n",
+    )
+    assert trace.loop is not None and len(trace.motions) == 1
+
+
+@pytest.mark.parametrize(
+    ("body", "extra", "io", "match"),
+    [
+        ("    WHILE n >= 0 DO\n      n := n + 1;\n    ENDWHILE", "", None, "turns without"),
+        ("    Rec 1;", "  PROC Rec(num k)\n    Rec k + 1;\n  ENDPROC\n", None, "recursion"),
+        ("    WaitDI diGo, 1;", "", {"diGo": 0}, "never ends"),
+        ("    MoveJ p10, v100, fine, tWelder;", "", None, "tWelder is declared nowhere"),
+        ("    Frobnicate 1;", "", None, "Frobnicate is declared nowhere"),
+        ("    MoveJ Offs(p10, 2000, 0, 0), v100, fine, tG;", "", None, None),
+    ],
+)
+def test_bounded_and_refused_in_one_line(body, extra, io, match):
+    if match is None:  # an unreachable target is refused where a robot is given
+        from joulepath import load_robot
+        from joulepath.program._task import RobotKinematics
+
+        text = HEAD + "  PROC main()\n" + body + "\n  ENDPROC\nENDMODULE\n"
+        task = Task((parse_module(text, path="t.mod"),), frozenset(), "t.mod")
+        with pytest.raises(RapidError, match="out of the robot's reach") as err:
+            Interpreter(task, kinematics=RobotKinematics(load_robot("irb120"))).run()
+        assert str(err.value).startswith("t.mod:5:")
+        return
+    with pytest.raises(RapidError, match=match) as err:
+        run(body, decl="  VAR num n;\n", extra=extra, io=io)
+    assert str(err.value).startswith("t.mod:") and "\n" not in str(err.value)
+
+
+def test_no_main_lists_the_routines_that_move():
+    text = HEAD + "  PROC Path1()\n    MoveJ p10, v100, fine, tG;\n  ENDPROC\nENDMODULE\n"
+    task = Task((parse_module(text, path="lib.mod"),), frozenset(), "lib.mod")
+    with pytest.raises(RapidError, match="--routine NAME.*Path1"):
+        Interpreter(task).run()
+    trace = Interpreter(task).run("Path1")
+    assert len(trace.motions) == 1
+
+
+def test_data_and_routines_are_found_across_modules():
+    sysmod = parse_module(
+        "MODULE CellData(SYSMODULE)\n  PERS tooldata tPen := [TRUE,[[0,0,120],[1,0,0,0]],[0.5,[0,0,40],[1,0,0,0],0,0,0]];\n"
+        "  PROC Home()\n    MoveAbsJ [[0,0,0,0,30,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v1000, fine, tPen;\n  ENDPROC\n"
+        "ENDMODULE\n",
+        path="cell.sys",
+    )
+    _, trace = run("    Home;\n    MoveJ p10, v100, fine, tPen;", modules=(sysmod,))
+    assert [m.tool_name for m in trace.motions] == ["tPen", "tPen"]
+    assert trace.motions[0].pos.file == "cell.sys"
+
+
+def test_traps_and_error_handlers_are_not_run():
+    interp, trace = run(
+        "    n := 1;\n  ERROR\n    n := 99;",
+        decl="  VAR num n;\n",
+        extra="  TRAP tr\n    n := 7;\n  ENDTRAP\n",
+    )
+    assert value(interp, "n") == 1.0
+    assert all(isinstance(e, (Action, Wait, Motion)) for e in trace.events)
+
+
+def test_random_numbers_follow_the_seed_and_are_marked():
+    text = HEAD + "  VAR num r;\n  PROC main()\n    r := Rand();\n    MoveJ Offs(p10, 0, 0, r * 10), v100, fine, tG;\n  ENDPROC\nENDMODULE\n"
+    task = Task((parse_module(text, path="t.mod"),), frozenset(), "t.mod")
+    a = Interpreter(task, seed=3).run()
+    b = Interpreter(task, seed=3).run()
+    assert a.motions[0].target == b.motions[0].target
+    assert a.motions[0].kept
