@@ -652,8 +652,12 @@ def _mark_idle(tc: object, idle_waits: Collection[int]) -> tuple[Step, ...]:
     for st in tc.steps:
         if st.kind == "wait" and isinstance(st.statement, Wait) and not st.statement.io:
             module = tc.task.module_of(st.statement.pos.file)
-            text = "" if module is None else module.text.split("\n")[st.line - 1]
-            marked = "joulepath: idle" in text.lower()
+            lines = [] if module is None else module.text.split("\n")
+            text = lines[st.line - 1] if st.line - 1 < len(lines) else ""
+            before = lines[st.line - 2].strip() if 2 <= st.line <= len(lines) else ""
+            marked = "joulepath: idle" in text.lower() or (
+                before.startswith("!") and "joulepath: idle" in before.lower()
+            )
             if marked or st.line in lines:
                 st = replace(st, idle=True)
         out.append(st)

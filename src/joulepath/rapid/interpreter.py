@@ -589,6 +589,13 @@ class Interpreter:
                 "inputs it waits for (--io) or check the loop's condition"
             )
 
+    def source_of(self, pos: n.Pos) -> str:
+        """The source text at ``pos`` (one line, spaces collapsed)."""
+        m = self.task.module_of(pos.file)
+        if m is None:
+            return "(expression)"
+        return " ".join(m.text[pos.start : pos.end].split())
+
     def note(self, text: str) -> None:
         if text not in self._noted:
             self._noted.add(text)
@@ -1236,6 +1243,10 @@ class Interpreter:
                 break
         if taint and not self.ctx_taint:
             self.note(f"{s.pos}: IF decided at run time: {'; '.join(sorted(taint))} -> {label} taken")
+        elif not taint and not self.ctx_taint and not s.compact and self._has_motion((s,), 0):
+            cond = s.branches[0][0]
+            v, _ = self._condition(cond)
+            self.note(f"{s.pos}: IF {self.source_of(cond.pos)} ({'TRUE' if v else 'FALSE'}) -> {label} branch")
         self._under(taint, lambda: self.exec_body(chosen), s)
 
     def exec_test(self, s: n.Test) -> None:
@@ -1248,13 +1259,15 @@ class Interpreter:
                 cv, ct = self.ev(ve)
                 t |= ct
                 if equal(v, cv):
-                    chosen, label = body, f"CASE {_show(cv)}"
+                    chosen, label = body, f"CASE {_show(cv)} (line {ve.pos.line})"
                     break
             else:
                 continue
             break
         if t and not self.ctx_taint:
             self.note(f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken")
+        elif not t and not self.ctx_taint and self._has_motion((s,), 0):
+            self.note(f"{s.pos}: TEST {self.source_of(s.expr.pos)} ({_show(v)}) -> {label} branch")
         self._under(t, lambda: self.exec_body(chosen), s)
 
     def exec_for(self, s: n.For) -> None:
