@@ -561,8 +561,9 @@ class Interpreter:
         io_first = IO_SETTERS | IO_WAITS | {"isignaldi", "isignaldo", "isignalgi", "isignalai", "triggio"}
         io_funcs = {"dinput", "doutput", "ginput", "goutput", "ainput", "aoutput", "testdi", "validio"}
         for s in self._walk_stmts():
-            if isinstance(s, n.Call) and s.name.lower() in io_first and s.args:
-                v = s.args[0].value
+            first = next((a for a in s.args if a.kind == "pos"), None) if isinstance(s, n.Call) else None
+            if isinstance(s, n.Call) and s.name.lower() in io_first and first is not None:
+                v = first.value
                 if isinstance(v, n.Name):
                     out.add(v.name.lower())
             if isinstance(s, n.Call) and s.name.lower() in ("movejdo", "moveldo", "movecdo"):
@@ -571,8 +572,11 @@ class Interpreter:
                         out.add(a.value.name.lower())
         for m in self.task.modules:
             for node in _expressions(m):
-                if isinstance(node, n.FuncCall) and node.name.lower() in io_funcs and node.args:
-                    v = node.args[0].value
+                first = (
+                    next((a for a in node.args if a.kind == "pos"), None) if isinstance(node, n.FuncCall) else None
+                )
+                if isinstance(node, n.FuncCall) and node.name.lower() in io_funcs and first is not None:
+                    v = first.value
                     if isinstance(v, n.Name):
                         out.add(v.name.lower())
         return out
@@ -796,6 +800,9 @@ class Interpreter:
         try:
             return _apply(op, a, b), taint
         except (TypeErrorRapid, ZeroDivisionError, ValueError) as err:
+            if taint and isinstance(err, (ZeroDivisionError, ValueError)):
+                self.note(f"{e.pos}: {op} of a stand-in value fails ({err}); its result is assumed 0")
+                return 0.0, taint
             why = "division by zero" if isinstance(err, ZeroDivisionError) else str(err)
             raise RapidError(f"{e.pos}: {describe(a)} {op} {describe(b)}: {why}; correct the expression") from None
 
@@ -819,7 +826,10 @@ class Interpreter:
                 try:
                     cur.offset(tuple(idx))
                 except IndexError as err:
-                    raise RapidError(f"{e.pos}: {err}; correct the index") from None
+                    if not any(self.ev(i)[1] for i in e.indices):
+                        raise RapidError(f"{e.pos}: {err}; correct the index") from None
+                    self.note(f"{e.pos}: an index from run-time data ({err} for its stand-in): element 1 assumed")
+                    idx = [1] * len(cur.dims)
                 return _Ref(r.cell, (*r.path, ("idx", tuple(idx))))
             cur = r.get()
             if not isinstance(cur, Record) or e.name.lower() not in cur.names:
@@ -859,6 +869,8 @@ class Interpreter:
                 raise RapidError(f"{e.pos}: {e.name} is a {r.kind}, not a FUNC; call it as an instruction")
             return self.invoke(r, m, e.args, e.pos)
         key = e.name.lower()
+        if key == "strtoval":
+            return self.str_to_val(e)
         if key == "present":
             if not e.args or not isinstance(e.args[0].value, n.Name):
                 raise RapidError(f"{e.pos}: Present needs a parameter's name")
@@ -885,10 +897,46 @@ class Interpreter:
         vals = [self._signal_value(v, e.pos) if key not in _SIGNAL_FUNCS else v for v, _ in pos]
         try:
             result = self.builtin(key, e, vals, {k: v for k, (v, _) in opt.items()})
-        except (TypeErrorRapid, IndexError, ValueError) as err:
-            raise RapidError(f"{e.pos}: {e.name}: {err}; correct the arguments") from None
+        except (TypeErrorRapid, IndexError, ValueError, ZeroDivisionError) as err:
+            if not taint:
+                raise RapidError(f"{e.pos}: {e.name}: {err}; correct the arguments") from None
+            # a stand-in of run-time data the function cannot take: its result is a stand-in too
+            self.note(f"{e.pos}: {e.name} of a stand-in value fails ({err}); its result is assumed")
+            return _STANDIN_RESULT.get(key, 0.0), taint
         value, extra = result
         return value, taint | extra
+
+    def str_to_val(self, e: n.FuncCall) -> tuple[Value, Taint]:
+        """``StrToVal(Str, Val)``: the string read as a value of ``Val``'s type into ``Val``; TRUE if it
+        reads. The string is parsed by the grammar as a RAPID literal, never executed."""
+        args = [a for a in e.args if a.kind == "pos"]
+        if len(args) != 2 or args[0].value is None or args[1].value is None:
+            raise RapidError(f"{e.pos}: StrToVal needs a string and a variable")
+        text, t = self.ev(args[0].value)
+        if not isinstance(text, str):
+            raise RapidError(f"{e.pos}: StrToVal reads a string, not {describe(text)}")
+        target = self.ref(args[1].value)
+        r = target if isinstance(target, _Ref) else _Ref(target)
+        cur = r.get()
+        ok = False
+        value: Value = cur
+        if len(text) <= 512 and not any(c in text for c in ";%\n"):
+            try:
+                node = _parse_literal(text)
+                v, _ = self.ev(node)
+                if isinstance(cur, Record):
+                    value = self.types.coerce(v, cur.type)
+                elif isinstance(cur, (float, bool, str)):
+                    value = self.types.coerce(v, "num" if isinstance(cur, float) and not isinstance(cur, bool)
+                                              else "bool" if isinstance(cur, bool) else "string")
+                ok = True
+            except (RapidError, TypeErrorRapid):
+                ok = False
+        if ok:
+            r.set(value, t | self.ctx_taint)
+        elif t:
+            r.set(cur, r.cell.taint | t)
+        return ok, t
 
     def builtin(
         self, key: str, e: n.FuncCall, a: list[Value], opt: dict[str, Value]
@@ -1241,6 +1289,13 @@ class Interpreter:
             if v:
                 chosen, label = body, "THEN" if k == 0 else f"ELSEIF at line {cond.pos.line}"
                 break
+        if taint and not self._has_motion(chosen, 0):
+            # decided at run time: the stand-in's branch does not move; assume the first that does
+            options = [(b, "THEN" if k == 0 else f"ELSEIF at line {c.pos.line}") for k, (c, b) in enumerate(s.branches)]
+            options.append((s.orelse, "ELSE"))
+            moving = next(((b, lab) for b, lab in options if self._has_motion(b, 0)), None)
+            if moving is not None:
+                chosen, label = moving[0], moving[1] + " (assumed: the first branch that moves)"
         if taint and not self.ctx_taint:
             self.note(f"{s.pos}: IF decided at run time: {'; '.join(sorted(taint))} -> {label} taken")
         elif not taint and not self.ctx_taint and not s.compact and self._has_motion((s,), 0):
@@ -1264,6 +1319,11 @@ class Interpreter:
             else:
                 continue
             break
+        if t and not self._has_motion(chosen, 0):
+            options = [(b, f"CASE at line {vs[0].pos.line}") for vs, b in s.cases] + [(s.default or (), "DEFAULT")]
+            moving = next(((b, lab) for b, lab in options if self._has_motion(b, 0)), None)
+            if moving is not None:
+                chosen, label = moving[0], moving[1] + " (assumed: the first branch that moves)"
         if t and not self.ctx_taint:
             self.note(f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken")
         elif not t and not self.ctx_taint and self._has_motion((s,), 0):
@@ -1334,6 +1394,8 @@ class Interpreter:
         turns = 0
         while True:
             v, t = self._condition(s.cond)
+            if not v and t and turns == 0 and self._has_motion(s.body, 0):
+                v = True  # decided at run time and the stand-in skips it: assume one turn that moves
             if not v:
                 if t and self._has_motion(s.body, 0):
                     self.after_branch |= t
@@ -1753,6 +1815,9 @@ _ALL_MOTIONS = (
     set(JOINT_MOTIONS) | set(LINEAR_MOTIONS) | set(CIRCULAR_MOTIONS) | set(ABSJ_MOTIONS)
     | PROCESS_LINEAR | PROCESS_CIRCULAR | set(SEARCH_MOTIONS)
 )
+_STANDIN_RESULT: dict[str, Value] = {
+    k: "" for k in ("strpart", "numtostr", "dnumtostr", "valtostr", "booltostr", "bytetostr", "strmap", "stroneupper")
+} | {"strmemb": False, "strorder": False}
 _SIGNAL_FUNCS = {"dinput", "doutput", "ginput", "goutput", "ainput", "aoutput", "testdi", "validio"}
 
 
@@ -1845,6 +1910,28 @@ def _text_of(a: n.Arg, pos: n.Pos, *, value: bool = False) -> str:
     if isinstance(e, n.Aggregate):
         return "[...]"
     return "(expression)"
+
+
+def _parse_literal(text: str) -> n.Expr:
+    """A literal (number, bool, string or aggregate of them) parsed by the grammar; RapidError else."""
+    from joulepath.rapid._parse import parse_module
+
+    m = parse_module(f"MODULE jp_literal\nPROC jp_literal()\njp_value := {text};\nENDPROC\nENDMODULE\n")
+    stmt = m.routines[0].body[0]
+    assert isinstance(stmt, n.Assign)
+
+    def literal(e: n.Expr) -> bool:
+        if isinstance(e, (n.Num, n.Str, n.Bool)):
+            return True
+        if isinstance(e, n.Neg):
+            return literal(e.a)
+        if isinstance(e, n.Aggregate):
+            return all(literal(i) for i in e.items)
+        return False
+
+    if not literal(stmt.value):
+        raise RapidError(f"StrToVal: {text!r} is not a literal value")
+    return stmt.value
 
 
 def _lvalue_text(e: n.Expr) -> str:
