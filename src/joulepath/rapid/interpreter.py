@@ -1019,10 +1019,13 @@ class Interpreter:
             tool = t.coerce(a[1], "tooldata") if len(a) > 1 else tool
             assert isinstance(tool, Record)
         if self.kin is None:
-            why = f"{e.pos}: {e.name} needs the robot's kinematics (none given)"
-            return self.types.default("jointtarget" if key in ("cjointt", "calcjointt") else "robtarget"), frozenset(
-                {why}
-            )
+            why = frozenset({f"{e.pos}: {e.name} needs the robot's kinematics (none given)"})
+            if key in ("cjointt", "calcjointt"):
+                return self.types.default("jointtarget"), why
+            stand_in = self.types.default("robtarget")
+            assert isinstance(stand_in, Record)
+            stand_in = stand_in.replace("rot", make_orient((1.0, 0.0, 0.0, 0.0)))
+            return (stand_in.get("trans") if key == "cpos" else stand_in), why
         if key == "calcjointt":
             rt = t.coerce(a[0], "robtarget")
             assert isinstance(rt, Record)
