@@ -167,7 +167,7 @@ def test_the_production_loop_is_the_cycle():
         "      MoveL Offs(p10,0,0,-50), v100, fine, tG;\n    ENDWHILE"
     )
     assert trace.loop is not None and trace.loop.line == 6
-    assert len(trace.motions) == 2 and len(trace.events) == 3
+    assert len(trace.motions) == 2 and len(trace.events) == 5  # the way there, a first turn, the cycle
 
 
 def test_a_loop_in_another_routine_is_the_cycle_too():
@@ -244,3 +244,18 @@ def test_random_numbers_follow_the_seed_and_are_marked():
     b = Interpreter(task, seed=3).run()
     assert a.motions[0].target == b.motions[0].target
     assert a.motions[0].kept
+
+
+def test_the_cycle_starts_with_the_settings_a_turn_leaves():
+    _, trace = run(
+        "    AccSet 100, 100;\n    WHILE TRUE DO\n      MoveJ p10, v1000, z10, tG;\n      AccSet 40, 20;\n"
+        "      MoveL Offs(p10,0,0,-50), v100, fine, tG;\n      AccSet 100, 100;\n      n := n + 1;\n    ENDWHILE",
+        decl="  VAR num n;\n",
+    )
+    first, second = trace.motions
+    assert (first.settings.acc_pct, second.settings.acc_pct) == (100.0, 40.0)
+    _, trace = run(
+        "    WHILE TRUE DO\n      MoveJ p10, v1000, z10, tG;\n      AccSet 40, 20;\n"
+        "      MoveL Offs(p10,0,0,-50), v100, fine, tG;\n    ENDWHILE"
+    )
+    assert [m.settings.acc_pct for m in trace.motions] == [40.0, 40.0]  # the steady state, not the first turn

@@ -22,8 +22,9 @@ nowhere, an unreachable target and a program that never ends are refused
 
 **The cycle.** The program runs from ``main`` (or the routine given). The first endless
 loop it enters (``WHILE TRUE``, or ``WHILE`` on a ``bool`` no statement assigns) is the
-production loop: its first turn is the cycle, what ran before it is the way there. Without
-such a loop the cycle is one run of the routine. ``TRAP`` routines and ``ERROR`` /
+production loop: a turn of it is the cycle (the second: it starts where a turn ends, with the
+motion settings a turn leaves, as every later one does); what ran before it is the way there.
+Without such a loop the cycle is one run of the routine. ``TRAP`` routines and ``ERROR`` /
 ``UNDO`` / ``BACKWARD`` handlers are read and kept, never run.
 """
 
@@ -1386,7 +1387,12 @@ class Interpreter:
     def exec_while(self, s: n.While) -> None:
         if self._endless(s.cond):
             if self.cycle_end is None and self.loop is None:
+                # the production loop: its first turn starts from where the way there left the robot
+                # and with the settings made before it; the turns after it are the cycle that repeats
+                # (it starts where a turn ends, with the motion settings a turn leaves), so the cycle
+                # is the second turn
                 self.loop = s.pos
+                self.exec_body(s.body)
                 self.cycle_start = len(self.events)
                 self.exec_body(s.body)
                 self.cycle_end = len(self.events)
