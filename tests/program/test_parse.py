@@ -5,8 +5,9 @@ from pathlib import Path
 
 import pytest
 
+import joulepath
 from joulepath.cli._main import main
-from joulepath.program import format_move, parse_module, read_module, write_module
+from joulepath.program import format_move, parse_module, read_cycle_program, read_module, write_module
 from joulepath.program._model import Call, Move, WaitTime, WhileTrue
 
 EXAMPLE = Path(__file__).parents[2] / "examples" / "pick_and_place.mod"
@@ -85,8 +86,6 @@ def _prog(*body: str, decl: str = "") -> str:
 CORPUS = [
     ("unknown target", _prog("MoveJ pB, v100, fine, tool0;"), 5),
     ("missing semicolon", _prog("MoveJ pA, v100, fine, tool0", "WaitTime 1;"), 5),
-    ("conc argument", _prog("MoveJ \\Conc, pA, v100, fine, tool0;"), 5),
-    ("inpos argument", _prog("MoveJ pA, v100, fine \\Inpos:=inpos50, tool0;"), 5),
     (
         "unreachable pose",
         _prog(
@@ -103,8 +102,6 @@ CORPUS = [
         ),
         6,
     ),
-    ("MoveC", _prog("MoveC pA, pA, v100, fine, tool0;"), 5),
-    ("VelSet", _prog("VelSet 50, 800;", "MoveJ pA, v100, fine, tool0;"), 5),
     ("no ENDMODULE", (HEAD + "    PROC main()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n"), 6),
     ("no main", HEAD + "    PROC other()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n" + TAIL, 1),
     (
@@ -113,7 +110,7 @@ CORPUS = [
             "MoveJ pQ, v100, fine, tool0;",
             decl=_rt("pQ", "375, 0, 540", quat="0, 0, 2, 0"),
         ),
-        4,
+        6,
     ),
     (
         "joint out of range",
@@ -124,7 +121,7 @@ CORPUS = [
         6,
     ),
     ("unknown speeddata", _prog("MoveAbsJ jA, v123, fine, tool0;"), 5),
-    ("move inside IF", _prog("IF nParts > 3 THEN", "    MoveJ pA, v100, fine, tool0;", "ENDIF"), 6),
+    ("undeclared in a condition", _prog("IF nParts > 3 THEN", "    MoveJ pA, v100, fine, tool0;", "ENDIF"), 5),
     ("other work object", _prog("MoveJ pA, v100, fine, tool0 \\WObj:=wobjTable;"), 5),
     ("WaitTime InPos without a time", _prog("MoveJ pA, v100, fine, tool0;", "WaitTime \\InPos;"), 6),
     (
@@ -138,7 +135,7 @@ CORPUS = [
     (
         "robtarget without value",
         _prog("MoveJ pNone, v100, fine, tool0;", decl="    VAR robtarget pNone;\n"),
-        4,
+        6,
     ),
     (
         "recursion",
@@ -175,6 +172,25 @@ def test_malformed_program_exit_2_with_line(tmp_path, capsys, name, text, line):
     assert len(err.splitlines()) == 1, err
     assert f"bad.mod:{line}:" in err, err
     assert not out.exists()
+
+
+def test_what_the_subset_reader_refused_is_now_read(tmp_path):
+    """\\Conc, \\Inpos, MoveC and VelSet are RAPID: read, with a \\Conc move kept as taught."""
+    robot = joulepath.load_robot("irb120")
+    text = _prog(
+        "MoveJ pA, v100, fine, tool0;",
+        "VelSet 50, 800;",
+        "MoveJ \\Conc, pB, v100, fine \\Inpos:=inpos50, tool0;",
+        "MoveC pC, pA, v100, fine, tool0;",
+        decl=_rt("pB", "300, 150, 400") + _rt("pC", "340, 80, 500"),
+    )
+    prog = tmp_path / "ok.mod"
+    prog.write_text(text)
+    spec, _ = read_cycle_program(prog, robot)
+    moves = [s for s in spec.steps if s.kind == "move"]
+    assert [bool(s.kept) for s in moves] == [False, True, False]
+    assert moves[2].circle_q is not None and moves[2].linear
+    assert "Conc" in spec.kept[0][1]
 
 
 def test_corpus_is_large_enough():

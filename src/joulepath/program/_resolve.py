@@ -652,9 +652,9 @@ def _mark_idle(tc: object, idle_waits: Collection[int]) -> tuple[Step, ...]:
     for st in tc.steps:
         if st.kind == "wait" and isinstance(st.statement, Wait) and not st.statement.io:
             module = tc.task.module_of(st.statement.pos.file)
-            lines = [] if module is None else module.text.split("\n")
-            text = lines[st.line - 1] if st.line - 1 < len(lines) else ""
-            before = lines[st.line - 2].strip() if 2 <= st.line <= len(lines) else ""
+            source = [] if module is None else module.text.split("\n")
+            text = source[st.line - 1] if st.line - 1 < len(source) else ""
+            before = source[st.line - 2].strip() if 2 <= st.line <= len(source) else ""
             marked = "joulepath: idle" in text.lower() or (
                 before.startswith("!") and "joulepath: idle" in before.lower()
             )

@@ -186,7 +186,13 @@ def read_task_cycle(
     trace = interp.run(routine)
     moves = [e for e in trace.cycle if isinstance(e, Motion)]
     if not moves:
-        where = f"{trace.loop}" if trace.loop is not None else task.source
+        if trace.loop is not None:
+            where = str(trace.loop)
+        else:
+            found = next(
+                (r for m in task.modules for r in m.routines if r.name.lower() == trace.routine.lower()), None
+            )
+            where = str(found.pos) if found is not None else task.source
         raise RapidError(f"{where}: the cycle ({trace.routine}) holds no move; nothing to optimize")
     check_work(
         "moves",

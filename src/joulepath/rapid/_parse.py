@@ -93,6 +93,13 @@ def _syntax_message(err: lark.exceptions.UnexpectedInput, text: str, path: str) 
     line = getattr(err, "line", 1) or 1
     if isinstance(err, lark.exceptions.UnexpectedToken):
         tok = err.token
+        start = tok.start_pos if tok.start_pos is not None else 0
+        line_start = text.rfind("\n", 0, start) + 1
+        if tok.type != "$END" and not text[line_start:start].strip() and "SEMICOLON" in err.expected:
+            # the statement before this line ended without ';': name its line
+            prev = text[:line_start].rstrip()
+            if prev:
+                return f"{path}:{prev.count(chr(10)) + 1}: the statement ends without ';'; add it"
         if tok.type == "$END":
             return f"{path}:{line}: the text ends inside a declaration or routine; close it (ENDPROC, ENDMODULE)"
         expected = sorted(e.lstrip("_") for e in err.expected)[:6]

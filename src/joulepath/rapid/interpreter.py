@@ -414,6 +414,8 @@ def _predefined(types: Types) -> dict[str, Cell]:
     put("wobj0", "wobjdata", (False, True, "", pose0, pose0), "PERS")
     for k in range(1, 6):
         put(f"reg{k}", "num", 0.0, "VAR")
+    for pct in (20, 50, 100):  # ABB's in-position stop point data: position and speed in % of fine
+        put(f"inpos{pct}", "stoppointdata", (1.0, False, float(pct), float(pct), 0.0, 20.0, 0.0, 0.0, "", 0.0, 0.0))
     for name, value in (("pi", math.pi),):
         put(name, "num", value)
     return out
@@ -1258,6 +1260,9 @@ class Interpreter:
         if stmt is not None and self._has_motion((stmt,), 0):
             self.after_branch = self.after_branch | taint
 
+    def _moves(self) -> int:
+        return sum(isinstance(e, Motion) for e in self.events)
+
     def _has_motion(self, body: tuple[n.Stmt, ...], depth: int) -> bool:
         """Whether a statement list holds a move, directly or in a routine it calls (8 calls deep)."""
         if depth > 8:
@@ -1710,6 +1715,20 @@ class Interpreter:
         assert isinstance(wobj, Record)
         circle = targets[0][0] if kind == "circular" else None
         target, target_t, target_text = targets[-1]
+        want = "jointtarget" if kind == "absjoint" else "robtarget"
+        for rec, _, text in targets:
+            if rec.type != want:
+                fix = "use MoveAbsJ" if want == "robtarget" else "use MoveJ (or give a jointtarget)"
+                raise RapidError(f"{s.pos}: {s.name} goes to a {want}; {text} is a {rec.type}: {fix}")
+        for rec, t, text in targets:
+            if rec.type == "robtarget" and not t:
+                q = geo.orient_values(rec.get("rot"))
+                norm = math.sqrt(sum(v * v for v in q))
+                if abs(norm - 1.0) > 1e-3:
+                    raise RapidError(
+                        f"{s.pos}: {text}: its orientation {list(q)} is not a unit quaternion (norm {norm:.4g}); "
+                        "correct it (or NOrient it)"
+                    )
         kept = set(taint | start_taint | target_t | speed_t | zone_t | tool_t | wobj_t)
         if circle is not None:
             kept |= targets[0][1]
@@ -1780,13 +1799,14 @@ class Interpreter:
                 found = self.local_routines[m.name.lower()].get(name.lower()) or found
         if found is None:
             movers = sorted({r.name for r, _ in self.routines.values() if r.kind == "PROC" and _moves_in(r)})
+            where = f"{self.task.modules[0].path}:{self.task.modules[0].pos.line}"
             if routine is None:
                 raise RapidError(
-                    f"{self.task.source}: no main routine; give --routine NAME, one of the routines that move "
-                    f"the robot: {', '.join(movers) or '(none)'}"
+                    f"{where}: no main routine in {self.task.source}; give --routine NAME, one of the "
+                    f"routines that move the robot: {', '.join(movers) or '(none)'}"
                 )
             raise RapidError(
-                f"{self.task.source}: no routine {routine}; give --routine NAME, one of: "
+                f"{where}: no routine {routine} in {self.task.source}; give --routine NAME, one of: "
                 f"{', '.join(movers) or '(none)'}"
             )
         r, m = found
