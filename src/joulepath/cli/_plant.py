@@ -88,8 +88,16 @@ def plant(
             print(f"error: {problem}", file=sys.stderr)
         print(f"error: {len(err.problems)} problem(s) in {plant_file}; nothing was computed", file=sys.stderr)
         raise typer.Exit(2) from None
-    with _progress(f"{config.name}: cells") as say:
-        run = run_plant(config, out, jobs=jobs, scheduler=scheduler, progress=say)
+    try:
+        with _progress(f"{config.name}: cells") as say:
+            run = run_plant(config, out, jobs=jobs, scheduler=scheduler, progress=say)
+    except KeyboardInterrupt:
+        print(
+            f"interrupted: the cells finished so far are kept in {out / 'cache'}; run the same command "
+            "again to compute the rest",
+            file=sys.stderr,
+        )
+        raise typer.Exit(130) from None
     files = write_plant_report(config, out)
     import json
 

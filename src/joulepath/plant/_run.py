@@ -198,6 +198,7 @@ def run_plant(
     jobs: int | None = None,
     scheduler: str | None = None,
     progress: Callable[[PlantProgress], None] | None = None,
+    task: Callable[[CellTask], dict[str, Any]] = run_cell,
 ) -> PlantRun:
     """Run every cell of ``plant`` not yet in ``out``'s cache; store each result as it finishes.
 
@@ -213,6 +214,9 @@ def run_plant(
         ``tcp://host:port`` of a running Dask scheduler, instead of a local cluster.
     progress : callable, optional
         Told a :class:`PlantProgress` once at the start and after each cell.
+    task : callable, default :func:`~joulepath.plant.run_cell`
+        The per-cell task (a pure function of a :class:`~joulepath.plant.CellTask`, importable or
+        picklable on the workers).
 
     Returns
     -------
@@ -227,19 +231,19 @@ def run_plant(
     with outside_journal():  # results outlive an interrupted run
         make_folder(root / CACHE)
     todo: dict[str, CellTask] = {}
-    for task in tasks:
-        rec = read_result(root, task.key)
+    for t in tasks:
+        rec = read_result(root, t.key)
         if rec is None:
-            todo.setdefault(task.key, task)
+            todo.setdefault(t.key, t)
         else:
-            status[task.key] = str(rec["status"])
-            cached.append(task.name)
+            status[t.key] = str(rec["status"])
+            cached.append(t.name)
     names_by_key: dict[str, list[str]] = {}
-    for task in tasks:
-        names_by_key.setdefault(task.key, []).append(task.name)
+    for t in tasks:
+        names_by_key.setdefault(t.key, []).append(t.name)
 
     def counts(cell: str | None = None, state: str | None = None, hit: bool = False) -> PlantProgress:
-        per_cell = [status.get(t.key) for t in tasks]
+        per_cell = [status.get(c.key) for c in tasks]
         failed = sum(s == "failed" for s in per_cell)
         finished = sum(s is not None for s in per_cell)
         return PlantProgress(len(tasks), finished - failed, failed, len(tasks) - finished, cell, state, hit)
@@ -249,7 +253,7 @@ def run_plant(
     if todo:
         with _client(jobs, scheduler) as client:
             futures = client.map(
-                run_cell,
+                task,
                 list(todo.values()),
                 key=[f"joulepath-cell-{k}" for k in todo],
                 retries=RETRIES,
@@ -277,7 +281,7 @@ def run_plant(
                 computed.extend(names_by_key[key])
                 say(counts(todo[key].name, status[key]))
                 del result
-    failed = tuple(t.name for t in tasks if status.get(t.key) == "failed")
+    failed = tuple(c.name for c in tasks if status.get(c.key) == "failed")
     return PlantRun(
         out=root,
         n_cells=len(tasks),
