@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -168,6 +169,7 @@ def main() -> None:
     parser.add_argument("--n-memory", type=int, default=1000)
     args = parser.parse_args()
     start = datetime.now(UTC)
+    load = [os.getloadavg()[0]]
     commit = subprocess.run(
         ["git", "rev-parse", "--short=10", "HEAD"], cwd=ROOT, capture_output=True, text=True, check=False
     ).stdout.strip()
@@ -181,6 +183,7 @@ def main() -> None:
         print(real, flush=True)
         mem = memory(make_plant(base / "big", args.n_memory, cheap=True), base / "big-run", replay=True)
         print(mem, flush=True)
+    load.append(os.getloadavg()[0])
     one, two = rows
     ratio_wall = two["cells_per_s"] / one["cells_per_s"]
     ratio_steady = two["steady_cells_per_s"] / one["steady_cells_per_s"]
@@ -188,7 +191,7 @@ def main() -> None:
     body = f"""## A plant on Dask: throughput with 1 and 2 workers, client memory (benchmarks/plant_throughput.py)
 
 Machine: {machine()}; worker processes pinned to one BLAS/OpenMP thread; the 2 cores shared with other work
-(about 6 other jobs ran on them at the same time). Code: commit {commit} (run {start:%Y-%m-%d %H:%M} to
+(load average {load[0]:.1f} at the start, {load[1]:.1f} at the end). Code: commit {commit} (run {start:%Y-%m-%d %H:%M} to
 {end:%H:%M} UTC). One run each (no repeats: the time went to the 1,000-cell run).
 
 Throughput: a generated plant of {one["cells"]} small cells (two short MoveJ from rest to rest, two waits;
