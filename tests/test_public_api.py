@@ -25,6 +25,7 @@ PACKAGES = [
     "joulepath.program",
     "joulepath.measure",
     "joulepath.egm",
+    "joulepath.plant",
 ]
 
 
@@ -80,6 +81,7 @@ ALLOWED = {
     "report": set(),  # reads a run folder's files only
     "egm": {"description", "dynamics", "energy"},  # streams a run folder's path; its robot and energy
     "experiment": None,  # orchestrates every stage, like the CLI
+    "plant": {"description", "dynamics", "energy", "program", "optimize"},  # cell programs' cycles, on Dask
     "cli": None,  # may import anything
 }
 FOUNDATION = {"_typing", "_rng", "_io", "_runfolder", "_work", "errors", "units", "abb", "__version__"}

@@ -24,6 +24,7 @@ from joulepath.cli._identify import identify
 from joulepath.cli._learn import importance, train
 from joulepath.cli._measure import measure
 from joulepath.cli._optimize import bench_optimizers, optimize
+from joulepath.cli._plant import plant
 from joulepath.cli._robot import robot_app
 from joulepath.cli._stream import stream
 from joulepath.cli._synth import compare, synth
@@ -49,6 +50,7 @@ app.command("compare")(compare)
 app.command("optimize")(optimize)
 app.command("bench-optimizers")(bench_optimizers)
 app.command("cycle")(cycle)
+app.command("plant")(plant)
 app.command("measure")(measure)
 app.command("stream")(stream)
 app.command("run")(run)

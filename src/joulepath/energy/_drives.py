@@ -14,6 +14,10 @@ like its friction. Every value carries its source, or ``"assumed"``::
     regen_efficiency = 0.9         # share returned, with bus = "regenerative"
     standby_W = 90.0               # W drawn whatever the arm does
     bus_voltage_V = 48.0           # optional, informative
+    brakes_W = 34.0                # optional: W drawn at rest with the brakes engaged (power-saving mode)
+    brakes_entry_s = 0.5           # s a pause loses to entering and leaving that mode
+    bus_off_W = 24.0               # optional: W drawn with the drives' bus power off
+    bus_off_entry_s = 5.0          # s a pause loses to switching the bus off and on
 
     [sources]                      # where each value comes from; a missing one is "assumed"
     standby_W = "UR5 technical specifications: power consumption min 90 W"
@@ -40,7 +44,10 @@ BUS_KINDS = ("bleeder", "regenerative", "per-axis")
 ASSUMED = "assumed"
 
 _PER_JOINT = ("torque_constant", "resistance", "drive_efficiency", "gear_efficiency")
-_SCALARS = ("regen_efficiency", "standby_W", "bus_voltage_V")
+_MODE_KEYS = ("brakes_W", "brakes_entry_s", "bus_off_W", "bus_off_entry_s")
+_SCALARS = ("regen_efficiency", "standby_W", "bus_voltage_V", *_MODE_KEYS)
+IDLE_MODES = ("brakes", "bus_off")
+"""Power-saving modes a drives file may give for the robot at rest (``<mode>_W``, ``<mode>_entry_s``)."""
 _VALUE_KEYS = (*_PER_JOINT, "bus", *_SCALARS)
 _KEYS = {*_VALUE_KEYS, "sources", "note"}
 
@@ -68,6 +75,12 @@ class DriveModel:
         W the cabinet draws whatever the arm does (controller, fans, drives idle).
     bus_voltage_V : float or None
         Informative only.
+    brakes_W, bus_off_W : float or None
+        W the cabinet draws at rest in a power-saving mode: the brakes engaged (the drives
+        hold no torque), or the drives' bus power off; at most ``standby_W``. None: not known.
+    brakes_entry_s, bus_off_entry_s : float or None
+        s of a pause lost to entering and leaving each mode (drawn at the ``standby_W``
+        rate); a pause shorter than that gains nothing from the mode.
     sources : dict of str to str
         Where each value comes from; a value without an entry is ``"assumed"``, and so is
         one whose source starts with "assumed" (an estimate states its basis after it).
@@ -83,6 +96,10 @@ class DriveModel:
     regen_efficiency: float = 0.0
     standby_W: float = 0.0
     bus_voltage_V: float | None = None
+    brakes_W: float | None = None
+    brakes_entry_s: float | None = None
+    bus_off_W: float | None = None
+    bus_off_entry_s: float | None = None
     sources: dict[str, str] = field(default_factory=dict)
     origin: str = "given"
 
@@ -115,6 +132,16 @@ class DriveModel:
             raise InvalidInput(f"{where}: regen_efficiency must be in [0, 1], got {self.regen_efficiency}")
         if not (math.isfinite(self.standby_W) and self.standby_W >= 0):
             raise InvalidInput(f"{where}: standby_W must be ≥ 0 W, got {self.standby_W}")
+        for mode in IDLE_MODES:
+            power, entry = getattr(self, f"{mode}_W"), getattr(self, f"{mode}_entry_s")
+            if (power is None) != (entry is None):
+                raise InvalidInput(f"{where}: give both {mode}_W and {mode}_entry_s, or neither")
+            if power is not None and not (math.isfinite(power) and 0 <= power <= self.standby_W):
+                raise InvalidInput(
+                    f"{where}: {mode}_W must be in [0, standby_W = {self.standby_W}] W, got {power}"
+                )
+            if entry is not None and not (math.isfinite(entry) and entry >= 0):
+                raise InvalidInput(f"{where}: {mode}_entry_s must be ≥ 0 s, got {entry}")
         unknown = sorted(set(self.sources) - set(_VALUE_KEYS))
         if unknown:
             raise InvalidInput(
@@ -131,7 +158,11 @@ class DriveModel:
 
     def describe(self) -> str:
         """One line: the file, and which values are sourced or assumed (shown with electrical figures)."""
-        used = [k for k in _VALUE_KEYS if k != "bus_voltage_V" and getattr(self, k) is not None]
+        used = [
+            k
+            for k in _VALUE_KEYS
+            if k != "bus_voltage_V" and k not in _MODE_KEYS and getattr(self, k) is not None
+        ]
         if self.bus != "regenerative":
             used.remove("regen_efficiency")
         assumed = [k for k in used if self.source(k).lower().startswith(ASSUMED)]
