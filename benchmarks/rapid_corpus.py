@@ -34,7 +34,9 @@ def cases() -> list[tuple[str, list[Path], dict[str, object], str | None, str]]:
     out = []
     for d in sorted(p for p in CORPUS.iterdir() if p.is_dir()):
         e = tomllib.loads((d / "expect.toml").read_text(encoding="utf-8"))
-        out.append((d.name, [d / p for p in e["program"]], dict(e.get("io", {})), e.get("routine"), e["outcome"]))
+        out.append(
+            (d.name, [d / p for p in e["program"]], dict(e.get("io", {})), e.get("routine"), e["outcome"])
+        )
     task = ROOT / "examples" / "cell_task"
     out.append(("examples/cell_task (diBigPart=1)", [task], {"diBigPart": 1, "diPartPresent": 1}, None, "ok"))
     return out
@@ -72,7 +74,11 @@ def run(name: str, paths: list[Path], io: dict[str, object], routine: str | None
             saved_pct=c["saved_pct"] if "saved_pct" in c else None,
             default_J=c.get("energy_default_J"),
             optimized_J=c.get("energy_optimized_J"),
-            written="RAPID" if (out / "optimized.mod").is_file() else "EGM" if (out / "egm.mod").is_file() else "none",
+            written="RAPID"
+            if (out / "optimized.mod").is_file()
+            else "EGM"
+            if (out / "egm.mod").is_file()
+            else "none",
         )
     else:
         row["error"] = (err.strip().splitlines() or [""])[-1][:160]
@@ -90,11 +96,15 @@ def main() -> None:
         rows.append(row)
         print(json.dumps(row), file=sys.stderr, flush=True)
     print(f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}\n")
-    print("| program | exit | moves | optimized | kept (run time) | open % | saved % (plan) | written | CPU s | wall s |")
+    print(
+        "| program | exit | moves | optimized | kept (run time) | open % | saved % (plan) | written | CPU s | wall s |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         if r.get("moves") is None:
-            print(f"| {r['name']} | {r['exit']} | refused: {r.get('error', '')} | | | | | | {r['cpu_s']:.1f} | {r['wall_s']:.1f} |")
+            print(
+                f"| {r['name']} | {r['exit']} | refused: {r.get('error', '')} | | | | | | {r['cpu_s']:.1f} | {r['wall_s']:.1f} |"
+            )
             continue
         saved = "" if r["saved_pct"] is None else f"{r['saved_pct']:.1f}"
         print(

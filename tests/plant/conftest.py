@@ -1,4 +1,5 @@
-"""A mini plant (three one-module cells of two moves each, one two-module task) and its reference run."""
+"""A mini plant (three one-module cells of two moves each, one two-module task with a sensor) and its
+reference run."""
 
 from __future__ import annotations
 
@@ -62,8 +63,14 @@ def make_mini_plant(
         parts.append(f'[[cell]]\nname = "{name}"\nprogram = "{name}.mod"\n')
     task = folder / "task"
     task.mkdir(exist_ok=True)
-    (task / "main.mod").write_text(tiny_program("TaskMain", 110, 0.5, 0.5), encoding="utf-8")
-    (task / "lib.sys").write_text("MODULE Lib(SYSMODULE)\nENDMODULE\n", encoding="utf-8")
+    main = tiny_program("TaskMain", 110, 0.5, 0.5).replace(f"    {TOOL}\n", "")
+    main = main.replace(
+        "            WaitTime 0.5;\n", "            WaitDI diPartReady, 1;\n            WaitTime 0.5;\n", 1
+    )
+    (task / "main.mod").write_text(
+        main, encoding="utf-8"
+    )  # its tool in the system module, a sensor to wait for
+    (task / "lib.sys").write_text(f"MODULE Lib(SYSMODULE)\n    {TOOL}\nENDMODULE\n", encoding="utf-8")
     parts.append('[[cell]]\nname = "task"\nprogram = "task"\nio = { diPartReady = 1 }\n')
     path = folder / "plant.toml"
     path.write_text("\n".join(parts) + extra, encoding="utf-8")
@@ -81,9 +88,7 @@ def reference_run(mini_plant: Path) -> Path:
     from joulepath.cli import main
 
     out = mini_plant.parent / "reference"
-    assert (
-        main(["plant", str(mini_plant), "--out", str(out), "--jobs", "2"]) == 1
-    )  # the two-module task fails
+    assert main(["plant", str(mini_plant), "--out", str(out), "--jobs", "2"]) == 0
     return out
 
 

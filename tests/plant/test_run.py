@@ -24,8 +24,8 @@ from .conftest import CELLS, cell_results
 def test_plant_run_writes_the_report(reference_run):
     summary = json.loads((reference_run / "plant.json").read_text())
     cells = {c["cell"]: c for c in summary["cells"]}
-    assert summary["n_cells"] == 4 and summary["n_failed"] == 1
-    assert "multi-module tasks need the RAPID interpreter" in cells["task"]["reason"]
+    assert summary["n_cells"] == 4 and summary["n_failed"] == 0
+    assert cells["task"]["status"] == "ok"  # two modules, its tool in the system module, an I/O scenario
     for name in CELLS:
         c = cells[name]
         assert c["status"] in ("ok", "refused"), c
@@ -63,7 +63,7 @@ def test_plant_rerun_computes_only_what_is_missing(mini_plant, reference_run, tm
     shutil.copytree(reference_run / CACHE, out / CACHE)
     plant = read_plant(mini_plant)
     run = run_plant(plant, out, jobs=1)
-    assert set(run.cached) == set(CELLS) and run.computed == ("task",)  # a reader failure is tried again
+    assert set(run.cached) == {*CELLS, "task"} and run.computed == ()
     write_plant_report(plant, out)
     assert cell_results(out) == cell_results(reference_run)
 
@@ -153,7 +153,7 @@ def test_plant_on_a_dask_scheduler_with_a_worker_killed_mid_task(mini_plant, ref
                 time.sleep(0.02)
             text = client.communicate(timeout=300)[0].decode()
         assert killed is not None, "no worker was seen running a task"
-        assert client.returncode == 1, text  # the two-module task fails; the others finish
+        assert client.returncode == 0, text  # every cell finishes, the killed one retried
     finally:
         for p in procs:
             p.kill()

@@ -121,7 +121,11 @@ CORPUS = [
         6,
     ),
     ("unknown speeddata", _prog("MoveAbsJ jA, v123, fine, tool0;"), 5),
-    ("undeclared in a condition", _prog("IF nParts > 3 THEN", "    MoveJ pA, v100, fine, tool0;", "ENDIF"), 5),
+    (
+        "undeclared in a condition",
+        _prog("IF nParts > 3 THEN", "    MoveJ pA, v100, fine, tool0;", "ENDIF"),
+        5,
+    ),
     ("other work object", _prog("MoveJ pA, v100, fine, tool0 \\WObj:=wobjTable;"), 5),
     ("WaitTime InPos without a time", _prog("MoveJ pA, v100, fine, tool0;", "WaitTime \\InPos;"), 6),
     (

@@ -61,7 +61,10 @@ ENDMODULE
 def test_every_construct_parses_into_typed_nodes():
     m = parse_module(EVERY_CONSTRUCT, path="cell.sys")
     assert m.name == "Cell" and m.system
-    assert [r.name for r in m.records] == ["part"] and m.records[0].fields == (("num", "weight"), ("robtarget", "grip"))
+    assert [r.name for r in m.records] == ["part"] and m.records[0].fields == (
+        ("num", "weight"),
+        ("robtarget", "grip"),
+    )
     assert [a.name for a in m.aliases] == ["counter"]
     assert [d.name for d in m.data] == ["p10", "grid", "tGrip", "diExtra"]
     assert m.data[1].scope == "LOCAL" and len(m.data[1].dims) == 2
@@ -73,12 +76,28 @@ def test_every_construct_parses_into_typed_nodes():
     assert types == ["DataDecl", "For", "If", "If", "Test", "While", "Connect", "Return"]
     above = m.routines[1]
     assert above.type == "robtarget"
-    assert [(p.name, p.optional, p.group) for p in above.params] == [("p", False, 0), ("dz", True, 1), ("none", True, 1)]
+    assert [(p.name, p.optional, p.group) for p in above.params] == [
+        ("p", False, 0),
+        ("dz", True, 1),
+        ("none", True, 1),
+    ]
     loop = main.body[1]
     assert isinstance(loop, nodes.For)
     movel, movej = loop.body
-    assert isinstance(movel, nodes.Call) and [a.kind for a in movel.args] == ["pos", "pos", "pos", "pos", "opt"]
-    assert isinstance(movej, nodes.Call) and [a.kind for a in movej.args] == ["pos", "pos", "pos", "pos", "opt"]
+    assert isinstance(movel, nodes.Call) and [a.kind for a in movel.args] == [
+        "pos",
+        "pos",
+        "pos",
+        "pos",
+        "opt",
+    ]
+    assert isinstance(movej, nodes.Call) and [a.kind for a in movej.args] == [
+        "pos",
+        "pos",
+        "pos",
+        "pos",
+        "opt",
+    ]
     compact = main.body[3]
     assert isinstance(compact, nodes.If) and compact.compact
 
@@ -96,7 +115,9 @@ def test_positions_point_at_the_source_text():
 
 
 def test_operator_precedence():
-    m = parse_module("MODULE M\nPROC main()\nx := 1 + 2 * 3 - -4 / 2;\nb := a OR b AND NOT c = d;\nENDPROC\nENDMODULE\n")
+    m = parse_module(
+        "MODULE M\nPROC main()\nx := 1 + 2 * 3 - -4 / 2;\nb := a OR b AND NOT c = d;\nENDPROC\nENDMODULE\n"
+    )
     x = m.routines[0].body[0]
     assert isinstance(x, nodes.Assign)
     top = x.value
@@ -109,7 +130,10 @@ def test_operator_precedence():
 
 
 def test_keywords_in_any_case_and_the_header_keeps_line_numbers():
-    text = "%%%\n  VERSION:1\n  LANGUAGE:ENGLISH\n%%%\n\nmodule m\n  proc MAIN()\n    waittime 1;\n  endproc\nendmodule\n"
+    text = (
+        "%%%\n  VERSION:1\n  LANGUAGE:ENGLISH\n%%%\n\n"
+        "module m\n  proc MAIN()\n    waittime 1;\n  endproc\nendmodule\n"
+    )
     m = parse_module(text)
     assert m.routines[0].name == "MAIN"
     assert m.routines[0].body[0].pos.line == 8
@@ -123,7 +147,7 @@ def test_latin1_and_crlf_are_decoded_and_remembered(tmp_path):
     assert m.encoding == "latin-1" and m.newline == "\r\n"
     assert m.routines[0].name == "Hämta_Del"
     assert "\r" not in m.text
-    assert decode("ok\n".encode())[1:] == ("utf-8", "\n")
+    assert decode(b"ok\n")[1:] == ("utf-8", "\n")
 
 
 @pytest.mark.parametrize(

@@ -31,7 +31,7 @@ def value(interp: Interpreter, name: str):
 
 def test_arithmetic_strings_and_precedence():
     interp, _ = run(
-        "    x := 1 + 2 * 3 - -4 / 2;\n    y := 17 DIV 5 + 17 MOD 5;\n    s := \"a\" + NumToStr(2.5, 1);\n"
+        '    x := 1 + 2 * 3 - -4 / 2;\n    y := 17 DIV 5 + 17 MOD 5;\n    s := "a" + NumToStr(2.5, 1);\n'
         "    b := 1 < 2 AND NOT (3 <= 2) OR FALSE;\n    r := Round(2.345\\Dec:=2) + Trunc(-1.7);",
         decl="  VAR num x; VAR num y; VAR string s; VAR bool b; VAR num r;\n",
     )
@@ -174,7 +174,8 @@ def test_a_loop_in_another_routine_is_the_cycle_too():
     _, trace = run(
         "    Production;",
         decl="  PERS bool bRun := TRUE;\n",
-        extra="  PROC Production()\n    WHILE bRun DO\n      MoveJ p10, v1000, fine, tG;\n    ENDWHILE\n  ENDPROC\n",
+        extra="  PROC Production()\n    "
+        "    WHILE bRun DO\n      MoveJ p10, v1000, fine, tG;\n    ENDWHILE\n  ENDPROC\n",
     )
     assert trace.loop is not None and len(trace.motions) == 1
 
@@ -217,8 +218,10 @@ def test_no_main_lists_the_routines_that_move():
 
 def test_data_and_routines_are_found_across_modules():
     sysmod = parse_module(
-        "MODULE CellData(SYSMODULE)\n  PERS tooldata tPen := [TRUE,[[0,0,120],[1,0,0,0]],[0.5,[0,0,40],[1,0,0,0],0,0,0]];\n"
-        "  PROC Home()\n    MoveAbsJ [[0,0,0,0,30,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v1000, fine, tPen;\n  ENDPROC\n"
+        "MODULE CellData(SYSMODULE)\n  "
+        "  PERS tooldata tPen := [TRUE,[[0,0,120],[1,0,0,0]],[0.5,[0,0,40],[1,0,0,0],0,0,0]];\n"
+        "  PROC Home()\n    MoveAbsJ [[0,0,0,0,30,0],[9E9,9E9,9E9,9E9,9E9,9E9]], "
+        " v1000, fine, tPen;\n  ENDPROC\n"
         "ENDMODULE\n",
         path="cell.sys",
     )
@@ -238,7 +241,10 @@ def test_traps_and_error_handlers_are_not_run():
 
 
 def test_random_numbers_follow_the_seed_and_are_marked():
-    text = HEAD + "  VAR num r;\n  PROC main()\n    r := Rand();\n    MoveJ Offs(p10, 0, 0, r * 10), v100, fine, tG;\n  ENDPROC\nENDMODULE\n"
+    text = (
+        HEAD + "  VAR num r;\n  PROC main()\n    "
+        "    r := Rand();\n    MoveJ Offs(p10, 0, 0, r * 10), v100, fine, tG;\n  ENDPROC\nENDMODULE\n"
+    )
     task = Task((parse_module(text, path="t.mod"),), frozenset(), "t.mod")
     a = Interpreter(task, seed=3).run()
     b = Interpreter(task, seed=3).run()
@@ -249,7 +255,8 @@ def test_random_numbers_follow_the_seed_and_are_marked():
 def test_the_cycle_starts_with_the_settings_a_turn_leaves():
     _, trace = run(
         "    AccSet 100, 100;\n    WHILE TRUE DO\n      MoveJ p10, v1000, z10, tG;\n      AccSet 40, 20;\n"
-        "      MoveL Offs(p10,0,0,-50), v100, fine, tG;\n      AccSet 100, 100;\n      n := n + 1;\n    ENDWHILE",
+        "      MoveL Offs(p10,0,0,-50), v100, fine, tG;\n      "
+        "      AccSet 100, 100;\n      n := n + 1;\n    ENDWHILE",
         decl="  VAR num n;\n",
     )
     first, second = trace.motions

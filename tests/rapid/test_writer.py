@@ -8,7 +8,14 @@ import pytest
 
 from joulepath.rapid.interpreter import Interpreter
 from joulepath.rapid.task import load_task
-from joulepath.rapid.writer import Edit, apply_edits, insert_before, original_bytes, replace_argument, set_optional
+from joulepath.rapid.writer import (
+    Edit,
+    apply_edits,
+    insert_before,
+    original_bytes,
+    replace_argument,
+    set_optional,
+)
 
 MAIN = (
     "MODULE Hauptmodul\r\n"
@@ -24,7 +31,7 @@ MAIN = (
 USER = (
     "MODULE Zelldaten(SYSMODULE)\n"
     "  PERS tooldata tGreifer := [TRUE,[[0,0,100],[1,0,0,0]],[1,[0,0,50],[1,0,0,0],0,0,0]];\n"
-    "  PERS wobjdata wTisch := [FALSE,TRUE,\"\",[[0,0,0],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];\n"
+    '  PERS wobjdata wTisch := [FALSE,TRUE,"",[[0,0,0],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];\n'
     "ENDMODULE\n"
 )
 

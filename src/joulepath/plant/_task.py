@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from joulepath.errors import InvalidInput, JoulepathError
+from joulepath.errors import JoulepathError
 from joulepath.plant._idle import EnergySplit, mode_saving, split_energy
 
 REPORT_MEASURE = "electrical"
@@ -27,10 +27,6 @@ REPORT_MEASURE = "electrical"
 RETURNED_FILES = ("cycle.json", "optimized.mod")
 """Files of a cell's run that come back with its result; ``cycle_path.csv`` (every sample of the
 plan) does not: ``joulepath cycle`` on the cell's program writes it for an EGM stream."""
-
-
-class Unsupported(InvalidInput):
-    """A program this reader cannot read yet (not cached: a later joulepath may read it)."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -84,22 +80,14 @@ def cycle_settings(settings: Mapping[str, Any]) -> Any:
 
 
 def _read_program(task: CellTask, robot: Any, idle_waits: list[int]) -> tuple[Any, bool]:
-    """The program's cycle (the real-programs reader). Today's reader reads one module; a task
-    of several modules, an I/O scenario or another entry routine wait for the RAPID interpreter."""
+    """The program's cycle: the task's modules run by the RAPID interpreter, with the cell's I/O
+    scenario and entry routine."""
     from joulepath.program import read_cycle_program
 
-    if len(task.program) != 1:
-        raise Unsupported(
-            f"{len(task.program)} modules: multi-module tasks need the RAPID interpreter (this joulepath "
-            "reads one module per program)"
-        )
-    if task.io:
-        raise Unsupported("an I/O scenario (io) needs the RAPID interpreter (this joulepath reads none)")
-    if task.routine not in (None, "main"):
-        raise Unsupported(
-            f"entry routine {task.routine!r}: another routine than main needs the RAPID interpreter"
-        )
-    return read_cycle_program(task.program[0], robot, idle_waits=idle_waits)
+    routine = None if task.routine in (None, "main") else task.routine
+    return read_cycle_program(
+        list(task.program), robot, idle_waits=idle_waits, io=dict(task.io) or None, routine=routine
+    )
 
 
 def _split(robot: Any, traj: Any, cycle_time: float, measure: str) -> EnergySplit:
@@ -174,8 +162,6 @@ def run_cell(task: CellTask) -> dict[str, Any]:
     try:
         with threadpool_limits(limits=1):
             body = _run(task)
-    except Unsupported as err:
-        body = {"status": "failed", "reason": str(err), "cacheable": False}
     except JoulepathError as err:
         body = {"status": "failed", "reason": f"{type(err).__name__}: {err}", "cacheable": True}
     except Exception as err:  # a bug: recorded with its place, retried on the next run

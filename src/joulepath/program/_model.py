@@ -10,11 +10,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from joulepath.errors import InvalidInput
-from joulepath.sim._steps import SpeedData
-
-
 from joulepath.rapid import RapidError  # noqa: E402  (one definition: the RAPID language's)
+from joulepath.sim._steps import SpeedData
 
 __all__ = ["RapidError"]
 

@@ -50,7 +50,6 @@ from joulepath.program._parse import (
     TOOL0,
     WOBJ0,
     parse_module,
-    read_module,
 )
 from joulepath.sim._steps import SpeedData, Step
 
@@ -641,11 +640,16 @@ def _mark_idle(tc: object, idle_waits: Collection[int]) -> tuple[Step, ...]:
 
     assert isinstance(tc, TaskCycle)
     lines = set(idle_waits)
-    waits = {st.line for st in tc.steps if st.kind == "wait" and isinstance(st.statement, Wait) and not st.statement.io}
+    waits = {
+        st.line
+        for st in tc.steps
+        if st.kind == "wait" and isinstance(st.statement, Wait) and not st.statement.io
+    }
     for line in sorted(lines):
         if line not in waits:
             raise RapidError(
-                f"{tc.task.source}:{line}: idle_waits names line {line}, which is not a WaitTime the cycle runs; "
+                f"{tc.task.source}:{line}: idle_waits names line {line}, "
+                f"which is not a WaitTime the cycle runs; "
                 "name the line of a WaitTime (or mark it '! joulepath: idle')"
             )
     out = []

@@ -173,8 +173,10 @@ def read_task_cycle(
     """
     if robot.n_joints != RAPID_AXES:
         raise RapidError(
-            f"{', '.join(map(str, paths))}: a RAPID program drives a {RAPID_AXES}-axis ABB arm, but this robot "
-            f"has {robot.n_joints} joints; give a {RAPID_AXES}-joint robot, or write the cycle as a plain cycle "
+            f"{', '.join(map(str, paths))}: a RAPID program drives a {RAPID_AXES}-axis ABB arm, "
+            "but this robot "
+            f"has {robot.n_joints} joints; give a {RAPID_AXES}-joint robot, "
+            "or write the cycle as a plain cycle "
             "file (.toml)"
         )
     try:
@@ -205,7 +207,9 @@ def read_task_cycle(
     notes = list(trace.notes)
     for k in unused:
         notes.append(f"--io {k}: the cycle never read it")
-    trace = Trace(trace.events, trace.cycle_start, trace.cycle_end, tuple(notes), trace.routine, trace.loop, trace.steps)
+    trace = Trace(
+        trace.events, trace.cycle_start, trace.cycle_end, tuple(notes), trace.routine, trace.loop, trace.steps
+    )
     return TaskCycle(task, trace, steps, kept)
 
 

@@ -77,7 +77,9 @@ def read_module_file(path: str | Path) -> n.Module:
     return parse_module(text, path=str(p), encoding=encoding, newline=newline)
 
 
-def parse_module(text: str, *, path: str = "<text>", encoding: str = "utf-8", newline: str = "\n") -> n.Module:
+def parse_module(
+    text: str, *, path: str = "<text>", encoding: str = "utf-8", newline: str = "\n"
+) -> n.Module:
     """Parse a module's text (line ends ``\\n``) into a :class:`~joulepath.rapid.nodes.Module`."""
     source = _blank_header(text)
     try:
@@ -101,14 +103,17 @@ def _syntax_message(err: lark.exceptions.UnexpectedInput, text: str, path: str) 
             if prev:
                 return f"{path}:{prev.count(chr(10)) + 1}: the statement ends without ';'; add it"
         if tok.type == "$END":
-            return f"{path}:{line}: the text ends inside a declaration or routine; close it (ENDPROC, ENDMODULE)"
+            return (
+                f"{path}:{line}: the text ends inside a declaration or routine; close it (ENDPROC, ENDMODULE)"
+            )
         expected = sorted(e.lstrip("_") for e in err.expected)[:6]
         return (
             f"{path}:{line}: syntax error at {str(tok)!r}: RAPID expects {', '.join(expected)} here; "
             "correct the statement"
         )
     if isinstance(err, lark.exceptions.UnexpectedCharacters):
-        ch = text[err.pos_in_stream] if 0 <= err.pos_in_stream < len(text) else "?"
+        at = err.pos_in_stream if err.pos_in_stream is not None else -1
+        ch = text[at] if 0 <= at < len(text) else "?"
         return f"{path}:{line}: {ch!r} is not RAPID here; correct the statement"
     return f"{path}:{line}: not RAPID text; give a RAPID module (MODULE name ... ENDMODULE)"
 
@@ -157,9 +162,7 @@ class _Builder(lark.Transformer[Any, Any]):
         return n.Pos(self.path, meta.line, meta.end_line, meta.start_pos, meta.end_pos)
 
     def _tpos(self, tok: lark.Token) -> n.Pos:
-        return n.Pos(
-            self.path, tok.line or 0, tok.end_line or 0, tok.start_pos or 0, tok.end_pos or 0
-        )
+        return n.Pos(self.path, tok.line or 0, tok.end_line or 0, tok.start_pos or 0, tok.end_pos or 0)
 
     def __default__(self, data: Any, children: Any, meta: Any) -> Any:  # pragma: no cover - grammar bug
         raise AssertionError(f"no builder for {data}")

@@ -48,11 +48,10 @@ from joulepath.rapid.values import (
     NUM_TYPES,
     SIGNAL_TYPES,
     Array,
-    Opaque,
     Record,
     Signal,
-    Types,
     TypeErrorRapid,
+    Types,
     Value,
     describe,
     equal,
@@ -74,8 +73,8 @@ MAX_DEPTH = 100
 MAX_LOOP_TURNS = 200_000
 """Turns one loop may take."""
 
-SPEEDS = (5, 10, 20, 30, 40, 50, 60, 80, 100, 150, 200, 300, 400, 500, 600, 800, 1000, 1500, 2000)
-SPEEDS += (2500, 3000, 4000, 5000, 6000, 7000)
+SPEEDS: tuple[int, ...] = (5, 10, 20, 30, 40, 50, 60, 80, 100, 150, 200, 300, 400, 500, 600, 800, 1000)
+SPEEDS += (1500, 2000, 2500, 3000, 4000, 5000, 6000, 7000)
 ZONES = (0, 1, 5, 10, 15, 20, 30, 40, 50, 60, 80, 100, 150, 200)
 
 JOINT_MOTIONS = {"movej": "MoveJ", "movejdo": "MoveJ", "movejsync": "MoveJ", "triggj": "MoveJ"}
@@ -415,7 +414,11 @@ def _predefined(types: Types) -> dict[str, Cell]:
     for k in range(1, 6):
         put(f"reg{k}", "num", 0.0, "VAR")
     for pct in (20, 50, 100):  # ABB's in-position stop point data: position and speed in % of fine
-        put(f"inpos{pct}", "stoppointdata", (1.0, False, float(pct), float(pct), 0.0, 20.0, 0.0, 0.0, "", 0.0, 0.0))
+        put(
+            f"inpos{pct}",
+            "stoppointdata",
+            (1.0, False, float(pct), float(pct), 0.0, 20.0, 0.0, 0.0, "", 0.0, 0.0),
+        )
     for name, value in (("pi", math.pi),):
         put(name, "num", value)
     return out
@@ -483,7 +486,9 @@ class Interpreter:
             for r in m.records:
                 key = r.name.lower()
                 if key in self.types.records:
-                    raise RapidError(f"{r.pos}: the record type {r.name} is defined twice; keep one definition")
+                    raise RapidError(
+                        f"{r.pos}: the record type {r.name} is defined twice; keep one definition"
+                    )
                 self.types.records[key] = tuple((ft, fn.lower()) for ft, fn in r.fields)
             for a in m.aliases:
                 self.types.aliases[a.name.lower()] = a.type.lower()
@@ -503,7 +508,9 @@ class Interpreter:
                 if d.scope == "LOCAL":
                     self.locals_of[mkey][key] = (d, m)
                     continue
-                if key in self.globals and not (d.storage == "PERS" and self.globals[key][0].storage == "PERS"):
+                if key in self.globals and not (
+                    d.storage == "PERS" and self.globals[key][0].storage == "PERS"
+                ):
                     raise RapidError(
                         f"{d.pos}: {d.name} is also declared at {where[key]}; a task's global names are "
                         "unique: rename one or make it LOCAL"
@@ -519,7 +526,8 @@ class Interpreter:
                 if key in self.routines:
                     other = self.routines[key][0]
                     raise RapidError(
-                        f"{r.pos}: routine {r.name} is also declared at {other.pos}; rename one or make it LOCAL"
+                        f"{r.pos}: routine {r.name} is also declared at {other.pos}; "
+                        "rename one or make it LOCAL"
                     )
                 self.routines[key] = (r, m)
 
@@ -576,7 +584,9 @@ class Interpreter:
         for m in self.task.modules:
             for node in _expressions(m):
                 first = (
-                    next((a for a in node.args if a.kind == "pos"), None) if isinstance(node, n.FuncCall) else None
+                    next((a for a in node.args if a.kind == "pos"), None)
+                    if isinstance(node, n.FuncCall)
+                    else None
                 )
                 if isinstance(node, n.FuncCall) and node.name.lower() in io_funcs and first is not None:
                     v = first.value
@@ -807,7 +817,9 @@ class Interpreter:
                 self.note(f"{e.pos}: {op} of a stand-in value fails ({err}); its result is assumed 0")
                 return 0.0, taint
             why = "division by zero" if isinstance(err, ZeroDivisionError) else str(err)
-            raise RapidError(f"{e.pos}: {describe(a)} {op} {describe(b)}: {why}; correct the expression") from None
+            raise RapidError(
+                f"{e.pos}: {describe(a)} {op} {describe(b)}: {why}; correct the expression"
+            ) from None
 
     def ref(self, e: n.Expr) -> Cell | _Ref:
         if isinstance(e, n.Name):
@@ -831,7 +843,9 @@ class Interpreter:
                 except IndexError as err:
                     if not any(self.ev(i)[1] for i in e.indices):
                         raise RapidError(f"{e.pos}: {err}; correct the index") from None
-                    self.note(f"{e.pos}: an index from run-time data ({err} for its stand-in): element 1 assumed")
+                    self.note(
+                        f"{e.pos}: an index from run-time data ({err} for its stand-in): element 1 assumed"
+                    )
                     idx = [1] * len(cur.dims)
                 return _Ref(r.cell, (*r.path, ("idx", tuple(idx))))
             cur = r.get()
@@ -930,8 +944,14 @@ class Interpreter:
                 if isinstance(cur, Record):
                     value = self.types.coerce(v, cur.type)
                 elif isinstance(cur, (float, bool, str)):
-                    value = self.types.coerce(v, "num" if isinstance(cur, float) and not isinstance(cur, bool)
-                                              else "bool" if isinstance(cur, bool) else "string")
+                    value = self.types.coerce(
+                        v,
+                        "num"
+                        if isinstance(cur, float) and not isinstance(cur, bool)
+                        else "bool"
+                        if isinstance(cur, bool)
+                        else "string",
+                    )
                 ok = True
             except (RapidError, TypeErrorRapid):
                 ok = False
@@ -941,9 +961,7 @@ class Interpreter:
             r.set(cur, r.cell.taint | t)
         return ok, t
 
-    def builtin(
-        self, key: str, e: n.FuncCall, a: list[Value], opt: dict[str, Value]
-    ) -> tuple[Value, Taint]:
+    def builtin(self, key: str, e: n.FuncCall, a: list[Value], opt: dict[str, Value]) -> tuple[Value, Taint]:
         pos = e.pos
         t = self.types
         if key in _MATH:
@@ -979,7 +997,7 @@ class Interpreter:
             assert isinstance(p1, Record)
             m1 = geo.pose_matrix(p1)
             if key == "poseinv":
-                return geo.with_pose(p1, np.linalg.inv(m1)), CLEAN
+                return geo.with_pose(p1, np.asarray(np.linalg.inv(m1), dtype=float)), CLEAN
             if key == "posemult":
                 p2 = t.coerce(a[1], "pose")
                 assert isinstance(p2, Record)
@@ -994,10 +1012,10 @@ class Interpreter:
             sig = a[0]
             if not isinstance(sig, Signal):
                 raise TypeErrorRapid(f"needs an I/O signal, not {describe(sig)}")
-            v, taint = self.read_signal(sig, pos)
+            level, taint = self.read_signal(sig, pos)
             if key == "testdi":
-                return (num(v) == 1.0), taint
-            return v, taint
+                return (num(level) == 1.0), taint
+            return level, taint
         if key == "rand":
             why = f"{pos}: Rand() is a random number (the run's seed {self.seed} gives the stand-in)"
             return float(self.rng.random()), frozenset({why})
@@ -1088,9 +1106,7 @@ class Interpreter:
         return q
 
     # ---- routines
-    def invoke(
-        self, r: n.Routine, m: n.Module, args: tuple[n.Arg, ...], pos: n.Pos
-    ) -> tuple[Value, Taint]:
+    def invoke(self, r: n.Routine, m: n.Module, args: tuple[n.Arg, ...], pos: n.Pos) -> tuple[Value, Taint]:
         if len(self.stack) >= MAX_DEPTH:
             raise RapidError(
                 f"{pos}: {r.name} calls itself deeper than {MAX_DEPTH} levels: a recursion that never ends; "
@@ -1171,7 +1187,11 @@ class Interpreter:
                 self.exec(s)
             except _Goto as g:
                 idx = next(
-                    (j for j, t in enumerate(body) if isinstance(t, n.Label) and t.name.lower() == g.label.lower()),
+                    (
+                        j
+                        for j, t in enumerate(body)
+                        if isinstance(t, n.Label) and t.name.lower() == g.label.lower()
+                    ),
                     None,
                 )
                 if idx is None:
@@ -1225,8 +1245,10 @@ class Interpreter:
         elif isinstance(s, n.Exit):
             raise _Stop(f"{s.pos}: EXIT ends the program")
         elif isinstance(s, n.Raise):
-            self.note(f"{s.pos}: RAISE: an error raised while running is handled by the program's ERROR handler, "
-                      "which is not part of the cycle; the run goes on after it")
+            self.note(
+                f"{s.pos}: RAISE: an error raised while running is handled by the program's ERROR handler, "
+                "which is not part of the cycle; the run goes on after it"
+            )
         elif isinstance(s, n.LateCall):
             self.late_call(s)
         elif isinstance(s, (n.Label, n.Empty, n.DataDecl, n.Retry, n.TryNext)):
@@ -1278,13 +1300,17 @@ class Interpreter:
             elif isinstance(s, n.LateCall):
                 return True
             elif isinstance(s, n.If):
-                if any(self._has_motion(b, depth) for _, b in s.branches) or self._has_motion(s.orelse, depth):
+                if any(self._has_motion(b, depth) for _, b in s.branches) or self._has_motion(
+                    s.orelse, depth
+                ):
                     return True
             elif isinstance(s, (n.For, n.While)):
                 if self._has_motion(s.body, depth):
                     return True
             elif isinstance(s, n.Test):
-                if any(self._has_motion(b, depth) for _, b in s.cases) or self._has_motion(s.default or (), depth):
+                if any(self._has_motion(b, depth) for _, b in s.cases) or self._has_motion(
+                    s.default or (), depth
+                ):
                     return True
         return False
 
@@ -1300,7 +1326,10 @@ class Interpreter:
                 break
         if taint and not self._has_motion(chosen, 0):
             # decided at run time: the stand-in's branch does not move; assume the first that does
-            options = [(b, "THEN" if k == 0 else f"ELSEIF at line {c.pos.line}") for k, (c, b) in enumerate(s.branches)]
+            options = [
+                (b, "THEN" if k == 0 else f"ELSEIF at line {c.pos.line}")
+                for k, (c, b) in enumerate(s.branches)
+            ]
             options.append((s.orelse, "ELSE"))
             moving = next(((b, lab) for b, lab in options if self._has_motion(b, 0)), None)
             if moving is not None:
@@ -1310,7 +1339,9 @@ class Interpreter:
         elif not taint and not self.ctx_taint and not s.compact and self._has_motion((s,), 0):
             cond = s.branches[0][0]
             v, _ = self._condition(cond)
-            self.note(f"{s.pos}: IF {self.source_of(cond.pos)} ({'TRUE' if v else 'FALSE'}) -> {label} branch")
+            self.note(
+                f"{s.pos}: IF {self.source_of(cond.pos)} ({'TRUE' if v else 'FALSE'}) -> {label} branch"
+            )
         self._under(taint, lambda: self.exec_body(chosen), s)
 
     def exec_test(self, s: n.Test) -> None:
@@ -1329,7 +1360,9 @@ class Interpreter:
                 continue
             break
         if t and not self._has_motion(chosen, 0):
-            options = [(b, f"CASE at line {vs[0].pos.line}") for vs, b in s.cases] + [(s.default or (), "DEFAULT")]
+            options = [(b, f"CASE at line {vs[0].pos.line}") for vs, b in s.cases] + [
+                (s.default or (), "DEFAULT")
+            ]
             moving = next(((b, lab) for b, lab in options if self._has_motion(b, 0)), None)
             if moving is not None:
                 chosen, label = moving[0], moving[1] + " (assumed: the first branch that moves)"
@@ -1342,7 +1375,7 @@ class Interpreter:
     def exec_for(self, s: n.For) -> None:
         a, ta = self.ev(s.start)
         b, tb = self.ev(s.stop)
-        step, ts = (self.ev(s.step) if s.step is not None else (1.0, CLEAN))
+        step, ts = self.ev(s.step) if s.step is not None else (1.0, CLEAN)
         a, b, step = self._num(a, s.pos), self._num(b, s.pos), self._num(step, s.pos)
         if step == 0:
             raise RapidError(f"{s.pos}: FOR with STEP 0 never ends; give a step")
@@ -1416,15 +1449,14 @@ class Interpreter:
                 return
             if t:
                 if not self.ctx_taint:
-                    self.note(
-                        f"{s.pos}: WHILE decided at run time: {'; '.join(sorted(t))} -> one turn taken"
-                    )
+                    self.note(f"{s.pos}: WHILE decided at run time: {'; '.join(sorted(t))} -> one turn taken")
                 self._under(t, lambda: self.exec_body(s.body), s)
                 return
             turns += 1
             if turns > MAX_LOOP_TURNS:
                 raise RapidError(
-                    f"{s.pos}: WHILE runs more than {MAX_LOOP_TURNS} turns without its condition turning FALSE; "
+                    f"{s.pos}: WHILE runs more than {MAX_LOOP_TURNS} turns "
+                    "without its condition turning FALSE; "
                     "give the inputs it waits for (--io) or check the condition"
                 )
             self.exec_body(s.body)
@@ -1432,7 +1464,9 @@ class Interpreter:
     def late_call(self, s: n.LateCall) -> None:
         v, t = self.ev(s.target)
         if not isinstance(v, str):
-            raise RapidError(f"{s.pos}: late binding needs a string (the procedure's name), not {describe(v)}")
+            raise RapidError(
+                f"{s.pos}: late binding needs a string (the procedure's name), not {describe(v)}"
+            )
         if t and not self.ctx_taint:
             self.note(f"{s.pos}: the procedure {v!r} is chosen at run time: {'; '.join(sorted(t))}")
         call = n.Call(s.pos, v, s.args)
@@ -1492,8 +1526,12 @@ class Interpreter:
             args, _ = self._args(s.args, raw_first=True)
             if args and isinstance(args[0][0], Signal):
                 sig = args[0][0]
-                value: Value = 1.0 if key in ("set", "pulsedo") else 0.0 if key == "reset" else (
-                    args[1][0] if len(args) > 1 else 0.0
+                value: Value = (
+                    1.0
+                    if key in ("set", "pulsedo")
+                    else 0.0
+                    if key == "reset"
+                    else (args[1][0] if len(args) > 1 else 0.0)
                 )
                 self.outputs[sig.name.lower()] = value if key != "pulsedo" else 0.0
             self.events.append(Action(s, s.name, ctx))
@@ -1588,7 +1626,9 @@ class Interpreter:
         for _, t in args:
             taint |= t
         if taint:
-            self.note(f"{s.pos}: {s.name} takes values known only at run time; the values it holds now assumed")
+            self.note(
+                f"{s.pos}: {s.name} takes values known only at run time; the values it holds now assumed"
+            )
         st = self.settings
         vals = [self._signal_value(v, s.pos) for v, _ in args]
         if key == "accset":
@@ -1599,7 +1639,9 @@ class Interpreter:
         elif key == "velset":
             ov, vmax = self._num(vals[0], s.pos), self._num(vals[1], s.pos)
             if not (0 < ov <= 100) or vmax <= 0:
-                raise RapidError(f"{s.pos}: VelSet {ov:g}, {vmax:g}: the override is 1 to 100 %, the max above 0")
+                raise RapidError(
+                    f"{s.pos}: VelSet {ov:g}, {vmax:g}: the override is 1 to 100 %, the max above 0"
+                )
             st = replace(st, vel_override_pct=ov, vel_max_mm_s=vmax)
         elif key == "gripload":
             load = self.types.coerce(vals[0], "loaddata")
@@ -1608,7 +1650,7 @@ class Interpreter:
             st = replace(st, grip_load=load if num(load.get("mass")) > 0 else None, grip_load_name=name)
         elif key in ("confj", "confl"):
             on = "off" not in opt
-            st = replace(st, **{"conf_j" if key == "confj" else "conf_l": on})
+            st = replace(st, conf_j=on) if key == "confj" else replace(st, conf_l=on)
         elif key == "singarea":
             mode = next((k for k in ("wrist", "lockaxis4", "off") if k in opt), "off")
             st = replace(st, sing_area=mode.capitalize())
@@ -1681,13 +1723,18 @@ class Interpreter:
                     tool, tool_t, tool_name = v, t, text
         args_opt = {a.name.lower(): a for a in s.args if a.kind == "opt" and a.name}
         if not targets or speed is None or tool is None or (zone is None and key not in SEARCH_MOTIONS):
-            missing = "a target" if not targets else "a speeddata" if speed is None else (
-                "a tooldata" if tool is None else "a zonedata"
+            missing = (
+                "a target"
+                if not targets
+                else "a speeddata"
+                if speed is None
+                else ("a tooldata" if tool is None else "a zonedata")
             )
             raise RapidError(f"{s.pos}: {s.name} needs {missing}; correct the instruction")
         if zone is None:
-            zone = self.predefined["fine"].value
-            assert isinstance(zone, Record)
+            fine = self.predefined["fine"].value
+            assert isinstance(fine, Record)
+            zone = fine
         if kind == "circular" and len(targets) < 2:
             raise RapidError(f"{s.pos}: {s.name} needs a circle point and a target; correct the instruction")
         wobj = self.predefined["wobj0"].value
@@ -1726,7 +1773,8 @@ class Interpreter:
                 norm = math.sqrt(sum(v * v for v in q))
                 if abs(norm - 1.0) > 1e-3:
                     raise RapidError(
-                        f"{s.pos}: {text}: its orientation {list(q)} is not a unit quaternion (norm {norm:.4g}); "
+                        f"{s.pos}: {text}: its orientation {list(q)} is not a unit quaternion "
+                        f"(norm {norm:.4g}); "
                         "correct it (or NOrient it)"
                     )
         kept = set(taint | start_taint | target_t | speed_t | zone_t | tool_t | wobj_t)
@@ -1737,7 +1785,9 @@ class Interpreter:
         if key in SEARCH_MOTIONS:
             kept.add(f"{s.pos}: {s.name} stops where its signal comes: its end is known only at run time")
         if bool(wobj.get("robhold")) and bool(tool.get("robhold")):
-            raise RapidError(f"{s.pos}: both the tool and the work object are held by the robot; one must stand")
+            raise RapidError(
+                f"{s.pos}: both the tool and the work object are held by the robot; one must stand"
+            )
         if str(wobj.get("ufmec")).strip() or not bool(wobj.get("ufprog")):
             kept.add(f"{s.pos}: the work object {wobj_name} moves with a mechanical unit (coordinated)")
         process = s.name if key in PROCESS_LINEAR or key in PROCESS_CIRCULAR else None
@@ -1815,11 +1865,14 @@ class Interpreter:
                 f"{r.pos}: {r.name} is a {r.kind} with required parameters; give a PROC that runs on its own"
             )
         for k in self.io:
-            if k not in self.signals_used and k not in self.globals and not any(
-                k in loc for loc in self.locals_of.values()
+            if (
+                k not in self.signals_used
+                and k not in self.globals
+                and not any(k in loc for loc in self.locals_of.values())
             ):
                 raise RapidError(
-                    f"--io {k}: the program reads no signal or data of that name; give a name the program uses"
+                    f"--io {k}: the program reads no signal or data of that name; "
+                    "give a name the program uses"
                 )
         self.stack = [_Frame(None, m, {}, set(), m.name)]
         limit = sys.getrecursionlimit()
@@ -1830,22 +1883,41 @@ class Interpreter:
             if self.cycle_end is None:
                 self.note(stop.why)
         except _Goto as g:
-            raise RapidError(f"{g.pos}: GOTO {g.label}: no such label in the routine; add the label") from None
+            raise RapidError(
+                f"{g.pos}: GOTO {g.label}: no such label in the routine; add the label"
+            ) from None
         except _Return:
             pass
         finally:
             sys.setrecursionlimit(limit)
         end = self.cycle_end if self.cycle_end is not None else len(self.events)
-        return Trace(tuple(self.events), self.cycle_start, end, tuple(self.notes), r.name, self.loop, self.steps)
+        return Trace(
+            tuple(self.events), self.cycle_start, end, tuple(self.notes), r.name, self.loop, self.steps
+        )
 
 
 # ------------------------------------------------------------------ helpers
 _ALL_MOTIONS = (
-    set(JOINT_MOTIONS) | set(LINEAR_MOTIONS) | set(CIRCULAR_MOTIONS) | set(ABSJ_MOTIONS)
-    | PROCESS_LINEAR | PROCESS_CIRCULAR | set(SEARCH_MOTIONS)
+    set(JOINT_MOTIONS)
+    | set(LINEAR_MOTIONS)
+    | set(CIRCULAR_MOTIONS)
+    | set(ABSJ_MOTIONS)
+    | PROCESS_LINEAR
+    | PROCESS_CIRCULAR
+    | set(SEARCH_MOTIONS)
 )
 _STANDIN_RESULT: dict[str, Value] = {
-    k: "" for k in ("strpart", "numtostr", "dnumtostr", "valtostr", "booltostr", "bytetostr", "strmap", "stroneupper")
+    k: ""
+    for k in (
+        "strpart",
+        "numtostr",
+        "dnumtostr",
+        "valtostr",
+        "booltostr",
+        "bytetostr",
+        "strmap",
+        "stroneupper",
+    )
 } | {"strmemb": False, "strorder": False}
 _SIGNAL_FUNCS = {"dinput", "doutput", "ginput", "goutput", "ainput", "aoutput", "testdi", "validio"}
 

@@ -52,9 +52,7 @@ def load_task(paths: Sequence[str | Path]) -> Task:
     for raw in paths:
         p = Path(raw)
         if p.is_dir():
-            found = sorted(
-                f for f in p.rglob("*") if f.is_file() and f.suffix.lower() in MODULE_SUFFIXES
-            )
+            found = sorted(f for f in p.rglob("*") if f.is_file() and f.suffix.lower() in MODULE_SUFFIXES)
             eio.extend(sorted(f for f in p.rglob("*") if f.is_file() and f.name.lower() == "eio.cfg"))
             if not found:
                 raise RapidError(f"{p}: the folder holds no RAPID module (.mod, .sys); give a task's folder")
@@ -65,9 +63,13 @@ def load_task(paths: Sequence[str | Path]) -> Task:
             else:
                 files.append(p)
         else:
-            raise RapidError(f"{p}: no such file or folder; give a module file (.mod, .sys) or a task's folder")
+            raise RapidError(
+                f"{p}: no such file or folder; give a module file (.mod, .sys) or a task's folder"
+            )
     if len(files) > MAX_MODULES:
-        raise RapidError(f"{len(files)} module files: a task holds at most {MAX_MODULES}; give one task's modules")
+        raise RapidError(
+            f"{len(files)} module files: a task holds at most {MAX_MODULES}; give one task's modules"
+        )
     if not files:
         raise RapidError("only an I/O configuration was given: add the task's modules (.mod, .sys)")
     unique: list[Path] = []

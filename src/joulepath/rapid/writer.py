@@ -86,7 +86,8 @@ def replace_argument(call: n.Call, index: int, text: str) -> Edit:
 
 
 def set_optional(module: n.Module, call: n.Call, name: str, value: str | None, after: int) -> Edit | None:
-    """``\\name:=value`` set (``value`` None: removed) on a call; added after positional argument ``after``."""
+    """``\\name:=value`` set (``value`` None: removed) on a call; added after
+    positional argument ``after``."""
     cur = _opt(call, name)
     if cur is not None:
         start = cur.pos.start

@@ -210,7 +210,8 @@ def arc_points(p0: FloatArray, pv: FloatArray, p1: FloatArray, s: FloatArray, wh
     nn = float(normal @ normal)
     if nn < 1e-14 or min(np.linalg.norm(a), np.linalg.norm(b), np.linalg.norm(p1 - pv)) < 1e-4:
         raise InvalidInput(
-            f"{where}: the start, circle point and target lie on one line or too close (< 0.1 mm): no circle; "
+            f"{where}: the start, circle point and target lie on one line or too close (< 0.1 mm): "
+            "no circle; "
             "move the circle point"
         )
     center = p0 + (np.cross(normal, a) * float(b @ b) + np.cross(b, normal) * float(a @ a)) / (2.0 * nn)
