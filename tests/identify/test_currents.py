@@ -335,7 +335,8 @@ def test_a_weak_joint_takes_the_data_sheet_k_or_is_refused_without_a_prior(plant
     sheet.mkdir()
     (sheet / "ur.irml").write_text(irml_string(ur10e()))
     (sheet / "ur.drives.toml").write_text(
-        f"torque_constant = {list(K * 1.02)}\nresistance = {list(R)}\n"
+        f"torque_constant = {[float(v) for v in K * 1.02]}\nresistance = {list(R)}\n"
+        'drive_efficiency = 0.95\nbus = "bleeder"\n'
         '[sources]\ntorque_constant = "data sheet of the test drives"\n'
     )
     gains = fit_drive_gains(data, joulepath.load_robot(sheet / "ur.irml"))
