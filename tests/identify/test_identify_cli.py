@@ -73,6 +73,35 @@ def test_optimize_on_the_twin_is_verified_on_the_lab_robot(twin, tmp_path, capsy
     assert like_for_like < mixed
     assert set(on_twin["energies"]) == {"thesis", "mechanical", "electrical"}
     assert "drives" in on_twin["energies"]["electrical"]["source"]
+    # read as a user reads result.json: the headline pairs are all on the run's measure, and the
+    # twin's planned energies compare with the lab robot's on it (the mixed pair is deprecated)
+    assert_paired(on_twin)
+    assert "mechanical" in on_twin["deprecated_keys"]["energy_default_lab_J"]
+    vs = on_twin["energy_figures"]["planned_vs_lab"]
+    assert vs["measure"] == on_twin["energy_measure"] == "thesis"
+    assert abs(on_twin["planned_default_J"] / on_twin["lab_default_J"] - 1) <= 0.02
+    assert abs(on_twin["planned_optimized_J"] / on_twin["lab_optimized_J"] - 1) <= 0.02
+    assert abs(on_twin["planned_saved_pct"] - on_twin["lab_saved_pct"]) <= 1.0
+    assert vs["saved_points"] == pytest.approx(on_twin["planned_saved_pct"] - on_twin["lab_saved_pct"])
+
+
+def assert_paired(result):
+    """Every figure of result.json's energy blocks is one stage on one named measure."""
+    m = result["energy_measure"]
+    figures = result["energy_figures"]
+    assert figures["measure"] == m
+    for stage in ("planned", "lab", "executed"):
+        block = figures[stage]
+        if block is None:
+            continue
+        assert block["measure"] == m and block["on"]
+        for key in ("default_J", "optimized_J", "saved_pct"):
+            assert result[f"{stage}_{key}"] == pytest.approx(block[key])  # the headline keys, same figures
+    # the planned and lab stages are the per-measure block of the run's measure, model and lab alike
+    per_measure = result["energies"][m]
+    assert result["planned_default_J"] == pytest.approx(per_measure["default_J"])
+    assert result["lab_default_J"] == pytest.approx(per_measure["lab_default_J"])
+    assert result["lab_optimized_J"] == pytest.approx(per_measure["lab_optimized_J"])
 
 
 def test_identify_refuses_without_writing(twin, lab_log, tmp_path, capsys):

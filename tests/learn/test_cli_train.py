@@ -86,3 +86,63 @@ def test_train_reports_search_progress_as_numbers(tables, tmp_path):
     assert events[0] == ("par", "E", 0, 4) and events[-1] == ("par", "E", 4, 4)
     assert [e[2] for e in events] == [0, 1, 2, 3, 4]
     assert len([m for m in messages if re.match(r"par E: \d/4 candidates", m)]) == len(events)
+
+
+@pytest.fixture(scope="module")
+def generic_tables(tmp_path_factory):
+    """Generic joint logs (t, q, dq, tau, move in SI) of an arm joulepath is told nothing about,
+    ingested with the defaults (no --robot): the joint-only tables a user of another arm makes."""
+    import numpy as np
+
+    from joulepath.data import read_log
+
+    d = tmp_path_factory.mktemp("generic")
+    tables = {}
+    for name, n_moves, seed in (("train", 10, 5), ("test", 4, 6)):
+        sim = simulate(d / f"{name}-ctl.csv", plant="lab", n_moves=n_moves, seed=seed)
+        log = read_log(sim.log)
+        cols = ["t"] + [f"{p}{i}" for i in range(1, 7) for p in ("q", "dq", "tau")]
+        data = [log.t] + [a[:, i] for i in range(6) for a in (log.q, log.qd, log.tau)]
+        csv = d / f"{name}.csv"
+        np.savetxt(csv, np.column_stack(data), delimiter=",", header=",".join(cols), comments="", fmt="%.9g")
+        out = d / f"{name}.parquet"
+        assert main(["ingest", str(csv), "--out", str(out)]) == 0
+        tables[name] = out
+    return tables
+
+
+def test_train_a_generic_log_with_the_defaults(generic_tables, tmp_path, capsys):
+    """No robot known: the raw inputs, one line saying so, the held-out R² on stdout and the card."""
+    import json
+
+    import numpy as np
+
+    from joulepath.data import load_table
+    from joulepath.learn import NO_ROBOT_NOTE
+
+    assert load_table(generic_tables["train"]).robot is None
+    capsys.readouterr()
+    out = tmp_path / "models"
+    argv = ["train", "--data", str(generic_tables["train"]), "--test", str(generic_tables["test"])]
+    code = main([*argv, "--family", "par", "--cv", "2", "--out", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert captured.err.splitlines().count(NO_ROBOT_NOTE) == 1
+    assert "--robot" in NO_ROBOT_NOTE and "raw (thesis) inputs" in NO_ROBOT_NOTE
+    card = json.loads((out / "par-E" / "card.json").read_text())
+    assert card["inputs"] == "thesis" and card["inputs_reason"] == "default: no robot known"
+    header = next(line for line in captured.out.splitlines() if "test_r2" in line).split()
+    row = next(line for line in captured.out.splitlines() if line.split()[:2] == ["par", "E"]).split()
+    held_out = float(row[header.index("test_r2")])
+    assert held_out == pytest.approx(card["test"]["r2"], abs=1e-4)  # the card's held-out score, shown
+    assert np.isfinite(held_out) and held_out <= 1.0
+    assert card["test"]["n_moves"] == load_table(generic_tables["test"]).n_moves == 4
+
+
+def test_train_physics_inputs_without_a_robot_names_both_ways_out(generic_tables, tmp_path, capsys):
+    out = tmp_path / "models"
+    argv = ["train", "--data", str(generic_tables["train"]), "--test", str(generic_tables["test"])]
+    assert main([*argv, "--inputs", "physics", "--family", "par", "--cv", "2", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--robot" in err[0] and "--inputs thesis" in err[0], err
+    assert not out.exists()

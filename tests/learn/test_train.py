@@ -126,13 +126,14 @@ def test_default_inputs_train_on_a_seven_joint_table(seven_joint_tables, tmp_pat
     from joulepath.learn import train
 
     path, train_table, test_table = seven_joint_tables
-    assert train_table.n_joints == 7 and TrainConfig().inputs == "physics"
+    assert train_table.n_joints == 7 and TrainConfig().inputs is None  # physics: the robot is known
     config = TrainConfig(families=("par",), targets=("E",), cv=2, seed=0, robot=str(path))
     report = train(train_table, test_table, config, tmp_path / "m")
     card = json.loads((tmp_path / "m" / "par-E" / "card.json").read_text())
     assert (
         card["inputs"] == "physics" and card["robot_source"] == str(path) and "ddq7" in card["input_columns"]
     )
+    assert card["inputs_reason"] == "default: robot known"
     assert np.isfinite(report.results["test_r2"]).all()
     assert [b["label"] for b in report.baselines] == ["dynamics model, no friction"]
 
@@ -157,5 +158,25 @@ def test_train_refuses_a_table_without_robot_for_physics_inputs(seven_joint_tabl
 
     _, train_table, test_table = seven_joint_tables
     bare = replace(train_table, robot=None)
-    with pytest.raises(InvalidInput, match="the table names no robot"):
-        train(bare, test_table, TrainConfig(families=("par",), cv=2), tmp_path / "m")
+    config = TrainConfig(families=("par",), cv=2, inputs="physics")
+    with pytest.raises(InvalidInput, match=r"names none .* \(--robot, .*\(--inputs thesis\)"):
+        train(bare, test_table, config, tmp_path / "m")
+    assert not (tmp_path / "m").exists()
+
+
+def test_train_without_robot_defaults_to_the_raw_inputs(seven_joint_tables, tmp_path):
+    """No robot known: the thesis inputs, said in one progress line and recorded on the card."""
+    from dataclasses import replace
+
+    from joulepath.learn import NO_ROBOT_NOTE, train
+
+    _, train_table, test_table = seven_joint_tables
+    bare, bare_test = replace(train_table, robot=None), replace(test_table, robot=None)
+    said: list[str] = []
+    config = TrainConfig(families=("par",), cv=2)
+    report = train(bare, bare_test, config, tmp_path / "m", progress=said.append)
+    assert said.count(NO_ROBOT_NOTE) == 1
+    card = json.loads((tmp_path / "m" / "par-E" / "card.json").read_text())
+    assert card["inputs"] == "thesis" and card["inputs_reason"] == "default: no robot known"
+    assert card["robot_source"] is None and report.baselines == []
+    assert "dt" not in card["input_columns"]  # the raw features only

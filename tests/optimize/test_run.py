@@ -109,3 +109,37 @@ def test_optimize_move_refuses_start_outside_the_range(irb120):
         OptimizeConfig(algorithm="gradient", fitness="surrogate")
     with pytest.raises(InvalidInput, match="same configuration"):
         optimize_move(irb120, QF, QF, 1.0, OptimizeConfig())
+
+
+def test_result_json_pairs_each_figure_with_its_measure(result, irb120, tmp_path):
+    """Read as a user: each stage's pair is on the run's measure, the headline keys are those
+    figures, and the lab's are the lab robot's own energies of the two paths on that measure."""
+    from joulepath.optimize._verify import plant_measured
+    from joulepath.sim import make_plant
+
+    write_run(result, irb120, tmp_path)
+    r = json.loads((tmp_path / "result.json").read_text())
+    m = r["energy_measure"]
+    figures = r["energy_figures"]
+    assert m == "thesis" and figures["measure"] == m
+    stages = [s for s in ("planned", "lab", "executed") if figures[s] is not None]
+    assert stages[:2] == ["planned", "lab"]
+    for stage in stages:
+        assert figures[stage]["measure"] == m
+        for key in ("default_J", "optimized_J", "saved_pct"):
+            assert r[f"{stage}_{key}"] == pytest.approx(figures[stage][key])
+    lab = make_plant("lab", irb120)
+    for path, key in ((result.default, "lab_default_J"), (result.optimized, "lab_optimized_J")):
+        assert r[key] == pytest.approx(plant_measured(lab, path, measure=m).total_J, rel=1e-12)
+    assert r["planned_default_J"] == r["energy_default_J"] == pytest.approx(r["energies"][m]["default_J"])
+    # the old lab keys are on another measure: kept, and listed as deprecated with their measure
+    assert r["energy_default_lab_J"] == pytest.approx(r["energies"]["mechanical"]["lab_default_J"])
+    assert r["energy_default_lab_J"] != pytest.approx(r["lab_default_J"], rel=1e-6)
+    assert "mechanical" in r["deprecated_keys"]["energy_default_lab_J"]
+    assert {k for k in r["deprecated_keys"] if not k.startswith("executed_")} <= set(r)  # still written
+    vs = figures["planned_vs_lab"]
+    assert vs["default_pct"] == pytest.approx(100 * (r["planned_default_J"] / r["lab_default_J"] - 1))
+    if figures["executed"] is not None:  # path.mod written: the emulation on the model and the lab
+        x = figures["executed"]
+        assert x["default_J"] == pytest.approx(r["executed_energy_default_J"])
+        assert x["lab_default_J"] == pytest.approx(r["executed_lab_default_J"])

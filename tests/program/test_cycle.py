@@ -219,6 +219,18 @@ def test_cli_writes_a_program_that_reads_back(tmp_path, robot):
     assert main(["cycle", str(prog), "--out", str(out), *args, "--write-anyway"]) == 0
     data = json.loads((out / "cycle.json").read_text())
     assert data["saved_pct"] == pytest.approx(strict["saved_pct"])  # same plan either way
+    # every energy figure is one stage on the run's measure (read as a user reads cycle.json)
+    m, figures = data["energy_measure"], data["energy_figures"]
+    assert figures["measure"] == m
+    for stage in ("planned", "lab", "executed"):
+        assert figures[stage]["measure"] == m
+        for key in ("default_J", "optimized_J", "saved_pct"):
+            assert data[f"{stage}_{key}"] == pytest.approx(figures[stage][key])
+    assert data["planned_default_J"] == pytest.approx(data["energy_default_J"])
+    whole = data["energies"][m]  # the whole cycle, standby included where counted: the motion alone
+    assert data["lab_default_J"] == pytest.approx(whole["lab_default_J"] - whole["standby_J"])
+    assert data["executed_optimized_J"] == pytest.approx(data["executed_energy_J"])
+    assert "mechanical" in data["deprecated_keys"]["saved_lab_pct"]
     assert data["limits_ok"] and data["optimized_cycle_s"] <= data["target_cycle_s"] + 1e-9
     assert data["waits"] == [{"line": 11, "default_s": 0.2, "optimized_s": 0.0}]  # the idle wait
     assert data["kept_verbatim_lines"] == [14]

@@ -248,10 +248,10 @@ def cycle(
     if "optimized.mod" in files and saved.get("executed_saved_pct") is not None:
         console.print(
             f"optimized.mod, as the controller emulation runs it: cycle {saved['executed_cycle_s']:.3f} s "
-            f"(taught {result.default_cycle_s:.3f} s), {saved['executed_energy_J']:.2f} J per cycle on "
-            f"physics against the taught {result.default_energy_J:.2f} J: "
-            f"{saved['executed_saved_pct']:.1f} % saved ({saved['executed_saved_lab_pct']:.1f} % on the lab "
-            f"robot); its via points follow {saved['rapid_follows']}"
+            f"(taught {result.default_cycle_s:.3f} s), {saved['executed_optimized_J']:.2f} J per cycle on "
+            f"the model ({result.energy_measure} energy, motion) against the taught "
+            f"{saved['executed_default_J']:.2f} J: {saved['executed_saved_pct']:.1f} % saved; its via points "
+            f"follow {saved['rapid_follows']}"
         )
     layout = saved.get("rapid_structure")
     if "optimized.mod" in files and layout is not None:
@@ -268,29 +268,40 @@ def cycle(
                 f"re-teaching {target} asks to optimize line(s) {', '.join(map(str, again))} again (their "
                 "via points were planned from it): `joulepath cycle` on the re-taught optimized.mod does"
             )
+    lab_pct = saved.get("lab_saved_pct")
+    on_lab = "" if lab_pct is None else f", {lab_pct:.1f} % on the lab robot on the same measure"
     if "egm.mod" in files:
         console.print(
             f"egm.mod streams the plan (cycle_path.csv: {result.optimized_cycle_s:.3f} s, "
-            f"{result.optimized_energy_J:.2f} J on physics, {result.saved_pct:.1f} % saved, "
-            f"{result.saved_lab_pct:.1f} % on the lab robot): `joulepath stream {out} --repeat K`"
+            f"{result.optimized_energy_J:.2f} J on the model ({result.energy_measure} energy), "
+            f"{result.saved_pct:.1f} % saved{on_lab}): `joulepath stream {out} --repeat K`"
         )
     console.print(
         f"the plan: cycle {result.default_cycle_s:.3f} s -> {result.optimized_cycle_s:.3f} s; energy on "
-        f"physics ({result.energy_measure}, motion) {result.default_energy_J:.2f} -> "
-        f"{result.optimized_energy_J:.2f} J "
-        f"({result.saved_pct:.1f} % saved), on the lab robot {result.saved_lab_pct:.1f} % saved"
+        f"the model ({result.energy_measure}, motion) {result.default_energy_J:.2f} -> "
+        f"{result.optimized_energy_J:.2f} J ({result.saved_pct:.1f} % saved)"
+        + (
+            ""
+            if lab_pct is None
+            else f"; on the lab robot ({result.energy_measure}, motion) {saved['lab_default_J']:.2f} -> "
+            f"{saved['lab_optimized_J']:.2f} J ({lab_pct:.1f} % saved)"
+        )
         + (" (every unit kept as taught)" if len(result.taught_units) == len(opt.optimizable) else "")
     )
     for e in result.energies:
-        lab = "" if e.lab_saved_pct is None else f"; lab {e.lab_saved_pct:.1f} %"
+        lab = (
+            ""
+            if e.lab_saved_pct is None
+            else f"; lab {e.lab_default_J:.2f} J -> {e.lab_optimized_J:.2f} J, {e.lab_saved_pct:.1f} %"
+        )
         standby = (
             f", standby {e.standby_J:.1f} J included ({100 * e.standby_J / e.default_J:.0f} % of the default)"
             if e.standby_J and e.default_J > 0
             else ""
         )
         console.print(
-            f"  {e.measure:<10} (at the {e.stage}): {e.default_J:.2f} J -> {e.optimized_J:.2f} J per cycle, "
-            f"{e.saved_pct:.1f} % saved{lab}{standby}",
+            f"  {e.measure:<10} (at the {e.stage}): model {e.default_J:.2f} J -> {e.optimized_J:.2f} J per "
+            f"cycle, {e.saved_pct:.1f} % saved{lab}{standby}",
             markup=False,
         )
     if any(e.measure == "electrical" for e in result.energies):

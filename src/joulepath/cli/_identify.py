@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from joulepath.cli._common import check_out_folder, console, robot_inputs
+from joulepath.cli._common import check_out_folder, console, err_console, robot_inputs
 from joulepath.cli._robot import load_robot_for_cli, unchecked_option
 
 
@@ -75,6 +75,7 @@ def identify(
         identified_drives,
         identify_from_currents,
         logged_signal,
+        parameter_report,
         write_twin,
     )
     from joulepath.identify import identify as run
@@ -112,15 +113,21 @@ def identify(
             both = identify_from_currents(data, nominal, options, payload=payload)
         result, gains = both.identification, both.gains
         drives = identified_drives(gains, nominal.drives, nominal.n_joints)
-        write_twin(result, nominal, out, extra=both.card(), drives=drives)
+        write_twin(result, nominal, out, extra=both.card(), drives=drives, gains=gains)
+        for assumed in gains.assumed:
+            err_console.print(f"warning: {assumed.warning()}", markup=False)
         pairs = zip(gains.torque_constant, gains.relative_error, strict=True)
-        k = ", ".join(f"{v:.4g} ± {100 * e:.2g} %" for v, e in pairs)
+        k = ", ".join(
+            f"{v:.4g} (assumed)" if gains.status(j + 1) == "assumed" else f"{v:.4g} ± {100 * e:.2g} %"
+            for j, (v, e) in enumerate(pairs)
+        )
         console.print(f"drive gains k (N·m/A, joint side): {k}", markup=False)
         console.print(f"scale reference: {gains.reference} ({gains.reference_note})", markup=False)
     else:
         with console.status(f"identifying from {data.n_samples:,} samples..."):
             result = run(data, nominal, options)
         write_twin(result, nominal, out)
+        gains, drives = None, None
     f = result.fit
     what = "current" if signal == "current" else "torque"
     console.print(
@@ -139,6 +146,18 @@ def identify(
             f"energy R² {h.energy_r2:.4f}, energy error {h.energy_error_pct:.2f} %",
             markup=False,
         )
+    assumed_rows = [
+        f"joint {row['joint']}: {name}"
+        for row in parameter_report(result, gains=gains, drives=drives)
+        for name, entry in row.items()
+        if isinstance(entry, dict) and entry.get("status") == "assumed"
+    ]
+    console.print(
+        "assumed, not identified: "
+        + ("; ".join(assumed_rows) if assumed_rows else "nothing")
+        + f" (per joint and parameter: {out / TWIN_CARD_FILE}, 'parameters')",
+        markup=False,
+    )
     console.print(f"wrote {out}/: {', '.join(files)} (use it as --robot {out})")
     return 0
 

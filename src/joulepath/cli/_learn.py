@@ -10,7 +10,7 @@ from pathlib import Path
 
 import typer
 
-from joulepath.cli._common import check_out_folder, console
+from joulepath.cli._common import check_out_folder, console, err_console
 
 
 def _split(
@@ -50,7 +50,11 @@ def train(
     target: str = typer.Option("E", help="Targets: E, E1..En (comma separated) or all."),
     grid: str = typer.Option("quick", help="quick, or thesis (Tables 2.2-2.5)."),
     cv: int = typer.Option(5, min=2, help="Folds."),
-    inputs: str = typer.Option("physics", help="physics (raw + nominal model terms) or thesis (raw)."),
+    inputs: str = typer.Option(
+        "",
+        help="physics (raw + nominal model terms) or thesis (raw); "
+        "default: physics with a robot known (--robot or the table's), else thesis.",
+    ),
     out: Path = typer.Option(..., "--out", help="Folder for models and reports."),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
     jobs: int = typer.Option(1, min=1, help="Local processes for the grid search."),
@@ -64,7 +68,7 @@ def train(
     from joulepath.data import load_table, target_columns
     from joulepath.data._schema import MAX_JOINTS
     from joulepath.errors import InvalidInput
-    from joulepath.learn import FAMILIES, TrainConfig
+    from joulepath.learn import FAMILIES, NO_ROBOT_NOTE, TrainConfig
     from joulepath.learn import train as run
 
     check_out_folder(  # the names every training writes, before any work
@@ -75,7 +79,7 @@ def train(
         targets=_split(target, "--target", target_columns(MAX_JOINTS), target_columns(MAX_JOINTS)),
         grid=grid,
         cv=cv,
-        inputs=inputs,
+        inputs=inputs or None,
         seed=seed,
         n_jobs=jobs,
         scheduler=scheduler or None,
@@ -102,7 +106,14 @@ def train(
             f"give --cv {train_table.n_moves} or less, or a table of more moves"
         )
     with _progress_lines("training...") as say:
-        report = run(train_table, test_table, config, out, progress=say)
+
+        def tell(message: str) -> None:  # the choice of inputs stays on screen, the progress passes
+            if message == NO_ROBOT_NOTE:
+                err_console.print(message, markup=False)
+            else:
+                say(message)
+
+        report = run(train_table, test_table, config, out, progress=tell)
     cols = [
         "family",
         "target",

@@ -189,21 +189,27 @@ def optimize(
         console.print(f"REFUSED: {program} was NOT written: {why}")
         console.print(f"wrote {', '.join(sorted(files))} in {out}")
         return 1
+    import json
+
+    written = json.loads((out / "result.json").read_text())
+    figures = written["energy_figures"]
+    m = figures["measure"]
     plan = (
-        f"default path {s.energy_default_J:.3f} J, optimized {s.energy_optimized_J:.3f} J "
-        f"on physics ({s.energy_measure} energy): {s.saved_pct:.1f} % saved at equal cycle time "
+        f"planned on the model ({m} energy): default {s.energy_default_J:.3f} J, optimized "
+        f"{s.energy_optimized_J:.3f} J, {s.saved_pct:.1f} % saved at equal cycle time "
         f"({s.algorithm}, {s.iterations} iterations, {s.evaluations:,} evaluations, {s.wall_s:.2f} s); "
         f"within every limit; largest TCP deviation {s.max_tcp_deviation_mm:.1f} mm, "
         f"largest jerk {s.max_jerk_rad_s3:.0f} rad/s³"
     )
     if exporter.follows == "via-points":
-        import json
-
-        e = json.loads((out / "result.json").read_text())
+        e, x = written, figures["executed"]
+        lab_x = (
+            "" if x["lab_saved_pct"] is None else f", {x['lab_saved_pct']:.1f} % on the emulated lab robot"
+        )
         console.print(
-            f"{program} as the controller emulation runs it: {e['executed_saved_pct']:.1f} % saved on "
-            f"physics ({e['executed_energy_default_J']:.3f} J -> {e['executed_energy_optimized_J']:.3f} J), "
-            f"{e['executed_saved_lab_pct']:.1f} % on the emulated lab robot; the optimized move takes "
+            f"{program} as the controller emulation runs it ({m} energy): {x['saved_pct']:.1f} % saved on "
+            f"the model ({x['default_J']:.3f} J -> {x['optimized_J']:.3f} J){lab_x}; the optimized move "
+            "takes "
             f"{e['executed_duration_s']:.3f} s (planned {s.duration_s:g} s), {e['executed_via_points']} via "
             f"points, TCP within {e['executed_tcp_deviation_mm']:.1f} mm of the plan"
         )
@@ -212,19 +218,32 @@ def optimize(
         console.print(plan)
     if r.friction is None:
         console.print(f"physics: no friction modelled for {r.name}; friction: {r.friction_note}")
-    if s.saved_lab_pct is not None:
+    lab, vs = figures["lab"], figures["planned_vs_lab"]
+    if lab is not None and lab["saved_pct"] is not None:
         what = "the plan" if exporter.follows == "via-points" else "the optimized path"
-        measured = f"{s.energy_lab_measure} energy, what its torque log integrates to"
-        if s.lab_plant.startswith("emulated IRB 120"):
-            console.print(f"{what} on the emulated lab robot: {s.saved_lab_pct:.1f} % saved ({measured})")
-        else:
-            console.print(f"{what} on a {s.lab_plant}: {s.saved_lab_pct:.1f} % saved ({measured})")
-    for m in s.energies:
-        lab = "" if m.lab_saved_pct is None else f"; lab {m.lab_saved_pct:.1f} %"
-        standby = f", standby {m.standby_J:.3f} J included" if m.standby_J else ""
+        where = "the emulated lab robot" if s.lab_plant.startswith("emulated IRB 120") else f"a {s.lab_plant}"
+        off = (
+            ""
+            if vs is None or vs["default_pct"] is None
+            else f"; the model's figures {vs['default_pct']:+.2f} % (default) and "
+            f"{vs['optimized_pct']:+.2f} % (optimized) off the lab's, the saving "
+            f"{vs['saved_points']:+.2f} points"
+        )
         console.print(
-            f"  {m.measure:<10} (at the {m.stage}): {m.default_J:.3f} J -> {m.optimized_J:.3f} J, "
-            f"{m.saved_pct:.1f} % saved{lab}{standby}",
+            f"{what} on {where} ({m} energy): default {lab['default_J']:.3f} J, optimized "
+            f"{lab['optimized_J']:.3f} J, {lab['saved_pct']:.1f} % saved{off}",
+            markup=False,
+        )
+    for ms in s.energies:
+        on_lab = (
+            ""
+            if ms.lab_saved_pct is None
+            else f"; lab {ms.lab_default_J:.3f} J -> {ms.lab_optimized_J:.3f} J, {ms.lab_saved_pct:.1f} %"
+        )
+        standby = f", standby {ms.standby_J:.3f} J included" if ms.standby_J else ""
+        console.print(
+            f"  {ms.measure:<10} (at the {ms.stage}): model {ms.default_J:.3f} J -> {ms.optimized_J:.3f} J, "
+            f"{ms.saved_pct:.1f} % saved{on_lab}{standby}",
             markup=False,
         )
     for name in s.energies_unavailable:

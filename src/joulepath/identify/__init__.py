@@ -20,12 +20,15 @@ from joulepath.identify._currents import (
     MAX_GAIN_ERROR,
     NOMINAL_PRIOR_WEIGHT,
     REFERENCES,
+    UNFIXED_GAIN_ERROR,
+    AssumedGain,
     CurrentIdentification,
     DriveGainFit,
     PayloadReference,
     fit_drive_gains,
     identified_drives,
     identify_from_currents,
+    same_motor,
 )
 from joulepath.identify._data import SIGNALS, IdentificationData, data_from_logs, logged_signal
 from joulepath.identify._evaluate import (
@@ -63,9 +66,17 @@ from joulepath.identify._regressor import (
     inertial_regressor,
     true_parameters,
 )
-from joulepath.identify._twin import CARD_FORMAT, link_inertials, twin_description, twin_robot, write_twin
+from joulepath.identify._twin import (
+    CARD_FORMAT,
+    link_inertials,
+    parameter_report,
+    twin_description,
+    twin_robot,
+    write_twin,
+)
 
 __all__ = [
+    "AssumedGain",
     "BaseParameters",
     "CARD_FORMAT",
     "CurrentIdentification",
@@ -87,6 +98,7 @@ __all__ = [
     "RANK_TOLERANCE",
     "REFERENCES",
     "SIGNALS",
+    "UNFIXED_GAIN_ERROR",
     "base_parameters",
     "data_from_logs",
     "design_excitation",
@@ -104,9 +116,11 @@ __all__ = [
     "link_inertials",
     "logged_signal",
     "min_eigenvalues",
+    "parameter_report",
     "pseudo_inertia",
     "r2_per_joint",
     "read_drive_gains",
+    "same_motor",
     "score_prediction",
     "simulate_excitation",
     "to_log_cholesky",

@@ -7,7 +7,9 @@ and read back by :func:`joulepath.load_robot`:
   each link's identified mass, centre of mass and inertia (a payload logged with the
   robot is part of the last link; the description has no separate payload);
 * ``friction.json`` — identified friction and gear efficiency;
-* ``card.json`` — data hash, fit and held-out scores, condition number, base parameters;
+* ``card.json`` — data hash, fit and held-out scores, condition number, base parameters,
+  and ``parameters``: per joint and per parameter what the logs identified and what was
+  assumed or taken as given, with why and from where (:func:`parameter_report`);
 * ``drives.toml`` — only for a twin identified from motor currents: the identified
   joint-side torque constants and gear efficiency, the other drive data as the nominal
   robot's drives file gives them (:func:`joulepath.identify.identified_drives`), in
@@ -43,6 +45,7 @@ from joulepath.dynamics import (
 )
 from joulepath.energy import TWIN_DRIVES_FILE, DriveModel, drives_toml
 from joulepath.errors import InvalidInput
+from joulepath.identify._currents import DriveGainFit
 from joulepath.identify._fit import Identification
 
 CARD_FORMAT = "joulepath-twin-card/1"
@@ -108,6 +111,78 @@ def twin_robot(nominal: Robot, ident: Identification) -> Robot:
     )
 
 
+def parameter_report(
+    ident: Identification, *, gains: DriveGainFit | None = None, drives: DriveModel | None = None
+) -> list[dict[str, Any]]:
+    """Per joint and per parameter: what the logs identified, what was assumed, what was given.
+
+    Each parameter is a dict with ``status``: ``"identified"`` (from these logs),
+    ``"assumed"`` (the logs do not fix it; ``reason`` says why, ``prior`` where the value
+    comes from), ``"given"`` (not identifiable from positions and currents: taken from
+    ``source``, the drives file or an option) or ``"not modelled"``.
+
+    Parameters
+    ----------
+    ident : Identification
+    gains : DriveGainFit, optional
+        The drive gains of an identification from currents.
+    drives : DriveModel, optional
+        The twin's drive data (its sources say what is assumed).
+
+    Returns
+    -------
+    list of dict
+        One per joint: ``joint`` (1-based) and one entry per parameter.
+    """
+    f = ident.friction
+    n = f.n_joints
+    options = ident.options
+    eta_status = "given" if options.gear_efficiency is not None else "identified"
+    out: list[dict[str, Any]] = []
+    for j in range(n):
+        names = [b for b in ident.base.names if b.startswith(f"link{j + 1}.")]
+        row: dict[str, Any] = {
+            "joint": j + 1,
+            "inertia": {
+                "status": "identified" if names else "not identifiable",
+                "base_parameters": names,
+                "note": "the logs fix these base parameters of the link (combinations with the links "
+                "after it); what they leave open follows the nominal description",
+            },
+            "coulomb": {"status": "identified", "value": f.coulomb[j]},
+            "viscous": {"status": "identified", "value": f.viscous[j]},
+            "offset": (
+                {"status": "identified", "value": f.offset[j]}
+                if options.offset
+                else {"status": "not modelled", "value": 0.0}
+            ),
+            "stribeck": (
+                {"status": "identified", "value": f.stribeck[j], "speed": f.stribeck_speed}
+                if options.stribeck_speed
+                else {"status": "not modelled", "value": 0.0}
+            ),
+            "gear_efficiency": {"status": eta_status, "value": ident.gear_efficiency},
+        }
+        if gains is not None:
+            k = {"value": gains.torque_constant[j], "relative_error": gains.relative_error[j]}
+            assumed = next((a for a in gains.assumed if a.joint == j + 1), None)
+            row["torque_constant"] = (
+                {"status": "identified", **k}
+                if assumed is None
+                else {"status": "assumed", **k, "reason": assumed.reason, "prior": assumed.prior}
+            )
+        if drives is not None:
+            for key in ("resistance", "drive_efficiency"):
+                source = drives.source(key)
+                row[key] = {
+                    "status": "assumed" if source.lower().startswith("assumed") else "given",
+                    "value": float(getattr(drives, key)[j]),
+                    "source": source,
+                }
+        out.append(row)
+    return out
+
+
 def write_twin(
     ident: Identification,
     nominal: Robot,
@@ -115,11 +190,15 @@ def write_twin(
     *,
     extra: dict[str, Any] | None = None,
     drives: DriveModel | None = None,
+    gains: DriveGainFit | None = None,
 ) -> list[Path]:
     """Write the twin folder; refuses (before writing anything) files it may not replace.
 
     Returns the paths written. ``extra`` adds entries to the card; ``drives`` (identified
-    drive data) is written as the folder's ``drives.toml``.
+    drive data) is written as the folder's ``drives.toml``; the card's ``parameters``
+    (:func:`parameter_report`) say per joint what was identified and what assumed,
+    the torque constants' included when ``gains`` (of an identification from currents)
+    are given.
     """
     from joulepath.description import irml_string
 
@@ -136,6 +215,7 @@ def write_twin(
     make_folder(folder)
     assert robot.description is not None and robot.calibration is not None
     card = {"format": CARD_FORMAT, "twin_of": robot.calibration.twin_of, **ident.card(), **(extra or {})}
+    card["parameters"] = parameter_report(ident, gains=gains, drives=drives)
     atomic_write_text(paths[0], irml_string(robot.description))
     atomic_write_text(paths[1], json.dumps(robot.calibration.to_json(), indent=2) + "\n")
     atomic_write_text(paths[2], json.dumps(finite_json(card), indent=2, default=_jsonable) + "\n")
@@ -156,4 +236,12 @@ def _jsonable(value: Any) -> Any:
     raise TypeError(f"not JSON serializable: {type(value).__name__}")
 
 
-__all__ = ["CARD_FORMAT", "link_inertials", "load_name", "twin_description", "twin_robot", "write_twin"]
+__all__ = [
+    "CARD_FORMAT",
+    "link_inertials",
+    "load_name",
+    "parameter_report",
+    "twin_description",
+    "twin_robot",
+    "write_twin",
+]

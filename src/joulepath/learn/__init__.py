@@ -15,7 +15,15 @@ from joulepath.learn._importance import feature_importance, plot_importance, ran
 from joulepath.learn._model import TRUSTED_TYPES, EnergyModel
 from joulepath.learn._search import CandidateResult, SearchResult, grid_search, make_splits
 from joulepath.learn._svr import KERNEL_SVR_MAX_ROWS, ScalableSVR, SubsampleWarning
-from joulepath.learn._train import TrainConfig, TrainingReport, best_model, load_models, train
+from joulepath.learn._train import (
+    NO_ROBOT_NOTE,
+    TrainConfig,
+    TrainingReport,
+    best_model,
+    choose_inputs,
+    load_models,
+    train,
+)
 from joulepath.learn._validate import check_finite_predictions, read_joints_json
 
 __all__ = [
@@ -25,6 +33,7 @@ __all__ = [
     "GRIDS",
     "INPUTS",
     "KERNEL_SVR_MAX_ROWS",
+    "NO_ROBOT_NOTE",
     "PhysicsFeatures",
     "QUICK_GRIDS",
     "SUBSTITUTIONS",
@@ -38,6 +47,7 @@ __all__ = [
     "TrainingReport",
     "best_model",
     "check_finite_predictions",
+    "choose_inputs",
     "feature_importance",
     "grid_for",
     "grid_search",

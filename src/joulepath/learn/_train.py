@@ -51,8 +51,10 @@ class TrainConfig:
         Hyperparameter grids (``thesis``: Tables 2.2–2.5).
     cv : int
         Folds.
-    inputs : {"physics", "thesis"}
+    inputs : {"physics", "thesis"} or None
         Raw table features (``thesis``) or raw plus the nominal model's energy terms.
+        None (the default): ``physics`` when the robot of the data is known (``robot``
+        given, or the table names one), else ``thesis`` (:func:`choose_inputs`).
     seed : int
     n_jobs : int
         Local processes for the grid search.
@@ -68,7 +70,7 @@ class TrainConfig:
     targets: tuple[str, ...] = ("E",)
     grid: str = "quick"
     cv: int = 5
-    inputs: str = "physics"
+    inputs: str | None = None
     seed: int = 0
     n_jobs: int = 1
     scheduler: str | None = None
@@ -84,7 +86,7 @@ class TrainConfig:
             raise InvalidInput(f"targets {badt or '()'} unknown; use any of {', '.join(known)}")
         if self.grid not in GRIDS:
             raise InvalidInput(f"grid must be one of {GRIDS}, got {self.grid!r}")
-        if self.inputs not in INPUTS:
+        if self.inputs is not None and self.inputs not in INPUTS:
             raise InvalidInput(f"inputs must be one of {INPUTS}, got {self.inputs!r}")
         if self.cv < 2:
             raise InvalidInput(f"cv needs at least 2 folds, got {self.cv}")
@@ -100,7 +102,54 @@ class TrainingReport:
     models: dict[str, Path] = field(default_factory=dict)
 
 
-def _table_robot(table: EnergyTable, robot: str | None = None) -> tuple[str, Robot]:
+NO_ROBOT_NOTE = (
+    "no robot known (none given, the table names none): training on the raw (thesis) inputs; "
+    "give --robot for the grey-box physics inputs and the physics baselines"
+)
+"""The one line said when :func:`choose_inputs` falls back to the raw inputs."""
+
+
+def choose_inputs(inputs: str | None, table: EnergyTable, robot: str | None = None) -> tuple[str, str]:
+    """The inputs a training uses, and why, as ``(inputs, reason)``.
+
+    Parameters
+    ----------
+    inputs : {"physics", "thesis"} or None
+        The inputs asked for; None chooses: ``physics`` (raw plus the nominal
+        model's energy terms) when the robot of the data is known, ``thesis``
+        (the raw features) when it is not.
+    table : EnergyTable
+        The training table (:attr:`EnergyTable.robot` names its robot, if any).
+    robot : str or None
+        The robot given for the data.
+
+    Returns
+    -------
+    inputs : {"physics", "thesis"}
+    reason : str
+        ``"asked"``, ``"default: robot known"`` or ``"default: no robot known"``
+        (recorded on the model card as ``inputs_reason``).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from joulepath.data import EnergyTable
+    >>> table = EnergyTable(frame=pd.DataFrame(), feature_set="joint")
+    >>> choose_inputs(None, table)
+    ('thesis', 'default: no robot known')
+    >>> choose_inputs(None, table, "irb120")
+    ('physics', 'default: robot known')
+    """
+    if inputs is not None:
+        return inputs, "asked"
+    if robot is not None or table.robot is not None:
+        return "physics", "default: robot known"
+    return "thesis", "default: no robot known"
+
+
+def _table_robot(
+    table: EnergyTable, robot: str | None = None, *, inputs: str = "thesis"
+) -> tuple[str, Robot]:
     """The robot of a table's data, as ``(source, robot)``: ``robot`` if given, else the table's own.
 
     A table names the robot it was ingested with (:attr:`EnergyTable.robot`, the
@@ -119,6 +168,12 @@ def _table_robot(table: EnergyTable, robot: str | None = None) -> tuple[str, Rob
 
     source = robot
     if source is None:
+        if table.robot is None and inputs == "physics":
+            raise InvalidInput(
+                "the physics inputs need the robot of the data, but the table names none (it was "
+                f"ingested without --robot) and none was given; give it (--robot, e.g. {PRESETS[0]} "
+                "or a .urdf/.irml file), or train on the raw inputs (--inputs thesis)"
+            )
         if table.robot is None:
             raise InvalidInput(
                 f"the table names no robot (it was ingested without --robot) and no robot was given; "
@@ -130,6 +185,7 @@ def _table_robot(table: EnergyTable, robot: str | None = None) -> tuple[str, Rob
             raise InvalidInput(
                 f"the table's robot {table.robot!r} is not a bundled robot or named arm; give its "
                 "description (--robot path/to/robot.urdf or .irml)"
+                + (", or train on the raw inputs (--inputs thesis)" if inputs == "physics" else "")
             )
     loaded = load_robot(source)
     if loaded.n_joints != table.n_joints:
@@ -270,17 +326,20 @@ def train(
             f"does not have; use any of {', '.join(train_table.targets)}"
         )
     say = progress or (lambda _msg: None)
+    inputs, inputs_reason = choose_inputs(config.inputs, train_table, config.robot)
     robot_source: str | None = None
     robot: Robot | None = None
-    if config.inputs == "physics" or config.robot is not None or train_table.robot is not None:
-        robot_source, robot = _table_robot(train_table, config.robot)
-    else:
+    if inputs == "physics" or config.robot is not None or train_table.robot is not None:
+        robot_source, robot = _table_robot(train_table, config.robot, inputs=inputs)
+    elif inputs_reason == "asked":
         say("no robot given and the table names none: the physics baselines are left out")
+    else:
+        say(NO_ROBOT_NOTE)
     if config.scheduler is not None:  # an unreachable scheduler fails before anything is written
         connect_scheduler(config.scheduler).close()
     out = Path(out_dir)
     make_folder(out)
-    cols = input_columns(train_table.feature_set, config.inputs, train_table.n_joints)
+    cols = input_columns(train_table.feature_set, inputs, train_table.n_joints)
     X = train_table.frame[list(cols)].to_numpy(dtype=np.float64)
     groups = train_table.frame["move_id"].to_numpy()
     rows: list[dict[str, Any]] = []
@@ -289,7 +348,7 @@ def train(
         for target in config.targets:
             y = train_table.frame[target].to_numpy(dtype=np.float64)
             pipeline = make_pipeline(
-                family, seed=config.seed, inputs=config.inputs, columns=cols, robot=robot_source
+                family, seed=config.seed, inputs=inputs, columns=cols, robot=robot_source
             )
             grid = grid_for(family, config.grid)
             cache_dir = out / ".gridcache" / f"{family}-{target}"
@@ -325,7 +384,8 @@ def train(
                 "family": family,
                 "target": target,
                 "feature_set": train_table.feature_set,
-                "inputs": config.inputs,
+                "inputs": inputs,
+                "inputs_reason": inputs_reason,
                 "physics_version": PHYSICS_VERSION,
                 "input_columns": list(cols),
                 "robot": train_table.robot,
@@ -409,6 +469,8 @@ def train(
     atomic_write_text(out / "results.csv", results.to_csv(index=False))
     report = {
         "config": asdict(config),
+        "inputs": inputs,
+        "inputs_reason": inputs_reason,
         "robot_source": robot_source,
         "train": {
             "rows": len(train_table.frame),

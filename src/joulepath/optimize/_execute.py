@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from joulepath.dynamics import Robot
-from joulepath.energy import DEFAULT_MEASURE
+from joulepath.energy import DEFAULT_MEASURE, MEASURES
 from joulepath.optimize._verify import energy_on_samples, measured_energy, plant_energy
 from joulepath.trajectory import Trajectory
 
@@ -40,6 +40,10 @@ class Execution:
     ``executed_tcp_deviation_mm`` is the largest TCP distance between the planned and the
     executed TCP paths (each point of one to the nearest of the other, both ways);
     ``executed_tcp_lag_mm`` the largest distance at the same time.
+    ``executed_lab_*_J``: the emulated motions on the lab robot on the plan's measure
+    (None where the lab robot has no data for it); ``executed_energy_*_lab_J`` and
+    ``executed_saved_lab_pct`` are the lab's on its logged (``mechanical``) measure,
+    deprecated (:data:`joulepath.optimize._figures.RESULT_DEPRECATED`).
     """
 
     executed_via_points: int
@@ -58,6 +62,8 @@ class Execution:
     executed_duration_vs_plan_pct: float
     executed_matches_plan: bool
     executed_model: str
+    executed_lab_default_J: float | None = None
+    executed_lab_optimized_J: float | None = None
 
     def to_json(self) -> dict[str, Any]:
         from dataclasses import asdict
@@ -110,6 +116,12 @@ def rapid_execution(
             for path in (followed.executed, default)
         )
     l_opt, l_def = plant_energy(lab, followed.executed), plant_energy(lab, default)
+    lab_ok = MEASURES[measure].missing(lab.drivetrain) is None
+    m_opt, m_def = (
+        (plant_energy(lab, p, measure=measure) for p in (followed.executed, default))
+        if lab_ok
+        else (None, None)
+    )
     from scipy.spatial import cKDTree
 
     pos_plan = robot.fk(_at(planned, np.minimum(followed.executed.t, duration))).position_mm
@@ -137,6 +149,8 @@ def rapid_execution(
         executed_energy_vs_plan_pct=e_pct,
         executed_duration_vs_plan_pct=dur_pct,
         executed_matches_plan=bool(ok),
+        executed_lab_default_J=m_def,
+        executed_lab_optimized_J=m_opt,
         executed_model=(
             "joulepath's ABB controller emulation (joulepath.sim): the default is MoveAbsJ \\T:=duration "
             "(jerk-limited sin² profile), the optimized move the written MoveAbsJ via points (\\T, z200, the "

@@ -22,6 +22,13 @@ from joulepath.energy import (
     path_energy,
 )
 from joulepath.errors import InvalidInput, InvalidModel, LimitViolation
+from joulepath.optimize._figures import (
+    RESULT_DEPRECATED,
+    EnergyPair,
+    figures_json,
+    headline_keys,
+    lab_pair,
+)
 from joulepath.optimize._problem import FITNESS, PARAMETRIZATIONS, TrajectoryProblem
 from joulepath.optimize._search import (
     AUTO,
@@ -186,7 +193,10 @@ class MoveSummary:
     times finer (the integral the samples approximate). ``saved_pct`` compares the
     optimized path with the controller-like minimum-jerk move of the same duration.
     ``energy_*_lab_J`` are the lab plant's on ``energy_lab_measure`` (``mechanical``:
-    its drive torque, gears included, times speed: what its torque log integrates to).
+    its drive torque, gears included, times speed: what its torque log integrates to);
+    they and ``energy_*_J`` are deprecated in ``result.json``, where the headline keys
+    ``planned_*``, ``lab_*`` and ``executed_*`` and the block ``energy_figures`` pair each
+    stage's figures on ``energy_measure`` (:meth:`to_json`, :mod:`joulepath.optimize._figures`).
     ``energies`` holds every measure the robot has the data for
     (:class:`MeasureSummary`: model and lab, like for like), ``energies_unavailable``
     why each other one is not computed.
@@ -238,10 +248,29 @@ class MoveSummary:
         """The summary of measure ``name``, or None when it was not computed."""
         return next((m for m in self.energies if m.measure == name), None)
 
-    def to_json(self) -> dict[str, Any]:
-        """Plain JSON types; non-finite numbers become ``null`` (strict JSON); ``energies`` by measure."""
+    def energy_pairs(self) -> tuple[EnergyPair, EnergyPair]:
+        """The planned and the lab stage's energies, both on ``energy_measure`` (see :mod:`._figures`)."""
+        planned = EnergyPair(
+            stage="planned",
+            measure=self.energy_measure,
+            on=self.physics_model,
+            default_J=self.energy_default_J,
+            optimized_J=self.energy_optimized_J,
+        )
+        return planned, lab_pair(self.energy_measure, self.energies, on=self.lab_plant or "the lab robot")
+
+    def to_json(self, executed: EnergyPair | None = None) -> dict[str, Any]:
+        """Plain JSON types; non-finite numbers become ``null`` (strict JSON); ``energies`` by measure.
+
+        Adds the headline keys ``planned_*``, ``lab_*`` (and ``executed_*`` with ``executed``),
+        all on ``energy_measure``, the ``energy_figures`` block and ``deprecated_keys``.
+        """
         out: dict[str, Any] = finite_json(asdict(self))
         out["energies"] = {m["measure"]: m for m in out["energies"]}
+        pairs = (*self.energy_pairs(), *(() if executed is None else (executed,)))
+        out.update(finite_json(headline_keys(pairs)))
+        out["energy_figures"] = finite_json(figures_json(self.energy_measure, pairs))
+        out["deprecated_keys"] = dict(RESULT_DEPRECATED)
         return out
 
 
@@ -644,7 +673,7 @@ def write_run(
     out = make_folder(out_dir)
     files = {}
     s = result.summary
-    summary = s.to_json()
+    summary = s.to_json()  # the executed figures are added below, once the program has run
     summary["export"] = exporter.name
     programs: dict[str, str] = {}
     refused = None
@@ -668,6 +697,18 @@ def write_run(
             refused = str(err)
     if execution is not None:
         summary.update(execution.to_json())
+        executed = EnergyPair(
+            stage="executed",
+            measure=s.energy_measure,
+            on="the written program run by the controller emulation, on the planning model",
+            default_J=execution.executed_energy_default_J,
+            optimized_J=execution.executed_energy_optimized_J,
+            lab_default_J=execution.executed_lab_default_J,
+            lab_optimized_J=execution.executed_lab_optimized_J,
+        )
+        full = s.to_json(executed)
+        for key in ("executed_default_J", "executed_optimized_J", "executed_saved_pct", "energy_figures"):
+            summary[key] = full[key]
     if refused is None:
         for name, text in programs.items():
             files[name] = atomic_write_text(out / name, text)

@@ -211,6 +211,52 @@ def emulated_cycle_time(result: CycleResult, text: str) -> float:
     return float(check_written(result, text)["emulated_cycle_s"])
 
 
+def _energy_figures(result: CycleResult, check: dict[str, Any] | None) -> dict[str, Any]:
+    """The headline keys and ``energy_figures`` of ``cycle.json``: each stage on ``energy_measure``.
+
+    The cycle's motion (no standby) at every stage: planned on the model, the same motion on
+    the emulated lab robot, and the written module as the controller emulation runs it.
+    """
+    from joulepath.optimize._figures import (
+        CYCLE_DEPRECATED,
+        EnergyPair,
+        figures_json,
+        headline_keys,
+        lab_pair,
+    )
+
+    m = result.energy_measure
+    pairs = [
+        EnergyPair(
+            stage="planned",
+            measure=m,
+            on=f"the planning model of {result.spec.robot.name}, the cycle's motion (no standby)",
+            default_J=result.default_energy_J,
+            optimized_J=result.optimized_energy_J,
+        ),
+        lab_pair(
+            m, result.energies, on="the emulated lab robot, the cycle's motion (no standby)", standby=False
+        ),
+    ]
+    if check is not None:
+        pairs.append(
+            EnergyPair(
+                stage="executed",
+                measure=m,
+                on="the written module (and the taught program) run by the controller emulation, on the "
+                "planning model",
+                default_J=result.default_energy_J,
+                optimized_J=check["emulated_energy_J"],
+                note="the emulated module on the lab robot is on mechanical only (executed_energy_lab_J)",
+            )
+        )
+    return {
+        **finite_json(headline_keys(pairs)),
+        "energy_figures": finite_json(figures_json(m, pairs)),
+        "deprecated_keys": dict(CYCLE_DEPRECATED),
+    }
+
+
 def cycle_json(
     result: CycleResult,
     pareto: list[ParetoPoint] | None,
@@ -241,6 +287,7 @@ def cycle_json(
         )
     return {
         **executed,
+        **_energy_figures(result, check if rapid is not None else None),
         "source": result.spec.source,
         "robot": result.spec.robot.name,
         "choices": list(result.spec.choices),
