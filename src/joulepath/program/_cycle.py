@@ -8,8 +8,12 @@
 * Optimized: every ``MoveAbsJ`` / ``MoveJ`` that occurs once in the cycle is
   reshaped by the single-move gradient optimizer (:func:`joulepath.optimize.solve_move`,
   rest to rest, fixed duration, limits as constraints, tool0 within a corridor of
-  the taught joint move). ``MoveL`` moves and moves that occur more than once are
-  kept: same path, same controller profile, run on their own. An optimized move
+  the taught joint move); runs of them between stops or inside a segment with a
+  ``MoveL`` / ``MoveC`` are reshaped as one unit through their fly-by targets. ``MoveL``
+  and ``MoveC`` keep their path (line or circle, tool orientation) and are re-timed
+  along it (:meth:`CycleOptimizer.retime_segments`). Moves that occur more than once
+  (unless streamed) and moves the RAPID interpreter marked as known only at run time
+  (``Step.kept``) run as taught: same path, same controller profile. An optimized move
   comes to rest at its target; where the original stopped (``fine``, before a wait)
   it dwells as the controller does, where it had a zone the next move starts at once.
   What is lost against the default is the overlap of blended moves.
