@@ -32,6 +32,15 @@ class Step:
     (``MoveL``), the speed, ``\\T`` (s), the zone radius (mm; None: a stop point), the
     tool (TCP in m as a 4x4 flange-to-TCP transform) and the robot carrying its load.
     ``idle``: a wait the user declared idle time that an optimizer may spend on the moves.
+
+    The motion settings in force at a move (RAPID's ``AccSet`` and ``VelSet``, as ABB
+    documents them; :mod:`joulepath.sim._timing` applies them): ``acc_pct``, the
+    acceleration and deceleration in % of the controller's (``AccSet Acc``; below 20 it
+    is 20), ``ramp_pct``, the rate of change of acceleration (the jerk) in % of the
+    controller's (``AccSet Ramp``; below 10 it is 10); ``vel_override_pct``, the speeds
+    of the speeddata and ``\\T`` in % of the programmed (``VelSet Override``: 50 halves
+    the speeds and doubles a ``\\T``), ``vel_max_mm_s``, the highest TCP speed (``VelSet
+    Max``; None: no cap).
     """
 
     kind: str
@@ -48,6 +57,10 @@ class Step:
     seconds: float = 0.0
     repeated: bool = False
     idle: bool = False
+    acc_pct: float = 100.0
+    ramp_pct: float = 100.0
+    vel_override_pct: float = 100.0
+    vel_max_mm_s: float | None = None
 
 
 class StepSequence(Protocol):

@@ -30,6 +30,14 @@ speed limit on both segments and within its acceleration limit in the corner pat
 and the chain's first and last ``\\T`` long enough to reach and leave the segment
 speed; else that corner is run as any other (superposition). Nothing else changes: a
 program without such corners is timed exactly as before.
+
+Motion settings (a :class:`~joulepath.sim.Step`'s ``AccSet`` and ``VelSet``, as ABB documents
+them): ``AccSet Acc, Ramp`` scales a move's joint acceleration limits by ``Acc`` % (at least
+20 %) and its jerk limits by ``Ramp`` % (at least 10 %), in its own profile and in a timed
+fly-by chain's ramps and corners; ``VelSet Override, Max`` scales the speeddata's TCP and
+reorientation speeds by ``Override`` % (a ``\\T`` by its inverse: 50 % doubles it) and caps
+the TCP speed at ``Max`` mm/s. At 100 %, 100 % and no cap a move is timed exactly as without
+them.
 """
 
 from __future__ import annotations
@@ -55,6 +63,25 @@ LINE_POINTS = 64
 """Points along a MoveL line where the inverse kinematics is solved."""
 FINE_DT = 0.0025
 """s between the samples on which energies and limits of the cycle are evaluated."""
+ACC_MIN_PCT = 20.0
+"""``AccSet Acc`` below this gives this (% of the controller's acceleration; ABB's AccSet)."""
+RAMP_MIN_PCT = 10.0
+"""``AccSet Ramp`` below this gives this (% of the controller's rate of change of acceleration)."""
+
+
+def acc_share(step: Step) -> float:
+    """The share of the controller's acceleration a move runs at (``AccSet Acc``, at least 20 %)."""
+    return max(step.acc_pct, ACC_MIN_PCT) / 100.0
+
+
+def ramp_share(step: Step) -> float:
+    """The share of the controller's jerk a move runs at (``AccSet Ramp``, at least 10 %)."""
+    return max(step.ramp_pct, RAMP_MIN_PCT) / 100.0
+
+
+def timed_s(step: Step) -> float | None:
+    """A move's ``\\T`` as the controller runs it: stretched by ``VelSet``'s override below 100 %."""
+    return None if step.time_s is None else step.time_s * (100.0 / step.vel_override_pct)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -199,26 +226,32 @@ def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:
 
 
 def fastest_profile(step: Step, path: SegmentPath, config: ControllerConfig) -> Profile:
-    """The controller's profile for a move (its speeddata and the joint limits; ``\\T`` stretches it)."""
+    """The controller's profile for a move (its speeddata and the joint limits, scaled by its ``AccSet``
+    and ``VelSet``; ``\\T`` stretches it)."""
     assert step.robot is not None and step.speed is not None
     robot = step.robot
     vmax = np.asarray(robot.velocity_limit, dtype=float)
-    amax = vmax / config.accel_time
+    amax = vmax / config.accel_time * acc_share(step)
     jerk = jerk_limit(robot, config.accel_time, config.jerk_time)
-    jmax = np.full(vmax.shape, np.inf) if jerk is None else jerk
+    jmax = np.full(vmax.shape, np.inf) if jerk is None else jerk * ramp_share(step)
     _, dqds, _ = path.at(np.linspace(0.0, 1.0, 33))
     peak = np.abs(dqds).max(axis=0)
     moving = peak > 1e-9
     bounds = [float(np.min(vmax[moving] / peak[moving]))]
+    override = step.vel_override_pct / 100.0
+    v_tcp = step.speed.v_tcp * override
+    if step.vel_max_mm_s is not None:
+        v_tcp = min(v_tcp, step.vel_max_mm_s)
     if path.length_mm > 1e-6:
-        bounds.append(step.speed.v_tcp / path.length_mm)
+        bounds.append(v_tcp / path.length_mm)
     if path.angle_deg > 1e-6:
-        bounds.append(step.speed.v_ori / path.angle_deg)
+        bounds.append(step.speed.v_ori * override / path.angle_deg)
     profile = plan_profile(
         min(bounds), float(np.min(amax[moving] / peak[moving])), float(np.min(jmax[moving] / peak[moving]))
     )
-    if step.time_s is not None and step.time_s > profile.duration:
-        k = step.time_s / profile.duration
+    time_s = timed_s(step)
+    if time_s is not None and time_s > profile.duration:
+        k = time_s / profile.duration
         profile = Profile(ta=profile.ta * k, tc=profile.tc * k, v=profile.v / k)
     return profile
 
@@ -343,25 +376,28 @@ def _chain_profiles(
     robot = plans[0][1].robot
     assert robot is not None
     vmax = np.asarray(robot.velocity_limit, dtype=float)
-    amax = vmax / config.accel_time
+    amax_all = vmax / config.accel_time
     width: dict[int, float] = {}
     for k in sorted(active):
         (_, a, pa, _, _, _), (_, b, pb, _, _, _) = plans[k], plans[k + 1]
-        assert a.time_s is not None and b.time_s is not None and a.zone_mm is not None
+        ta, tb = timed_s(a), timed_s(b)
+        assert ta is not None and tb is not None and a.zone_mm is not None
         La, Lb = pa.length_mm, pb.length_mm
         if La > 1e-9 and Lb > 1e-9:
             R = min(a.zone_mm, 0.5 * La, 0.5 * Lb)  # reduced to half the distance to the nearest point
-            width[k] = 2.0 * min(R / La * a.time_s, R / Lb * b.time_s)
+            width[k] = 2.0 * min(R / La * ta, R / Lb * tb)
         else:
-            width[k] = min(a.time_s, b.time_s)
+            width[k] = min(ta, tb)
         if width[k] <= 0.0:
             return {}, k
     profiles: dict[int, tuple[AnyProfile, float]] = {}
     speed: dict[int, FloatArray] = {}  # joint velocity on the segment (rad/s)
     for j in sorted({k for c in active for k in (c, c + 1)}):
         _, step, path, rest, _, _ = plans[j]
-        assert step.time_s is not None
-        T = step.time_s
+        T_step = timed_s(step)
+        assert T_step is not None
+        T = T_step
+        amax = amax_all * acc_share(step)
         dq = path.q1 - path.q0
         m = float(np.max(np.abs(dq) / amax))
         w_in = width.get(j - 1) if (j - 1) in active else None
@@ -386,7 +422,8 @@ def _chain_profiles(
             return {}, (j if j in active else j - 1)
         speed[j] = v * dq
         profiles[j] = (prof, prof.w_out if j in active else 0.0)
-    for k in sorted(active):
+    for k in sorted(active):  # the corner within the lower of its two moves' acceleration limits
+        amax = amax_all * min(acc_share(plans[k][1]), acc_share(plans[k + 1][1]))
         if np.any(np.abs(speed[k + 1] - speed[k]) / width[k] > amax * (1 + 1e-9)):
             return {}, k
     return profiles, None
