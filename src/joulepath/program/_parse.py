@@ -1103,7 +1103,8 @@ def _motion_setting(path: str, unit: Unit, names: Names, instr: str) -> MotionSe
     parts = [p.strip() for p in body.split(",")]
     if len(parts) != 2 or any(not p or "\\" in p for p in parts):
         raise RapidError(
-            f"{path}:{unit.line}: {instr} {body!r} is not read; write {instr} {what}, without optional arguments"
+            f"{path}:{unit.line}: {instr} {body!r} is not read; write {instr} {what}, without optional "
+            "arguments"
         )
     a = _real(path, unit.line, parts[0], names, f"the {instr}")
     b = _real(path, unit.line, parts[1], names, f"the {instr}")

@@ -429,13 +429,50 @@ def _chain_profiles(
     return profiles, None
 
 
+class PathCache:
+    """Joint paths of moves already planned (:func:`segment_path`), by step line, start, target and
+    tool, and the times at which profiles reach a fraction of their path (zones' blends).
+
+    A move's path depends on where it starts and ends, its interpolation and its tool, not on
+    how it is timed (speed data, ``\\T``, zone, ``AccSet``, ``VelSet``): a search over those
+    plans the cycle many times and solves each ``MoveL``'s inverse kinematics once, and each
+    blend of a profile it has seen once (the same numbers as without the cache).
+    """
+
+    def __init__(self) -> None:
+        self._paths: dict[tuple[int, bool, bytes, bytes, bytes], SegmentPath] = {}
+        self._fractions: dict[tuple[AnyProfile, float], float] = {}
+
+    def time_at_fraction(self, p: AnyProfile, fraction: float) -> float:
+        """When profile ``p`` reaches ``fraction`` of its path (s), found once."""
+        key = (p, fraction)
+        found = self._fractions.get(key)
+        if found is None:
+            found = self._fractions[key] = _time_at_fraction(p, fraction)
+        return found
+
+    def path(self, step: Step, q0: FloatArray, where: str) -> SegmentPath:
+        """:func:`segment_path` of ``step`` from ``q0``, solved once."""
+        assert step.q is not None and step.tcp is not None
+        key = (step.line, step.linear, q0.tobytes(), step.q.tobytes(), step.tcp.tobytes())
+        found = self._paths.get(key)
+        if found is None:
+            found = self._paths[key] = segment_path(step, q0, where)
+        return found
+
+
 def plan_cycle(
-    spec: StepSequence, config: ControllerConfig, *, progress: Callable[[str], None] | None = None
+    spec: StepSequence,
+    config: ControllerConfig,
+    *,
+    progress: Callable[[str], None] | None = None,
+    paths: PathCache | None = None,
 ) -> PlannedCycle:
     """The controller's timing of one cycle (it starts at rest at ``spec.start``).
 
     ``progress`` (optional) is told each move planned (a ``MoveL`` solves the inverse
-    kinematics along its line: milliseconds each, minutes for thousands).
+    kinematics along its line: milliseconds each, minutes for thousands). ``paths``
+    (optional) keeps the moves' paths from one call to the next (:class:`PathCache`).
     """
     q = spec.start
     plans: list[tuple[int, Step, SegmentPath, Profile, float, bool]] = []
@@ -445,7 +482,7 @@ def plan_cycle(
             progress(f"planning the taught cycle: move {k}/{len(indices)}")
         step = spec.steps[i]
         assert step.q is not None
-        path = segment_path(step, q, spec.source)
+        path = segment_path(step, q, spec.source) if paths is None else paths.path(step, q, spec.source)
         if np.abs(step.q - q).max() <= 1e-9:
             fastest = Profile(ta=0.0, tc=0.0, v=0.0)
         else:
@@ -476,7 +513,8 @@ def plan_cycle(
         elif profile.duration == 0.0:
             t = end
         elif frac > 0.0 and nxt is not None and nxt.duration > 0:
-            blend = profile.duration - _time_at_fraction(profile, 1.0 - frac)
+            at = _time_at_fraction if paths is None else paths.time_at_fraction
+            blend = profile.duration - at(profile, 1.0 - frac)
             blend = min(blend, 0.5 * profile.duration, 0.5 * nxt.duration)
             t = end - blend
         else:
