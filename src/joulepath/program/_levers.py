@@ -775,6 +775,10 @@ def levers_module(
         raise InvalidInput(f"max_evaluations must be at least 1, got {max_evaluations}")
     if text is None:
         text, encoding = _source_text(spec)
+    if tuple(text.splitlines()) != spec.module.source:
+        raise InvalidInput(
+            f"{spec.module.path}: the text given is not the module's source; give the file's text as read"
+        )
     config = config or ControllerConfig()
     lines = text.splitlines(keepends=True)
     slots = _slots(spec, lines)
