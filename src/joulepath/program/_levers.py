@@ -464,6 +464,7 @@ def _search(
     plan, t, e = ev(state)
 
     def better(t_new: float, e_new: float, best: tuple[float, object] | None) -> bool:
+        """Within the cycle time, less energy than now, and than ``best``."""
         return t_new <= target_s + _TOL_S and e_new < e * (1.0 - 1e-9) and (best is None or e_new < best[0])
 
     while ev.n < max_evaluations:
@@ -499,20 +500,26 @@ def _search(
             ),
             key=lambda x: x[0],
         )
-        chosen: tuple[float, tuple[Setting, ...]] | None = None
-        for _, g, s in ranked[:pairs]:
+        # the pairs in turn, each on the settings as the pairs taken so far left them; a slot's lever
+        # is changed once per exchange step (the effects measured from ``state`` hold for it alone)
+        used: set[tuple[int, str]] = set()
+        taken = False
+        for _, g, s in ranked[: pairs * 4]:
             if ev.n >= max_evaluations:
                 break
+            if g[0] in used or s[0] in used:
+                continue
             (kg, kind_g), (ks, kind_s) = g[0], s[0]
             both = _with(state, kg, _combine(state[kg], g[1], kind_g))
             both = _with(both, ks, _combine(both[ks], s[1], kind_s))
             _, t_new, e_new = ev(both)
-            if better(t_new, e_new, chosen):
-                chosen = (e_new, both)
-        if chosen is None:
+            if better(t_new, e_new, None):
+                state = both
+                plan, t, e = ev(state)
+                used |= {g[0], s[0]}
+                taken = True
+        if not taken:
             break
-        state = chosen[1]
-        plan, t, e = ev(state)
     return state
 
 
