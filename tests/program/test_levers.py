@@ -317,3 +317,30 @@ def test_levers_refuse_a_cycle_file_and_a_zero_budget(robot, tmp_path):
         levers_module(replace(spec, module=None), robot, energy="thesis", max_evaluations=5)
     with pytest.raises(InvalidInput, match="source"):
         levers_module(spec, robot, energy="thesis", text=JOINT_CYCLE.replace("pC", "pD"), max_evaluations=5)
+
+
+def test_writer_edits_arguments_in_place_across_lines_and_comments(robot):
+    text = _module(
+        "            MoveJ pA,\n                  v1000 \\T:=2,\n                  z20, tool0; ! to A\n"
+        "            MoveL pB, v500 \\V:=450, z10, tool0;\n"
+        "            MoveJ pC, v1000, z10, tool0; MoveAbsJ jH, v1000, fine, tool0;\n"
+    )
+    spec = _spec(text, robot)
+    slots = _slots(spec, text.splitlines(keepends=True))
+    assert [("speed" in s.open, "zone" in s.open, "acc" in s.open) for s in slots] == [
+        (True, True, True),  # \T is a lever; the comment after the ';' stays
+        (False, True, True),  # \V: the speed stays as written
+        (False, False, False),  # two statements on one line: not edited
+        (False, False, False),
+    ]
+    chosen = (
+        replace(slots[0].taught, time_s=2.5, zone="z5"),
+        replace(slots[1].taught, zone="z30"),
+        *(s.taught for s in slots[2:]),
+    )
+    written, where = write_levers(spec.module, text, slots, chosen)
+    assert "                  v1000 \\T:=2.5,\n                  z5, tool0; ! to A\n" in written
+    assert "            MoveL pB, v500 \\V:=450, z30, tool0;\n" in written
+    assert where == {k: k for k in range(1, len(text.splitlines()) + 1)}
+    a, b, *_ = _moves(_spec(written, robot))
+    assert (a.time_s, a.zone_mm, b.zone_mm, b.speed.v_tcp) == (2.5, 5.0, 30.0, 450.0)

@@ -225,6 +225,7 @@ class _Slot:
 
     line: int
     label: str
+    instruction: str
     linear: bool
     steps: tuple[int, ...]
     written: _Written | None
@@ -233,13 +234,19 @@ class _Slot:
     closed: tuple[str, ...]
 
 
+def _key(step: Step) -> tuple[int, str]:
+    """A move statement: its line and instruction (two on one line are told apart, and not edited)."""
+    assert isinstance(step.statement, Move)
+    return step.line, step.statement.instruction
+
+
 def _slots(spec: CycleSpec, lines: list[str]) -> list[_Slot]:
-    by_line: dict[int, list[int]] = {}
+    by_key: dict[tuple[int, str], list[int]] = {}
     for i, s in enumerate(spec.steps):
         if s.kind == "move":
-            by_line.setdefault(s.line, []).append(i)
+            by_key.setdefault(_key(s), []).append(i)
     out: list[_Slot] = []
-    for line, idx in by_line.items():
+    for (line, _), idx in by_key.items():
         steps = [spec.steps[i] for i in idx]
         first = steps[0]
         move = first.statement
@@ -281,7 +288,15 @@ def _slots(spec: CycleSpec, lines: list[str]) -> list[_Slot]:
         taught = Setting(first.acc_pct, first.ramp_pct, move.speed, move.time_s, move.zone)
         out.append(
             _Slot(
-                line, first.label, first.linear, tuple(idx), written_ok, taught, tuple(open_), tuple(closed)
+                line,
+                first.label,
+                move.instruction,
+                first.linear,
+                tuple(idx),
+                written_ok,
+                taught,
+                tuple(open_),
+                tuple(closed),
             )
         )
     return out
@@ -405,10 +420,10 @@ def _apply(step: Step, setting: Setting, taught: Setting) -> Step:
     )
 
 
-def _durations(plan: PlannedCycle) -> dict[int, float]:
-    out: dict[int, float] = {}
+def _durations(plan: PlannedCycle) -> dict[tuple[int, str], float]:
+    out: dict[tuple[int, str], float] = {}
     for m in plan.moves:
-        out.setdefault(m.step.line, m.profile.duration)
+        out.setdefault(_key(m.step), m.profile.duration)
     return out
 
 
@@ -472,7 +487,7 @@ def _search(
         tried: list[Tried] = []
         for k, slot in enumerate(slots):
             for kind in _kinds(slot):
-                duration = _durations(plan).get(slot.line, 0.0)
+                duration = _durations(plan).get((slot.line, slot.instruction), 0.0)
                 best: tuple[float, Setting] | None = None
                 for option in _options(state, k, kind, slot, ev.spec, duration):
                     if ev.n >= max_evaluations and _with(state, k, option) not in ev.memo:
@@ -681,7 +696,7 @@ def _reads_back(
     got = [s for s in again.steps if s.kind in ("move", "wait")]
     if len(want) != len(got):
         return f"{len(got)} moves and waits, not {len(want)}"
-    by_line = {slot.line: c for slot, c in zip(slots, chosen, strict=True)}
+    by_key = {(slot.line, slot.instruction): c for slot, c in zip(slots, chosen, strict=True)}
     for a, b in zip(want, got, strict=True):
         if a.kind != b.kind or where.get(a.line) != b.line:
             return f"line {a.line}: {a.label} reads back as {b.label} at line {b.line}"
@@ -692,7 +707,7 @@ def _reads_back(
         assert a.q is not None and b.q is not None
         if not np.allclose(a.q, b.q, rtol=0.0, atol=1e-9):
             return f"line {a.line}: the target reads back elsewhere"
-        c = by_line[a.line]
+        c = by_key[_key(a)]
         speed = (
             a.speed if c.speed.lower() == a.statement.speed.lower() else PREDEFINED_SPEEDS[c.speed.lower()]
         )
@@ -731,7 +746,7 @@ def levers_module(
     cycle_time_s: float | None = None,
     text: str | None = None,
     encoding: str = "utf-8",
-    max_evaluations: int = 400,
+    max_evaluations: int = 1500,
     pairs: int = 8,
     use_waits: bool = False,
     config: ControllerConfig | None = None,
