@@ -15,11 +15,13 @@ written, where its statements stand.
   (or the taught zone, where larger). ``fine`` points stay stop points. A lever is open
   only where the statement can be edited in place: the argument written as a plain name
   (no ``\\V`` / ``\\Z``, not a procedure's parameter), the statement alone on its lines.
-* **Search**: steepest descent with exchanges, bounded by ``max_evaluations`` cycle plans.
-  Each round plans the cycle once per single change of the current settings; the change
+* **Search**: coordinate descent with exchanges, bounded by ``max_evaluations`` cycle plans.
+  Each lever of each statement in turn: every other value of it is planned, and the one
   that lowers the energy most while the cycle stays within the taught cycle time (+0 s)
-  is taken; where none does, pairs of a change that gains time and one that spends it for
-  less energy are ranked by their single effects and the best few planned together.
+  is taken. After a pass where none is, pairs of a change that gains time and one that
+  spends it for less energy are ranked by their single effects and the best taken in turn
+  where the two planned together keep the cycle time and lower the energy; the search
+  stops when neither helps or the plans are spent.
 * **Energy**: the cycle as the controller emulation runs it (:func:`joulepath.sim.evaluate_cycle`
   on the 2.5 ms grid), on the run's energy measure, with the model the written-program
   check uses (:func:`joulepath.program._output.check_written`): the whole cycle's motion,
@@ -31,7 +33,13 @@ written, where its statements stand.
   (encoding and line ends). The written text is read back with the module reader, checked
   to give the same targets, waits and the levers' settings, and run again through the
   controller emulation: its executed cycle time and energy are what :class:`LeverResult`
-  reports.
+  reports. Where it does not read back so, the program is returned as taught.
+* **Idle waits** (``use_waits``): the waits marked ``! joulepath: idle`` may be spent on the
+  moves; the cycle may then move longer by up to their time, and they are shortened by as
+  much (whole ms, rounded down), their seconds argument changed in place.
+
+Not searched: ``VelSet`` (the controller model applies it where a program has one), ``\\V``
+and ``\\Z``, and statements inside procedures whose arguments name the speed or zone.
 """
 
 from __future__ import annotations
