@@ -102,6 +102,7 @@ CORPUS = [
         ),
         6,
     ),
+    ("VelSet out of range", _prog("VelSet 0, 800;", "MoveJ pA, v100, fine, tool0;"), 5),
     ("no ENDMODULE", (HEAD + "    PROC main()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n"), 6),
     ("no main", HEAD + "    PROC other()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n" + TAIL, 1),
     (

@@ -11,6 +11,7 @@ from joulepath.program._cycle import (
     optimize_cycle,
     pareto,
 )
+from joulepath.program._levers import LeverResult, MoveLever, levers_module
 from joulepath.program._model import Module, RapidError
 from joulepath.program._output import CYCLE_FILES, optimized_module, write_cycle_run
 from joulepath.program._parse import parse_module, read_module
@@ -26,13 +27,16 @@ __all__ = [
     "CycleResult",
     "CycleSettings",
     "CycleSpec",
+    "LeverResult",
     "Module",
+    "MoveLever",
     "MoveOutcome",
     "ParetoPoint",
     "ProgramMotion",
     "ProgramRun",
     "RapidError",
     "format_move",
+    "levers_module",
     "optimize_cycle",
     "optimized_module",
     "pareto",

@@ -174,6 +174,18 @@ class Verbatim:
 
 
 @dataclass(frozen=True, slots=True)
+class MotionSetting(Verbatim):
+    """``AccSet Acc, Ramp;`` or ``VelSet Override, Max;`` (``text``: the instruction), kept as written.
+
+    ``values``: its two numbers (``AccSet``: % of the acceleration and of its rate of
+    change; ``VelSet``: % of the programmed speeds, the highest TCP speed in mm/s). It
+    takes no modelled time; the moves after it run with it (:class:`joulepath.sim.Step`).
+    """
+
+    values: tuple[float, float] = (100.0, 100.0)
+
+
+@dataclass(frozen=True, slots=True)
 class WhileTrue:
     """``WHILE TRUE DO ... ENDWHILE``: the cycle when it is in ``main``."""
 
@@ -213,7 +225,7 @@ class Branch:
     body: tuple[Statement, ...]
 
 
-Statement = Move | WaitTime | Call | Verbatim | WhileTrue | ForLoop | Branch
+Statement = Move | WaitTime | Call | Verbatim | WhileTrue | ForLoop | Branch  # MotionSetting is a Verbatim
 
 
 @dataclass(frozen=True, slots=True)

@@ -27,7 +27,8 @@ Refused (:class:`RapidError`, one line ``file:line: what; how to fix``): syntax
 errors, unknown names, arguments joulepath does not model (``\\Conc``, ``\\ID``, ...),
 moving work objects, other motion instructions (``MoveC``, ``SearchL`` ...),
 instructions that change how the robot moves (``PDispOn``, ``PDispSet``, ``EOffsSet``,
-``VelSet``, ``AccSet``, ``ConfJ \\Off`` ...), targets computed while the program runs
+``ConfJ \\Off`` ...; ``AccSet Acc, Ramp`` and ``VelSet Override, Max`` are read, as
+:class:`~joulepath.program._model.MotionSetting`), targets computed while the program runs
 (``CRobT``, a target some statement assigns), moves under conditions known only at run
 time, in other ``WHILE`` loops, and in FOR loops whose bounds are not constants.
 Reading never executes anything.
@@ -49,6 +50,7 @@ from joulepath.program._model import (
     ForLoop,
     JointTarget,
     Module,
+    MotionSetting,
     Move,
     Offset,
     Procedure,
@@ -1090,6 +1092,31 @@ def _wait(path: str, unit: Unit, names: Names, source: tuple[str, ...]) -> WaitT
     return WaitTime(unit.line, unit.end_line, seconds, inpos, _is_idle(source, unit))
 
 
+def _motion_setting(path: str, unit: Unit, names: Names, instr: str) -> MotionSetting:
+    """``AccSet Acc, Ramp;`` (each in (0, 100] %) or ``VelSet Override, Max;`` (% > 0, mm/s > 0)."""
+    body = unit.text[len(unit.head) :].rstrip(";").strip()
+    what = (
+        "Acc, Ramp (% of the acceleration and of its rate of change)"
+        if instr == "AccSet"
+        else ("Override, Max (% of the programmed speeds, the highest TCP speed in mm/s)")
+    )
+    parts = [p.strip() for p in body.split(",")]
+    if len(parts) != 2 or any(not p or "\\" in p for p in parts):
+        raise RapidError(
+            f"{path}:{unit.line}: {instr} {body!r} is not read; write {instr} {what}, without optional "
+            "arguments"
+        )
+    a = _real(path, unit.line, parts[0], names, f"the {instr}")
+    b = _real(path, unit.line, parts[1], names, f"the {instr}")
+    if instr == "AccSet" and not (0 < a <= 100 and 0 < b <= 100):
+        raise RapidError(f"{path}:{unit.line}: AccSet {a:g}, {b:g}: Acc and Ramp must be within (0, 100] %")
+    if instr == "VelSet" and not (0 < a and 0 < b):
+        raise RapidError(
+            f"{path}:{unit.line}: VelSet {a:g}, {b:g}: Override (%) and Max (mm/s) must be positive"
+        )
+    return MotionSetting(unit.line, unit.end_line, instr, (a, b))
+
+
 # ---------------------------------------------------------------- routines
 MOTION_FIXES = {
     "PDispOn": "it displaces every following target (program displacement); remove it and PDispOff, or "
@@ -1507,6 +1534,10 @@ class _Reader:
             )
         if head.lower() == "waittime":
             return _wait(self.path, u, self.names, self.source)
+        if head.lower() in ("accset", "velset"):
+            return _motion_setting(
+                self.path, u, self.names, "AccSet" if head.lower() == "accset" else "VelSet"
+            )
         for s in MOTION_SETTINGS:
             if head.lower() == s.lower():
                 if s in ("ConfJ", "ConfL") and re.search(r"\\\s*On\b", u.text, re.IGNORECASE):

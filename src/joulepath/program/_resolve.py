@@ -31,6 +31,7 @@ from joulepath.program._model import (
     ForLoop,
     JointTarget,
     Module,
+    MotionSetting,
     Move,
     RapidError,
     RobTarget,
@@ -235,7 +236,10 @@ def resolve_module(
     steps: list[Step] = []
     fixed: list[int] = []
     n_moves, k = sum(isinstance(s, Move) for s in flat), 0
+    settings = _settings_at_start(main.body if loop is not None else (), flat)
     for s in flat:
+        if isinstance(s, MotionSetting):
+            settings[s.text] = s.values
         if isinstance(s, WaitTime):
             idle = s.idle or s.line in idle_waits
             label = ("WaitTime \\InPos, " if s.inpos else "WaitTime ") + f"{s.seconds:g}"
@@ -247,7 +251,17 @@ def resolve_module(
             k += 1
             if progress is not None:
                 progress(f"reading {module.path}: move {k}/{n_moves}")
-            steps.append(_move_step(module, robot, s, lo, hi, robots, counts[s.line] > 1))
+            step = _move_step(module, robot, s, lo, hi, robots, counts[s.line] > 1)
+            (acc, ramp), (override, vmax) = settings["AccSet"], settings["VelSet"]
+            steps.append(
+                replace(
+                    step,
+                    acc_pct=acc,
+                    ramp_pct=ramp,
+                    vel_override_pct=override,
+                    vel_max_mm_s=None if vmax == _NO_CAP else vmax,
+                )
+            )
     moves = [st for st in steps if st.kind == "move"]
     if not moves:
         where = "main's WHILE TRUE loop" if loop is not None else "main"
@@ -256,6 +270,31 @@ def resolve_module(
         )
     assert moves[-1].q is not None
     return CycleSpec(tuple(steps), moves[-1].q.copy(), module.path, module, tuple(fixed), robot, tuple(notes))
+
+
+_NO_CAP = float("inf")
+
+
+def _settings_at_start(
+    before: tuple[Statement, ...], flat: list[Statement]
+) -> dict[str, tuple[float, float]]:
+    """``AccSet`` and ``VelSet`` in force when the cycle starts (100 %, 100 %, no cap when none is).
+
+    RAPID keeps them until the next: the cycle of a ``WHILE TRUE`` loop starts with the last
+    its body sets (from the second run on, the steady state), else with the last ``main``
+    sets before the loop (``before``: main's statements, up to the loop).
+    """
+    out = {"AccSet": (100.0, 100.0), "VelSet": (100.0, _NO_CAP)}
+    for s in before:
+        if isinstance(s, WhileTrue):
+            break
+        if isinstance(s, MotionSetting):
+            out[s.text] = s.values
+    if before:  # a loop: its body's last settings carry over into its next run
+        for s in flat:
+            if isinstance(s, MotionSetting):
+                out[s.text] = s.values
+    return out
 
 
 def _move_step(

@@ -36,6 +36,15 @@ class Step:
     time ...; empty: an optimizer may reshape it). ``circle_q``: a ``MoveC``'s circle point
     (joint values, rad): the TCP moves on the circle through it. ``file``: the module the
     statement stands in (a task has several).
+
+    The motion settings in force at a move (RAPID's ``AccSet`` and ``VelSet``, as ABB
+    documents them; :mod:`joulepath.sim._timing` applies them): ``acc_pct``, the
+    acceleration and deceleration in % of the controller's (``AccSet Acc``; below 20 it
+    is 20), ``ramp_pct``, the rate of change of acceleration (the jerk) in % of the
+    controller's (``AccSet Ramp``; below 10 it is 10); ``vel_override_pct``, the speeds
+    of the speeddata and ``\\T`` in % of the programmed (``VelSet Override``: 50 halves
+    the speeds and doubles a ``\\T``), ``vel_max_mm_s``, the highest TCP speed (``VelSet
+    Max``; None: no cap).
     """
 
     kind: str
@@ -55,6 +64,10 @@ class Step:
     kept: tuple[str, ...] = ()
     circle_q: FloatArray | None = None
     file: str = ""
+    acc_pct: float = 100.0
+    ramp_pct: float = 100.0
+    vel_override_pct: float = 100.0
+    vel_max_mm_s: float | None = None
 
 
 class StepSequence(Protocol):

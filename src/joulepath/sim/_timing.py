@@ -30,6 +30,14 @@ speed limit on both segments and within its acceleration limit in the corner pat
 and the chain's first and last ``\\T`` long enough to reach and leave the segment
 speed; else that corner is run as any other (superposition). Nothing else changes: a
 program without such corners is timed exactly as before.
+
+Motion settings (a :class:`~joulepath.sim.Step`'s ``AccSet`` and ``VelSet``, as ABB documents
+them): ``AccSet Acc, Ramp`` scales a move's joint acceleration limits by ``Acc`` % (at least
+20 %) and its jerk limits by ``Ramp`` % (at least 10 %), in its own profile and in a timed
+fly-by chain's ramps and corners; ``VelSet Override, Max`` scales the speeddata's TCP and
+reorientation speeds by ``Override`` % (a ``\\T`` by its inverse: 50 % doubles it) and caps
+the TCP speed at ``Max`` mm/s. At 100 %, 100 % and no cap a move is timed exactly as without
+them.
 """
 
 from __future__ import annotations
@@ -55,6 +63,25 @@ LINE_POINTS = 64
 """Points along a MoveL line where the inverse kinematics is solved."""
 FINE_DT = 0.0025
 """s between the samples on which energies and limits of the cycle are evaluated."""
+ACC_MIN_PCT = 20.0
+"""``AccSet Acc`` below this gives this (% of the controller's acceleration; ABB's AccSet)."""
+RAMP_MIN_PCT = 10.0
+"""``AccSet Ramp`` below this gives this (% of the controller's rate of change of acceleration)."""
+
+
+def acc_share(step: Step) -> float:
+    """The share of the controller's acceleration a move runs at (``AccSet Acc``, at least 20 %)."""
+    return max(step.acc_pct, ACC_MIN_PCT) / 100.0
+
+
+def ramp_share(step: Step) -> float:
+    """The share of the controller's jerk a move runs at (``AccSet Ramp``, at least 10 %)."""
+    return max(step.ramp_pct, RAMP_MIN_PCT) / 100.0
+
+
+def timed_s(step: Step) -> float | None:
+    """A move's ``\\T`` as the controller runs it: stretched by ``VelSet``'s override below 100 %."""
+    return None if step.time_s is None else step.time_s * (100.0 / step.vel_override_pct)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -233,26 +260,32 @@ def arc_points(p0: FloatArray, pv: FloatArray, p1: FloatArray, s: FloatArray, wh
 
 
 def fastest_profile(step: Step, path: SegmentPath, config: ControllerConfig) -> Profile:
-    """The controller's profile for a move (its speeddata and the joint limits; ``\\T`` stretches it)."""
+    """The controller's profile for a move (its speeddata and the joint limits, scaled by its ``AccSet``
+    and ``VelSet``; ``\\T`` stretches it)."""
     assert step.robot is not None and step.speed is not None
     robot = step.robot
     vmax = np.asarray(robot.velocity_limit, dtype=float)
-    amax = vmax / config.accel_time
+    amax = vmax / config.accel_time * acc_share(step)
     jerk = jerk_limit(robot, config.accel_time, config.jerk_time)
-    jmax = np.full(vmax.shape, np.inf) if jerk is None else jerk
+    jmax = np.full(vmax.shape, np.inf) if jerk is None else jerk * ramp_share(step)
     _, dqds, _ = path.at(np.linspace(0.0, 1.0, 33))
     peak = np.abs(dqds).max(axis=0)
     moving = peak > 1e-9
     bounds = [float(np.min(vmax[moving] / peak[moving]))]
+    override = step.vel_override_pct / 100.0
+    v_tcp = step.speed.v_tcp * override
+    if step.vel_max_mm_s is not None:
+        v_tcp = min(v_tcp, step.vel_max_mm_s)
     if path.length_mm > 1e-6:
-        bounds.append(step.speed.v_tcp / path.length_mm)
+        bounds.append(v_tcp / path.length_mm)
     if path.angle_deg > 1e-6:
-        bounds.append(step.speed.v_ori / path.angle_deg)
+        bounds.append(step.speed.v_ori * override / path.angle_deg)
     profile = plan_profile(
         min(bounds), float(np.min(amax[moving] / peak[moving])), float(np.min(jmax[moving] / peak[moving]))
     )
-    if step.time_s is not None and step.time_s > profile.duration:
-        k = step.time_s / profile.duration
+    time_s = timed_s(step)
+    if time_s is not None and time_s > profile.duration:
+        k = time_s / profile.duration
         profile = Profile(ta=profile.ta * k, tc=profile.tc * k, v=profile.v / k)
     return profile
 
@@ -377,25 +410,28 @@ def _chain_profiles(
     robot = plans[0][1].robot
     assert robot is not None
     vmax = np.asarray(robot.velocity_limit, dtype=float)
-    amax = vmax / config.accel_time
+    amax_all = vmax / config.accel_time
     width: dict[int, float] = {}
     for k in sorted(active):
         (_, a, pa, _, _, _), (_, b, pb, _, _, _) = plans[k], plans[k + 1]
-        assert a.time_s is not None and b.time_s is not None and a.zone_mm is not None
+        ta, tb = timed_s(a), timed_s(b)
+        assert ta is not None and tb is not None and a.zone_mm is not None
         La, Lb = pa.length_mm, pb.length_mm
         if La > 1e-9 and Lb > 1e-9:
             R = min(a.zone_mm, 0.5 * La, 0.5 * Lb)  # reduced to half the distance to the nearest point
-            width[k] = 2.0 * min(R / La * a.time_s, R / Lb * b.time_s)
+            width[k] = 2.0 * min(R / La * ta, R / Lb * tb)
         else:
-            width[k] = min(a.time_s, b.time_s)
+            width[k] = min(ta, tb)
         if width[k] <= 0.0:
             return {}, k
     profiles: dict[int, tuple[AnyProfile, float]] = {}
     speed: dict[int, FloatArray] = {}  # joint velocity on the segment (rad/s)
     for j in sorted({k for c in active for k in (c, c + 1)}):
         _, step, path, rest, _, _ = plans[j]
-        assert step.time_s is not None
-        T = step.time_s
+        T_step = timed_s(step)
+        assert T_step is not None
+        T = T_step
+        amax = amax_all * acc_share(step)
         dq = path.q1 - path.q0
         m = float(np.max(np.abs(dq) / amax))
         w_in = width.get(j - 1) if (j - 1) in active else None
@@ -420,19 +456,57 @@ def _chain_profiles(
             return {}, (j if j in active else j - 1)
         speed[j] = v * dq
         profiles[j] = (prof, prof.w_out if j in active else 0.0)
-    for k in sorted(active):
+    for k in sorted(active):  # the corner within the lower of its two moves' acceleration limits
+        amax = amax_all * min(acc_share(plans[k][1]), acc_share(plans[k + 1][1]))
         if np.any(np.abs(speed[k + 1] - speed[k]) / width[k] > amax * (1 + 1e-9)):
             return {}, k
     return profiles, None
 
 
+class PathCache:
+    """Joint paths of moves already planned (:func:`segment_path`), by step line, start, target and
+    tool, and the times at which profiles reach a fraction of their path (zones' blends).
+
+    A move's path depends on where it starts and ends, its interpolation and its tool, not on
+    how it is timed (speed data, ``\\T``, zone, ``AccSet``, ``VelSet``): a search over those
+    plans the cycle many times and solves each ``MoveL``'s inverse kinematics once, and each
+    blend of a profile it has seen once (the same numbers as without the cache).
+    """
+
+    def __init__(self) -> None:
+        self._paths: dict[tuple[int, bool, bytes, bytes, bytes], SegmentPath] = {}
+        self._fractions: dict[tuple[AnyProfile, float], float] = {}
+
+    def time_at_fraction(self, p: AnyProfile, fraction: float) -> float:
+        """When profile ``p`` reaches ``fraction`` of its path (s), found once."""
+        key = (p, fraction)
+        found = self._fractions.get(key)
+        if found is None:
+            found = self._fractions[key] = _time_at_fraction(p, fraction)
+        return found
+
+    def path(self, step: Step, q0: FloatArray, where: str) -> SegmentPath:
+        """:func:`segment_path` of ``step`` from ``q0``, solved once."""
+        assert step.q is not None and step.tcp is not None
+        key = (step.line, step.linear, q0.tobytes(), step.q.tobytes(), step.tcp.tobytes())
+        found = self._paths.get(key)
+        if found is None:
+            found = self._paths[key] = segment_path(step, q0, where)
+        return found
+
+
 def plan_cycle(
-    spec: StepSequence, config: ControllerConfig, *, progress: Callable[[str], None] | None = None
+    spec: StepSequence,
+    config: ControllerConfig,
+    *,
+    progress: Callable[[str], None] | None = None,
+    paths: PathCache | None = None,
 ) -> PlannedCycle:
     """The controller's timing of one cycle (it starts at rest at ``spec.start``).
 
     ``progress`` (optional) is told each move planned (a ``MoveL`` solves the inverse
-    kinematics along its line: milliseconds each, minutes for thousands).
+    kinematics along its line: milliseconds each, minutes for thousands). ``paths``
+    (optional) keeps the moves' paths from one call to the next (:class:`PathCache`).
     """
     q = spec.start
     plans: list[tuple[int, Step, SegmentPath, Profile, float, bool]] = []
@@ -442,7 +516,7 @@ def plan_cycle(
             progress(f"planning the taught cycle: move {k}/{len(indices)}")
         step = spec.steps[i]
         assert step.q is not None
-        path = segment_path(step, q, spec.source)
+        path = segment_path(step, q, spec.source) if paths is None else paths.path(step, q, spec.source)
         if np.abs(step.q - q).max() <= 1e-9:
             fastest = Profile(ta=0.0, tc=0.0, v=0.0)
         else:
@@ -473,7 +547,8 @@ def plan_cycle(
         elif profile.duration == 0.0:
             t = end
         elif frac > 0.0 and nxt is not None and nxt.duration > 0:
-            blend = profile.duration - _time_at_fraction(profile, 1.0 - frac)
+            at = _time_at_fraction if paths is None else paths.time_at_fraction
+            blend = profile.duration - at(profile, 1.0 - frac)
             blend = min(blend, 0.5 * profile.duration, 0.5 * nxt.duration)
             t = end - blend
         else:
