@@ -220,6 +220,12 @@ def cycle(
         if pareto:
             say("energy against cycle time...")
             front = run_pareto(opt, points=points, use_waits=use_waits)
+        levers = None
+        if rapid and export != "egm" and spec.module is not None and result.limits_ok:
+            from joulepath.program import levers_module
+
+            say("searching the controller's levers (AccSet, speed data, zones) on the controller emulation")
+            levers = levers_module(spec, r, energy=energy, use_waits=use_waits)
         say(f"writing {out} (the written program is checked on the controller emulation)")
         files = write_cycle_run(
             out,
@@ -229,6 +235,7 @@ def cycle(
             cell=cell_data,
             write_anyway=write_anyway,
             egm="always" if export == "egm" else "fallback" if export == "auto" else "never",
+            levers=levers,
         )
     if use_waits and not any(s.idle for s in spec.steps if s.kind == "wait"):
         console.print(
@@ -250,9 +257,16 @@ def cycle(
             f"optimized.mod, as the controller emulation runs it: cycle {saved['executed_cycle_s']:.3f} s "
             f"(taught {result.default_cycle_s:.3f} s), {saved['executed_optimized_J']:.2f} J per cycle on "
             f"the model ({result.energy_measure} energy, motion) against the taught "
-            f"{saved['executed_default_J']:.2f} J: {saved['executed_saved_pct']:.1f} % saved; its via points "
-            f"follow {saved['rapid_follows']}"
+            f"{saved['executed_default_J']:.2f} J: {saved['executed_saved_pct']:.1f} % saved; "
+            + (
+                f"written with the controller's levers ({saved['rapid_levers']['moves_changed']} move "
+                "statements changed: AccSet, speed data, zones)"
+                if saved["rapid_written_from"] == "levers"
+                else f"its via points follow {saved['rapid_follows']}"
+            )
         )
+    if rapid:
+        console.print(f"export: {saved['export_choice']}")
     layout = saved.get("rapid_structure")
     if "optimized.mod" in files and layout is not None:
         lines = layout["optimized_lines"]

@@ -10,7 +10,14 @@ from typing import Any
 import numpy as np
 
 from joulepath import __version__
-from joulepath._io import atomic_write_text, finite_json, make_folder, remove_output, save_figure
+from joulepath._io import (
+    atomic_write_bytes,
+    atomic_write_text,
+    finite_json,
+    make_folder,
+    remove_output,
+    save_figure,
+)
 from joulepath.errors import LimitViolation
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._cycle import LAB_MEASURE, CycleResult, ParetoPoint
@@ -477,6 +484,41 @@ def _rapid_attempt(
     return text, check, None, layout
 
 
+def _levers_json(levers: Any) -> dict[str, Any]:
+    return {
+        "executed_cycle_s": levers.cycle_s,
+        "taught_cycle_s": levers.taught_cycle_s,
+        "executed_energy_J": levers.energy_J,
+        "default_energy_J": levers.default_energy_J,
+        "executed_saved_pct": levers.saved_pct,
+        "energy_measure": levers.energy_measure,
+        "moves_changed": levers.n_changed,
+        "reads_back": levers.reads_back,
+        "plans_searched": levers.n_evaluations,
+        "wall_s": levers.wall_s,
+        "moves": [
+            {"line": m.line, "label": m.label, "taught": asdict(m.taught), "chosen": asdict(m.chosen)}
+            for m in levers.moves
+            if m.changed
+        ],
+    }
+
+
+def _export_choice(
+    egm: str, written_from: str | None, rapid_saved: float | None, plan: float, stream: bool
+) -> str:
+    """One sentence: what was written and why, with the RAPID module's executed and the EGM plan's saving."""
+    egm_part = f"the EGM plan saves {plan:.1f} % (planned)"
+    if written_from is None:
+        return f"no RAPID module runs as planned; {egm_part}" + ("; egm.mod written" if stream else "")
+    rapid_part = f"optimized.mod ({written_from}) saves {rapid_saved:.1f} % as executed"
+    if egm == "fallback" and stream:
+        return f"{rapid_part}, less than half of what {egm_part}: egm.mod written too, the stream recommended"
+    if egm == "fallback":
+        return f"{rapid_part}, at least half of what {egm_part}: RAPID written, no PC in the loop"
+    return f"{rapid_part}; {egm_part}"
+
+
 def write_cycle_run(
     out: Path,
     result: CycleResult,
@@ -486,13 +528,19 @@ def write_cycle_run(
     cell: Cell | None = None,
     write_anyway: bool = False,
     egm: str = "never",
+    levers: Any | None = None,
 ) -> dict[str, Path]:
     """Write the run folder; the module only when every limit holds, the controller emulation
     runs it as the checks ask (:data:`CHECK_TOLERANCES`; ``write_anyway``: written all the same,
     with a warning in its header) and, with a cell, its emulated motion keeps the margin
     (else cycle.json says why). Always ``cycle_path.csv`` (the planned cycle); ``egm``
-    "always", or "fallback" when no module is written: also ``egm.mod`` and ``EGM_SETUP.md``
-    to stream it (``joulepath stream``); "never": not."""
+    "always", or "fallback": also ``egm.mod`` and ``EGM_SETUP.md`` to stream it (``joulepath
+    stream``) where no RAPID module is written or the written one saves, as executed, less than
+    half of what the EGM plan saves; "never": not.
+
+    ``levers`` (a :class:`~joulepath.program.LeverResult`): the program with the controller's own
+    levers (``AccSet``, speed data, zones), read back and run by the controller emulation. The
+    RAPID module written is the better of it and the via-point module, as executed."""
     if egm not in ("always", "fallback", "never"):
         raise ValueError(f"egm must be always, fallback or never, got {egm!r}")
     files: dict[str, Path] = {}
@@ -527,15 +575,46 @@ def write_cycle_run(
             if text is not None:
                 follows = name
                 break
+    via_saved = None
+    if text is not None and check is not None and result.default_energy_J > 0:
+        via_saved = 100.0 * (1.0 - check["emulated_energy_J"] / result.default_energy_J)
+    lever_ok = (
+        levers is not None
+        and levers.reads_back is None
+        and levers.n_changed > 0
+        and levers.energy_J < levers.default_energy_J
+        and levers.cycle_s <= levers.taught_cycle_s + 1e-9
+        and result.limits_ok
+    )
+    written_from = None if text is None else "via points"
+    data_bytes: bytes | None = None
+    if lever_ok and levers is not None and (via_saved is None or levers.saved_pct > via_saved):
+        written_from, data_bytes = "levers", levers.written_bytes()
+        check = {
+            "emulated_cycle_s": levers.cycle_s,
+            "emulated_energy_J": levers.energy_J,
+            "emulated_energy_lab_J": levers.energy_lab_J,
+            "within_tolerances": True,
+            "written_by": "levers: the controller's own plan of the written program (AccSet, speed data, "
+            "zones), read back and run by the controller emulation",
+        }
+        layout = None
     make_folder(out)
     stale = out / "optimized.mod"
-    if text is not None:
+    if data_bytes is not None:
+        files["optimized.mod"] = atomic_write_bytes(stale, data_bytes)
+    elif text is not None:
         files["optimized.mod"] = atomic_write_text(stale, text)
     elif stale.is_file() and not stale.is_symlink():
         remove_output(stale)
+    rapid_saved = via_saved
+    if written_from == "levers" and result.default_energy_J > 0:
+        assert levers is not None  # on the same basis as the via points': the taught cycle as emulated
+        rapid_saved = 100.0 * (1.0 - levers.energy_J / result.default_energy_J)
     files["optimized_cycle.csv"] = atomic_write_text(out / "optimized_cycle.csv", optimized_cycle_csv(result))
     files["cycle_path.csv"] = atomic_write_text(out / "cycle_path.csv", cycle_path_csv(result))
-    stream = egm == "always" or (egm == "fallback" and text is None)
+    half_of_plan = rapid_saved is not None and rapid_saved < 0.5 * result.saved_pct
+    stream = egm == "always" or (egm == "fallback" and (written_from is None or half_of_plan))
     egm_files = egm_cycle_files(result) if stream else {}
     for name in ("egm.mod", "EGM_SETUP.md"):
         old = out / name
@@ -547,7 +626,22 @@ def write_cycle_run(
         default = (result.default_cycle_s, result.default_energy_J, result.default_lab_J)
         files["pareto.csv"] = atomic_write_text(out / "pareto.csv", pareto_csv(pareto, default))
         files["pareto.png"] = pareto_plot(pareto, default, out / "pareto.png")
-    data = cycle_json(result, pareto, "optimized.mod" if text is not None else None, refused, check)
+    data = cycle_json(result, pareto, "optimized.mod" if written_from is not None else None, refused, check)
+    if written_from == "levers":
+        assert levers is not None
+        data["executed_saved_lab_pct"] = (
+            100.0 * (1.0 - levers.energy_lab_J / levers.default_lab_J) if levers.default_lab_J else None
+        )
+        data["executed_note"] = (
+            "optimized.mod (the program with the controller's levers) as the controller emulation runs it, "
+            "against the taught program run by the same emulation, both on energy_measure (the lab robot's "
+            "on the same measure)"
+        )
+    data["rapid_written_from"] = written_from
+    data["rapid_via_points_executed_saved_pct"] = via_saved
+    data["rapid_levers"] = None if levers is None else _levers_json(levers)
+    data["egm_plan_saved_pct"] = result.saved_pct
+    data["export_choice"] = _export_choice(egm, written_from, rapid_saved, result.saved_pct, stream)
     data["rapid_follows"] = follows
     data["rapid_plan_saved_pct"] = None if result.rapid_plan is None else result.rapid_plan.saved_pct
     data["rapid_follows_note"] = (

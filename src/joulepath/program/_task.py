@@ -145,6 +145,10 @@ def steps_of(trace: Trace, robot: Robot) -> tuple[tuple[Step, ...], tuple[tuple[
                     kept=reasons,
                     circle_q=None if e.circle_joints is None else e.circle_joints.copy(),
                     file=e.pos.file,
+                    acc_pct=e.settings.acc_pct,
+                    ramp_pct=e.settings.ramp_pct,
+                    vel_override_pct=e.settings.vel_override_pct,
+                    vel_max_mm_s=e.settings.vel_max_mm_s,
                 )
             )
         elif isinstance(e, Wait):
