@@ -221,11 +221,15 @@ def cycle(
             say("energy against cycle time...")
             front = run_pareto(opt, points=points, use_waits=use_waits)
         levers = None
-        if rapid and export != "egm" and spec.module is not None and result.limits_ok:
+        if rapid and export != "egm" and result.limits_ok:
             from joulepath.program import levers_module
+            from joulepath.program._task_levers import task_levers
 
             say("searching the controller's levers (AccSet, speed data, zones) on the controller emulation")
-            levers = levers_module(spec, r, energy=energy, use_waits=use_waits)
+            if spec.module is not None:
+                levers = levers_module(spec, r, energy=energy, use_waits=use_waits)
+            else:
+                levers = task_levers(spec, r, energy=energy, io=scenario_values or None, routine=routine)
         say(f"writing {out} (the written program is checked on the controller emulation)")
         files = write_cycle_run(
             out,
@@ -252,9 +256,12 @@ def cycle(
         return 1
     b = result.breakdown
     check = saved.get("written_program_check")
-    if "optimized.mod" in files and saved.get("executed_saved_pct") is not None:
+    written_name = "optimized_task/" if "optimized_task" in files else "optimized.mod"
+    if ("optimized.mod" in files or "optimized_task" in files) and saved.get(
+        "executed_saved_pct"
+    ) is not None:
         console.print(
-            f"optimized.mod, as the controller emulation runs it: cycle {saved['executed_cycle_s']:.3f} s "
+            f"{written_name}, as the controller emulation runs it: cycle {saved['executed_cycle_s']:.3f} s "
             f"(taught {result.default_cycle_s:.3f} s), {saved['executed_optimized_J']:.2f} J per cycle on "
             f"the model ({result.energy_measure} energy, motion) against the taught "
             f"{saved['executed_default_J']:.2f} J: {saved['executed_saved_pct']:.1f} % saved; "
@@ -351,7 +358,7 @@ def cycle(
         console.print(
             f"kept verbatim, run time treated as fixed: line(s) {', '.join(map(str, result.fixed_lines))}"
         )
-    if rapid and "optimized.mod" not in files:
+    if rapid and "optimized.mod" not in files and "optimized_task" not in files:
         console.print(f"NOT WRITTEN: optimized.mod: {saved['rapid_refused']}")
     elif check is not None and not check["within_tolerances"]:
         console.print(
@@ -360,4 +367,4 @@ def cycle(
             f"path within {check['tcp_path_deviation_mm']:.1f} mm (cycle.json: written_program_check)"
         )
     console.print(f"wrote {', '.join(sorted(files))} in {out}")
-    return 0 if ("optimized.mod" in files or "egm.mod" in files) else 1
+    return 0 if ("optimized.mod" in files or "optimized_task" in files or "egm.mod" in files) else 1

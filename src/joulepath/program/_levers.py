@@ -57,6 +57,7 @@ from joulepath.errors import InvalidInput
 from joulepath.program._model import Module, MotionSetting, Move, WaitTime
 from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES, _statements, parse_module
 from joulepath.program._resolve import CycleSpec, resolve_module
+from joulepath.rapid.interpreter import Motion
 from joulepath.sim import ControllerConfig, Plant, make_plant
 from joulepath.sim._steps import Step
 from joulepath.sim._timing import FINE_DT, PathCache, PlannedCycle, evaluate_cycle, plan_cycle, stops_after
@@ -140,6 +141,7 @@ class LeverResult:
     n_evaluations: int
     wall_s: float
     waits: tuple[tuple[int, float, float], ...] = ()
+    written_files: tuple[tuple[str, bytes], ...] = ()  # a task's modules (path, bytes); else written_text
 
     @property
     def saved_pct(self) -> float:
@@ -243,7 +245,11 @@ class _Slot:
 
 
 def _key(step: Step) -> tuple[int, str]:
-    """A move statement: its line and instruction (two on one line are told apart, and not edited)."""
+    """A move statement: its line and instruction (two on one line are told apart, and not edited);
+    a statement the RAPID interpreter ran (a task of several modules): its source position's."""
+    if isinstance(step.statement, Motion):
+        m = step.statement
+        return (hash((m.pos.file, m.pos.start)) & 0x7FFFFFFF, m.instruction)
     assert isinstance(step.statement, Move)
     return step.line, step.statement.instruction
 

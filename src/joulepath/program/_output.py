@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -32,6 +33,7 @@ from joulepath.program._rapid_write import (
 
 CYCLE_FILES = (
     "cycle.json",
+    "optimized_task",
     "optimized.mod",
     "pareto.csv",
     "pareto.png",
@@ -484,6 +486,28 @@ def _rapid_attempt(
     return text, check, None, layout
 
 
+OPTIMIZED_TASK = "optimized_task"
+"""The folder a task of several modules is written into (every module, the changed ones edited)."""
+TASK_MARK = "WRITTEN_BY_JOULEPATH.txt"
+
+
+def _write_task(folder: Path, files: tuple[tuple[str, bytes], ...]) -> Path:
+    """Every module under its path relative to the modules' common folder, and a note saying whose."""
+    paths = [Path(p).resolve() for p, _ in files]
+    common = Path(os.path.commonpath([str(p.parent) for p in paths])) if len(paths) > 1 else paths[0].parent
+    make_folder(folder)
+    for (_, data), p in zip(files, paths, strict=True):
+        dest = folder / p.relative_to(common)
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_bytes(dest, data)
+    atomic_write_text(
+        folder / TASK_MARK,
+        "The task as written, with the controller's levers (AccSet, speed data, zones) where joulepath "
+        "changed them; every other byte of every module as it was. See ../cycle.json (rapid_levers).\n",
+    )
+    return folder
+
+
 def _levers_json(levers: Any) -> dict[str, Any]:
     return {
         "executed_cycle_s": levers.cycle_s,
@@ -505,13 +529,13 @@ def _levers_json(levers: Any) -> dict[str, Any]:
 
 
 def _export_choice(
-    egm: str, written_from: str | None, rapid_saved: float | None, plan: float, stream: bool
+    egm: str, written_from: str | None, rapid_saved: float | None, plan: float, stream: bool, name: str
 ) -> str:
     """One sentence: what was written and why, with the RAPID module's executed and the EGM plan's saving."""
     egm_part = f"the EGM plan saves {plan:.1f} % (planned)"
     if written_from is None:
         return f"no RAPID module runs as planned; {egm_part}" + ("; egm.mod written" if stream else "")
-    rapid_part = f"optimized.mod ({written_from}) saves {rapid_saved:.1f} % as executed"
+    rapid_part = f"{name} ({written_from}) saves {rapid_saved:.1f} % as executed"
     if egm == "fallback" and stream:
         return f"{rapid_part}, less than half of what {egm_part}: egm.mod written too, the stream recommended"
     if egm == "fallback":
@@ -588,8 +612,13 @@ def write_cycle_run(
     )
     written_from = None if text is None else "via points"
     data_bytes: bytes | None = None
+    task_files: tuple[tuple[str, bytes], ...] = ()
     if lever_ok and levers is not None and (via_saved is None or levers.saved_pct > via_saved):
-        written_from, data_bytes = "levers", levers.written_bytes()
+        written_from = "levers"
+        if levers.written_files:
+            task_files = levers.written_files
+        else:
+            data_bytes = levers.written_bytes()
         check = {
             "emulated_cycle_s": levers.cycle_s,
             "emulated_energy_J": levers.energy_J,
@@ -601,12 +630,23 @@ def write_cycle_run(
         layout = None
     make_folder(out)
     stale = out / "optimized.mod"
+    task_dir = out / OPTIMIZED_TASK
+    if task_dir.is_dir() and not task_dir.is_symlink() and (task_dir / TASK_MARK).is_file():
+        for old in sorted(task_dir.rglob("*"), reverse=True):  # a task joulepath wrote here before
+            if old.is_file() or old.is_symlink():
+                old.unlink()
+            else:
+                old.rmdir()
+        task_dir.rmdir()
+    if task_files:
+        files[OPTIMIZED_TASK] = _write_task(task_dir, task_files)
     if data_bytes is not None:
         files["optimized.mod"] = atomic_write_bytes(stale, data_bytes)
     elif text is not None:
         files["optimized.mod"] = atomic_write_text(stale, text)
     elif stale.is_file() and not stale.is_symlink():
         remove_output(stale)
+    written_name = OPTIMIZED_TASK if task_files else "optimized.mod"
     rapid_saved = via_saved
     if written_from == "levers" and result.default_energy_J > 0:
         assert levers is not None  # on the same basis as the via points': the taught cycle as emulated
@@ -626,7 +666,7 @@ def write_cycle_run(
         default = (result.default_cycle_s, result.default_energy_J, result.default_lab_J)
         files["pareto.csv"] = atomic_write_text(out / "pareto.csv", pareto_csv(pareto, default))
         files["pareto.png"] = pareto_plot(pareto, default, out / "pareto.png")
-    data = cycle_json(result, pareto, "optimized.mod" if written_from is not None else None, refused, check)
+    data = cycle_json(result, pareto, written_name if written_from is not None else None, refused, check)
     if written_from == "levers":
         assert levers is not None
         data["executed_saved_lab_pct"] = (
@@ -641,7 +681,14 @@ def write_cycle_run(
     data["rapid_via_points_executed_saved_pct"] = via_saved
     data["rapid_levers"] = None if levers is None else _levers_json(levers)
     data["egm_plan_saved_pct"] = result.saved_pct
-    data["export_choice"] = _export_choice(egm, written_from, rapid_saved, result.saved_pct, stream)
+    data["export_choice"] = _export_choice(
+        egm,
+        written_from,
+        rapid_saved,
+        result.saved_pct,
+        stream,
+        f"{written_name}/" if task_files else written_name,
+    )
     data["rapid_follows"] = follows
     data["rapid_plan_saved_pct"] = None if result.rapid_plan is None else result.rapid_plan.saved_pct
     data["rapid_follows_note"] = (
