@@ -82,9 +82,24 @@ class AlgorithmSpec:
     run: Search
 
 
+GRID_SEARCH = {"rate_rows": "grid", "precondition": 0.0, "ftol": 1e-7, "max_iter": 200}
+"""``gradient-grid``: the gradient search as it was before the hull rows (one acceleration and jerk row
+per point of the fine grid, SLSQP in the plain coefficients): the yardstick of its speed."""
+
+
 def _gradient(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+    return _gradient_with(task, config, rng, {})
+
+
+def _gradient_grid(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+    return _gradient_with(task, config, rng, GRID_SEARCH)
+
+
+def _gradient_with(
+    task: SearchTask, config: OptimizeConfig, rng: np.random.Generator, overrides: dict[str, Any]
+) -> SearchOutcome:
     settings = GradientSettings(
-        knot_spacing=config.knot_spacing, n_starts=config.n_starts, check_factor=FINE_FACTOR
+        knot_spacing=config.knot_spacing, n_starts=config.n_starts, check_factor=FINE_FACTOR, **overrides
     )
     res, problem = solve_move(
         task.robot,
@@ -315,6 +330,14 @@ ALGORITHMS: dict[str, AlgorithmSpec] = {
             ("physics",),
             "SLSQP with exact RNEA derivatives over a rest-to-rest B-spline, limits as constraints",
             _gradient,
+        ),
+        AlgorithmSpec(
+            "gradient-grid",
+            "gradient",
+            ("physics",),
+            "the gradient search before the hull rows: acceleration and jerk limits on every point of "
+            "the fine grid (slower; the yardstick of benchmarks/optimizer_speed.py)",
+            _gradient_grid,
         ),
         AlgorithmSpec(
             "cmaes",
