@@ -7,6 +7,7 @@ BLAS thread, in the same process, one after the other on each task:
 
 * ``gradient`` — the default search (hull rows for the acceleration and jerk limits,
   preconditioned SLSQP: :class:`joulepath.optimize.GradientSettings`);
+* ``gradient-fast`` — the same search on one level of knots twice as wide (``--algo gradient-fast``);
 * ``gradient-grid`` — the search before (the same search with a row per point of the fine grid,
   SLSQP in the plain coefficients, ``max_iter`` 200, ``ftol`` 1e-7): the yardstick of the speed-up.
 
@@ -38,7 +39,6 @@ from _report import ROOT, machine, single_core, write_section  # noqa: E402
 
 single_core()
 
-import numpy as np  # noqa: E402
 from optimizer_peers import FIXED_TASK, fine_path_of  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
 
@@ -62,13 +62,17 @@ from joulepath.trajectory import minimum_jerk  # noqa: E402
 from joulepath.units import SAMPLE_PERIOD  # noqa: E402
 
 SECTION = "optimizer_speed"
-METHODS = ("gradient", "gradient-grid")
+METHODS = ("gradient", "gradient-fast", "gradient-grid")
 LABELS = {
     "gradient": "default (`gradient`: hull rows, preconditioned SLSQP)",
+    "gradient-fast": "`gradient-fast` (`--algo gradient-fast`: one level of knots 0.1 s apart)",
     "gradient-grid": "the search before (`gradient-grid`: fine-grid rows, plain SLSQP)",
 }
 REFERENCE_CSV = (
-    ROOT / "benchmarks" / "results" / "optimizer_peers_jerk_nominal_jerk0.125_fixed_00-19_default-reference.csv"
+    ROOT
+    / "benchmarks"
+    / "results"
+    / "optimizer_peers_jerk_nominal_jerk0.125_fixed_00-19_default-reference.csv"
 )
 FIELDS = (
     "task",
@@ -158,74 +162,91 @@ def run(args: argparse.Namespace) -> Path:
     return out_csv
 
 
-def report(path: Path) -> str:
+def _table(path: Path) -> tuple[list[str], list[float], int]:
+    """The summary table of one run (its methods against the first one's CPU), its loads and task count."""
     with path.open() as fh:
         rows = list(csv.DictReader(fh))
     by: dict[str, dict[str, dict[str, Any]]] = {}
     for r in rows:
         by.setdefault(r["task"], {})[r["method"]] = r
-    tasks = [t for t, m in by.items() if all(k in m for k in METHODS)]
-    loads = [float(r["load1"]) for r in rows]
+    methods = [m for m in METHODS if all(m in by[t] for t in by)]
+    tasks = list(by)
+    base = "gradient-grid" if "gradient-grid" in methods else methods[0]
     lines = [
-        "## One move, jerk limits on: the default search against the search before (issue 36)",
-        "",
-        f"Machine: {machine()}; one BLAS/OpenMP thread; CPU time of the process during `optimize_move`. "
-        f"The machine was shared with other jobs (1-minute load average {min(loads):.1f} to {max(loads):.1f}, "
-        f"median {statistics.median(loads):.1f}), so wall times are longer than on an idle core; CPU times "
-        "are what the search itself used. Script: `benchmarks/optimizer_speed.py` "
-        f"(run {time.strftime('%Y-%m-%d')}, raw rows `{path.relative_to(ROOT)}`).",
-        "",
-        f"**{len(tasks)} tasks** (the fixed task of issue 11 and the random tasks of "
-        "`benchmarks/optimizer_peers.py` whose minimum-jerk move keeps the jerk limit), both methods in the "
-        "same run, on each task one after the other. Share of the optimum = (E_default_move - E) / "
-        "(E_default_move - E_optimum) on the 10x grid, E_optimum the jerk-limited reference optimum stored "
-        f"by `benchmarks/optimizer_peers.py` (`{REFERENCE_CSV.name}`; the reference was not rerun).",
+        f"Run `{path.relative_to(ROOT) if path.is_relative_to(ROOT) else path}` ({len(tasks)} tasks):",
         "",
         "| method | tasks | median CPU per move | mean CPU | max CPU | mean share of the optimum | "
-        "min share | within limits (10x grid) | median CPU / the search before's |",
+        f"min share | within limits (10x grid) | median of CPU / {base}'s on the same task |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
-    base_cpu = {t: float(by[t]["gradient-grid"]["cpu_s"]) for t in tasks}
-    for m in METHODS:
+    for m in methods:
         cpu = [float(by[t][m]["cpu_s"]) for t in tasks]
         share = [float(by[t][m]["share_of_optimum"]) for t in tasks]
         ok = [by[t][m]["limits_ok"] == "True" for t in tasks]
-        ratio = statistics.median(float(by[t][m]["cpu_s"]) / base_cpu[t] for t in tasks)
+        ratio = statistics.median(float(by[t][m]["cpu_s"]) / float(by[t][base]["cpu_s"]) for t in tasks)
         lines.append(
             f"| {LABELS[m]} | {len(tasks)} | {statistics.median(cpu):.2f} s | {statistics.mean(cpu):.2f} s | "
             f"{max(cpu):.2f} s | {100 * statistics.mean(share):.1f} % | {100 * min(share):.1f} % | "
             f"{100 * sum(ok) / len(ok):.0f} % | {ratio:.2f}x |"
         )
-    lines += [
-        "",
-        "Per task (CPU s, share of the optimum):",
-        "",
-        "| task | T s | default CPU | default share | before CPU | before share |",
-        "|---|---|---|---|---|---|",
-    ]
+    lines += ["", "| task | T s | " + " | ".join(f"{m} CPU s, share" for m in methods) + " |"]
+    lines.append("|---|---|" + "---|" * len(methods))
     for t in tasks:
-        a, b = by[t]["gradient"], by[t]["gradient-grid"]
-        lines.append(
-            f"| {t} | {a['T_s']} | {float(a['cpu_s']):.2f} | {100 * float(a['share_of_optimum']):.1f} % | "
-            f"{float(b['cpu_s']):.2f} | {100 * float(b['share_of_optimum']):.1f} % |"
-        )
+        cells = [
+            f"{float(by[t][m]['cpu_s']):.2f}, {100 * float(by[t][m]['share_of_optimum']):.1f} %"
+            for m in methods
+        ]
+        lines.append(f"| {t} | {by[t][methods[0]]['T_s']} | " + " | ".join(cells) + " |")
+    return lines, [float(r["load1"]) for r in rows], len(tasks)
+
+
+def report(paths: list[Path]) -> str:
+    lines = [
+        "## One move, jerk limits on: the default search against the search before (issue 36)",
+        "",
+    ]
+    loads: list[float] = []
+    tables: list[str] = []
+    for path in paths:
+        table, load, _ = _table(path)
+        loads += load
+        tables += [*table, ""]
+    lines += [
+        f"Machine: {machine()}; one BLAS/OpenMP thread; CPU time of the process during `optimize_move` "
+        "(`time.process_time`). The machine was shared with other jobs (1-minute load average "
+        f"{min(loads):.1f} to {max(loads):.1f}, median {statistics.median(loads):.1f}, on 2 logical CPUs), so wall "
+        "times were several times the CPU times; CPU times are what the search itself used, and they too "
+        "run somewhat longer on a loaded machine (shared caches). Script: `benchmarks/optimizer_speed.py`.",
+        "",
+        "Tasks: the fixed task of issue 11 and the random tasks 0-19 of `benchmarks/optimizer_peers.py` "
+        "(seed 11; all 21 keep the jerk limit on their minimum-jerk move). Each run has its methods one after "
+        "the other on each task, in one process. Share of the optimum = (E_default_move - E) / "
+        "(E_default_move - E_optimum) on the 10x grid, E_optimum the jerk-limited reference optimum of the "
+        f"same task stored by `benchmarks/optimizer_peers.py` (`{REFERENCE_CSV.name}`; the reference, 70 s "
+        "of CPU per task, was not rerun). Limits: `check_limits` on the 10x grid (ranges, speeds, "
+        "accelerations, jerks, efforts).",
+        "",
+        *tables,
+    ]
     return "\n".join(lines)
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--tasks", type=int, default=20, help="random tasks to draw (from the first)")
     parser.add_argument("--seed", type=int, default=11, help="seed of the task draw and of every search")
     parser.add_argument("--fixed", action="store_true", help="run the issue's fixed task first")
-    parser.add_argument("--methods", default=",".join(METHODS))
+    parser.add_argument("--methods", default="gradient,gradient-grid")
     parser.add_argument("--reference-csv", type=Path, default=REFERENCE_CSV)
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     parser.add_argument("--no-report", action="store_true")
-    parser.add_argument("--report-only", type=Path, default=None, help="a CSV of an earlier run")
+    parser.add_argument("--report-only", type=Path, nargs="+", default=None, help="CSVs of earlier runs")
     args = parser.parse_args()
-    path = args.report_only if args.report_only is not None else run(args)
+    paths = args.report_only if args.report_only is not None else [run(args)]
     if not args.no_report:
-        write_section(SECTION, report(path))
+        write_section(SECTION, report(paths))
 
 
 if __name__ == "__main__":

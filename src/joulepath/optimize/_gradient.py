@@ -39,6 +39,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -526,10 +527,10 @@ class SplineProblem:
             linear("ineq", *self._jerk_rows(jer))
         eff = active.get("tau")
         if eff is not None and eff.size:
-            nonlinear(lambda x, idx=eff: self._effort_rows(x, idx))
+            nonlinear(partial(self._effort_rows, idx=eff))
         dev = active.get("tcp")
         if dev is not None and dev.size and self.max_deviation_m is not None:
-            nonlinear(lambda x, idx=dev: self._corridor_rows(x, idx))
+            nonlinear(partial(self._corridor_rows, idx=dev))
         return cons
 
     def _effort_rows(self, x: FloatArray, idx: np.ndarray) -> tuple[FloatArray, FloatArray]:
@@ -763,7 +764,9 @@ def _solve_from(
             else:  # the same problem in y, x = x + W y: its Hessian near the identity at y = 0
                 x_at, Wm = x, W
 
-                def fun_y(y: FloatArray) -> tuple[float, FloatArray]:
+                def fun_y(
+                    y: FloatArray, x_at: FloatArray = x_at, Wm: FloatArray = Wm
+                ) -> tuple[float, FloatArray]:
                     f, g = fun(x_at + Wm @ y)
                     return f, Wm.T @ g
 
