@@ -16,10 +16,15 @@ spline basis.
 
 Constraints (not penalties), solved by SLSQP:
 
-* joint ranges, speed, acceleration and jerk limits — linear in ``x`` — on a grid
-  ``check_factor`` times finer than the samples, so they also hold between samples
-  (the jerk is the difference of consecutive accelerations over the grid step, the
-  quantity :func:`joulepath.optimize._verify.path_jerk` checks);
+* joint ranges, speed, acceleration and jerk limits — linear in ``x`` — as bounds on the
+  control points of the path and of its first three derivatives (B-splines of degree 5 to 2;
+  the accelerations' and jerks' on knots ``hull_refine`` times finer, whose control points lie
+  closer to the curve): a B-spline lies in the convex hull of its control points, so the limits
+  hold at every instant, with a few rows per knot (``rate_rows="grid"``: the accelerations and
+  jerks instead on a grid ``check_factor`` times finer than the samples, the jerk being the
+  difference of consecutive accelerations over the grid step, the quantity
+  :func:`joulepath.optimize._verify.path_jerk` checks; a move added to a given ``base`` motion
+  always takes these);
 * effort limits (where the robot states them) on the same fine grid;
 * optionally a corridor: the TCP stays within ``max_deviation_m`` of the default
   move's TCP at every sample;
@@ -28,10 +33,16 @@ Constraints (not penalties), solved by SLSQP:
   a chain of fly-by targets solved as one move; exactly (equalities), or within a
   box of given half-widths per joint (``waypoint_radius``: a zone, inequalities).
 
-Fine-grid constraints are generated lazily (active-set style): each solve includes
-the grid points whose value is within ``SCREEN_BAND`` of its limit at the start
-point; after the solve, every fine-grid point is checked, the violated or nearly
-active ones are added, and the solve is repeated from the last point.
+Each continuation stage solves in coordinates in which the smoothed energy's Hessian at the
+stage's start is near the identity (``GradientSettings.precondition``): SLSQP's quasi-Newton
+model starts from the identity, and on the fine knots' many variables it needs far fewer
+iterations so.
+
+Constraints are generated lazily (active-set style): each solve includes
+the rows (control points, grid points) whose value is within ``SCREEN_BAND`` of its limit
+at the start point; after the solve, every row is checked, the violated or nearly active
+ones are added, and the solve is repeated from the last point. A result counts as within
+the limits only when every row holds and every point of the fine grid does too.
 """
 
 from __future__ import annotations

@@ -347,22 +347,6 @@ ALGORITHMS: dict[str, AlgorithmSpec] = {
             _gradient,
         ),
         AlgorithmSpec(
-            "gradient-fast",
-            "gradient",
-            ("physics",),
-            "the gradient search on knots twice as wide, without the refinement on the fine knots: "
-            "for interactive use, a few points of saving for about a third of the time (BENCHMARKS.md)",
-            _gradient_fast,
-        ),
-        AlgorithmSpec(
-            "gradient-grid",
-            "gradient",
-            ("physics",),
-            "the gradient search before the hull rows: acceleration and jerk limits on every point of "
-            "the fine grid (slower; the yardstick of benchmarks/optimizer_speed.py)",
-            _gradient_grid,
-        ),
-        AlgorithmSpec(
             "cmaes",
             "evolution strategy",
             ALL_FITNESS,
@@ -388,6 +372,22 @@ ALGORITHMS: dict[str, AlgorithmSpec] = {
             ALL_FITNESS,
             "memetic GA, local search on the most influential joints",
             _evolutionary("ma-informed"),
+        ),
+        AlgorithmSpec(
+            "gradient-fast",
+            "gradient",
+            ("physics",),
+            "the gradient search on knots twice as wide, without the refinement on the fine knots: "
+            "for interactive use, about half the time for a few points less saving (BENCHMARKS.md)",
+            _gradient_fast,
+        ),
+        AlgorithmSpec(
+            "gradient-grid",
+            "gradient",
+            ("physics",),
+            "the gradient search before the hull rows: acceleration and jerk limits on every point of "
+            "the fine grid (slower; the yardstick of benchmarks/optimizer_speed.py)",
+            _gradient_grid,
         ),
     )
 }
