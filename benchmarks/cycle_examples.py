@@ -14,8 +14,8 @@ and 105 % of its span, the best combination within the sum (``SHARED=0`` skips i
 
 Run: ``.venv/bin/python benchmarks/cycle_examples.py [PROGRAM ...]`` (one BLAS thread; about 25
 minutes on a shared 2-core machine, 16 of them the optimum's 13 segments of palletizing;
-``OPTIMUM=0``: the plans only, about 2 minutes; ``GRADIENT=grid``: the plans with the single-move
-search before the hull rows, ``joulepath.optimize._search.GRID_SEARCH``).
+``OPTIMUM=0``: the plans only, about 2 minutes; ``GRADIENT=hull``: the plans with the single move's
+default search in place of the cycle's, ``joulepath.optimize._gradient.GRID_SEARCH``).
 Writes the table to stdout; BENCHMARKS.md holds a copy with the machine.
 """
 
@@ -144,12 +144,12 @@ def shared_optimum(opt) -> tuple[float, float, str, float]:
 
 
 def plan_settings() -> CycleSettings:
-    """The CLI's defaults; ``GRADIENT=grid``: with the single-move search before the hull rows (issue 36)."""
-    if os.environ.get("GRADIENT", "") == "grid":
+    """The CLI's defaults; ``GRADIENT=hull``: with the single move's default search (hull rows,
+    preconditioned SLSQP; issue 36) in place of the cycle's (``GRID_SEARCH``)."""
+    if os.environ.get("GRADIENT", "") == "hull":
         from joulepath.optimize import GradientSettings
-        from joulepath.optimize._search import GRID_SEARCH
 
-        return CycleSettings(gradient=GradientSettings(**GRID_SEARCH))
+        return CycleSettings(gradient=GradientSettings())
     return CycleSettings()
 
 

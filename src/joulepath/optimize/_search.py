@@ -26,7 +26,7 @@ from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.evolve import DE, GA, MA, Termination, minimize
-from joulepath.optimize._gradient import GradientSettings, solve_move
+from joulepath.optimize._gradient import GRID_SEARCH, GradientSettings, solve_move
 from joulepath.optimize._problem import FITNESS, PENALTY, TrajectoryProblem, limit_violation
 from joulepath.optimize._verify import FINE_FACTOR
 from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk, rest_to_rest, thesis_quintic
@@ -80,11 +80,6 @@ class AlgorithmSpec:
     fitness: tuple[str, ...]
     description: str
     run: Search
-
-
-GRID_SEARCH = {"rate_rows": "grid", "precondition": 0.0, "ftol": 1e-7, "max_iter": 200}
-"""``gradient-grid``: the gradient search as it was before the hull rows (one acceleration and jerk row
-per point of the fine grid, SLSQP in the plain coefficients): the yardstick of its speed."""
 
 
 FAST_KNOT_FACTOR = 2
