@@ -211,6 +211,18 @@ def report(paths: list[Path]) -> str:
         table, load, _ = _table(path)
         loads += load
         tables += [*table, ""]
+    with paths[0].open() as fh:
+        first = [r for r in csv.DictReader(fh) if r["method"] == "gradient"]
+    med = statistics.median(float(r["cpu_s"]) for r in first)
+    share = 100 * statistics.mean(float(r["share_of_optimum"]) for r in first)
+    ok = 100 * sum(r["limits_ok"] == "True" for r in first) / len(first)
+    lines += [
+        f"Against issue 36's targets (first run): median CPU per move {med:.2f} s (target at most 1.0 s: "
+        f"{'met' if med <= 1.0 else 'not met'}); mean share of the jerk-limited optimum {share:.1f} % (target at "
+        f"least 97 %: {'met' if share >= 97.0 else 'not met'}); within every limit on the 10x grid {ok:.0f} % "
+        f"(target 100 %: {'met' if ok == 100 else 'not met'}).",
+        "",
+    ]
     lines += [
         f"Machine: {machine()}; one BLAS/OpenMP thread; CPU time of the process during `optimize_move` "
         "(`time.process_time`). The machine was shared with other jobs (1-minute load average "
