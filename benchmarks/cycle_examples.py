@@ -14,7 +14,8 @@ and 105 % of its span, the best combination within the sum (``SHARED=0`` skips i
 
 Run: ``.venv/bin/python benchmarks/cycle_examples.py [PROGRAM ...]`` (one BLAS thread; about 25
 minutes on a shared 2-core machine, 16 of them the optimum's 13 segments of palletizing;
-``OPTIMUM=0``: the plans only, about 2 minutes).
+``OPTIMUM=0``: the plans only, about 2 minutes; ``GRADIENT=hull``: the plans with the single move's
+default search in place of the cycle's, ``joulepath.optimize._gradient.GRID_SEARCH``).
 Writes the table to stdout; BENCHMARKS.md holds a copy with the machine.
 """
 
@@ -142,6 +143,16 @@ def shared_optimum(opt) -> tuple[float, float, str, float]:
     return taught, best, "shares " + ", ".join(f"{c:g}" for c in chosen), time.perf_counter() - w0
 
 
+def plan_settings() -> CycleSettings:
+    """The CLI's defaults; ``GRADIENT=hull``: with the single move's default search (hull rows,
+    preconditioned SLSQP; issue 36) in place of the cycle's (``GRID_SEARCH``)."""
+    if os.environ.get("GRADIENT", "") == "hull":
+        from joulepath.optimize import GradientSettings
+
+        return CycleSettings(gradient=GradientSettings())
+    return CycleSettings()
+
+
 def main(argv: list[str] | None = None) -> None:
     names = tuple(argv) if argv else PROGRAMS
     robot = load_robot("irb120")
@@ -150,7 +161,7 @@ def main(argv: list[str] | None = None) -> None:
         spec, rapid = read_cycle_program(EXAMPLES / f"{name}.mod", robot)
         t0 = time.process_time()
         w0 = time.perf_counter()
-        result, opt = optimize_cycle(spec, CycleSettings())
+        result, opt = optimize_cycle(spec, plan_settings())
         cpu = time.process_time() - t0
         wall = time.perf_counter() - w0
         with tempfile.TemporaryDirectory() as tmp:

@@ -11,11 +11,15 @@ import pytest
 
 import joulepath
 from joulepath.optimize import GradientSettings
+from joulepath.optimize._gradient import GRID_SEARCH
 from joulepath.program import CycleSettings, optimize_cycle, parse_module, read_cycle_program, resolve_module
 from joulepath.program._output import check_written, reads_back, written_rapid
 from joulepath.program._rapid_write import motion_model, planned_model, restore_program, same_model
 
-FAST = GradientSettings(knot_spacing=0.1, continuation=(0.3, 0.03), max_iter=60, coarse_factor=1)
+# the cycle's own search (CycleSettings.gradient: GRID_SEARCH), on wider knots and fewer stages
+FAST = GradientSettings(
+    **{**GRID_SEARCH, "knot_spacing": 0.1, "continuation": (0.3, 0.03), "max_iter": 60, "coarse_factor": 1}
+)
 # The module is written from the plan before its MoveL segments are re-timed along their path
 # (CycleResult.unretimed), which retime_segments=False gives as the result itself (measured: the same
 # palletizing module but its header's planned energy, in 1/9 of the time); the module of a re-timed

@@ -173,7 +173,6 @@ def cycle(
     --write-anyway); 2: bad input (unreadable program, unreachable target, infeasible cycle time).
     """
     from joulepath.energy import check_measure
-    from joulepath.optimize import GradientSettings
     from joulepath.program import (
         CYCLE_FILES,
         CycleSettings,
@@ -205,7 +204,7 @@ def cycle(
         seed=seed,
         table_points=table_points,
         corridor_mm=corridor or None,
-        gradient=GradientSettings(knot_spacing=knot_spacing),
+        gradient=replace(CycleSettings().gradient, knot_spacing=knot_spacing),
         energy=energy,
     )
     if jerk_time is not None:  # else the controller's default (CycleSettings')

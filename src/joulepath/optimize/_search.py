@@ -26,7 +26,7 @@ from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.evolve import DE, GA, MA, Termination, minimize
-from joulepath.optimize._gradient import GradientSettings, solve_move
+from joulepath.optimize._gradient import GRID_SEARCH, GradientSettings, solve_move
 from joulepath.optimize._problem import FITNESS, PENALTY, TrajectoryProblem, limit_violation
 from joulepath.optimize._verify import FINE_FACTOR
 from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk, rest_to_rest, thesis_quintic
@@ -82,9 +82,34 @@ class AlgorithmSpec:
     run: Search
 
 
+FAST_KNOT_FACTOR = 2
+"""``gradient-fast`` searches knots this many times wider apart than ``knot_spacing``, on one level."""
+
+
 def _gradient(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+    return _gradient_with(task, config, rng, {})
+
+
+def _gradient_fast(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+    return _gradient_with(
+        task, config, rng, {"knot_spacing": FAST_KNOT_FACTOR * config.knot_spacing, "coarse_factor": 1}
+    )
+
+
+def _gradient_grid(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+    return _gradient_with(task, config, rng, GRID_SEARCH)
+
+
+def _gradient_with(
+    task: SearchTask, config: OptimizeConfig, rng: np.random.Generator, overrides: dict[str, Any]
+) -> SearchOutcome:
     settings = GradientSettings(
-        knot_spacing=config.knot_spacing, n_starts=config.n_starts, check_factor=FINE_FACTOR
+        **{
+            "knot_spacing": config.knot_spacing,
+            "n_starts": config.n_starts,
+            "check_factor": FINE_FACTOR,
+            **overrides,
+        }
     )
     res, problem = solve_move(
         task.robot,
@@ -342,6 +367,22 @@ ALGORITHMS: dict[str, AlgorithmSpec] = {
             ALL_FITNESS,
             "memetic GA, local search on the most influential joints",
             _evolutionary("ma-informed"),
+        ),
+        AlgorithmSpec(
+            "gradient-fast",
+            "gradient",
+            ("physics",),
+            "the gradient search on knots twice as wide, without the refinement on the fine knots: "
+            "for interactive use, about half the time for a few points less saving (BENCHMARKS.md)",
+            _gradient_fast,
+        ),
+        AlgorithmSpec(
+            "gradient-grid",
+            "gradient",
+            ("physics",),
+            "the gradient search before the hull rows: acceleration and jerk limits on every point of "
+            "the fine grid (slower; the yardstick of benchmarks/optimizer_speed.py)",
+            _gradient_grid,
         ),
     )
 }
