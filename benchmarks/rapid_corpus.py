@@ -107,9 +107,10 @@ def main() -> None:
             )
             continue
         saved = "" if r["saved_pct"] is None else f"{r['saved_pct']:.1f}"
+        executed = "" if r.get("rapid_executed_pct") is None else f"{r['rapid_executed_pct']:.1f}"
         print(
             f"| {r['name']} | {r['exit']} | {r['moves']} | {r['optimized']} | {r['kept_runtime']} | "
-            f"{r['open_pct']:.0f} | {saved} | {r['written']} | {r['cpu_s']:.1f} | {r['wall_s']:.1f} |"
+            f"{r['open_pct']:.0f} | {saved} | {executed} | {r['written']} | {r['cpu_s']:.1f} | {r['wall_s']:.1f} |"
         )
 
 
