@@ -269,6 +269,9 @@ def test_an_interrupted_run_leaves_no_partial_file_and_resumes(
 
 def test_run_on_a_dask_scheduler_gives_the_local_results(tmp_path, dask_scheduler):
     text = TINY.replace("[optimize]", '[optimize]\nfitness = "physics"').replace("tasks = 2", "tasks = 1")
+    # seed 0: its random task (1.775 s) solves about 7 times faster than seed 1's (CPU time); the
+    # run runs twice, and the scheduler must reproduce the local results whatever the seed
+    text = text.replace("seed = 1", "seed = 0")
     text += "[bench]\ntasks = 1\ngenerations = 3\npopulation = 8\nconfigurations = 'compact'\n"
     # importance runs locally either way (the scheduler takes grid search and benchmark): E only, the
     # target whose joint ranking the optimizers use, not all seven
