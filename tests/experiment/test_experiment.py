@@ -116,6 +116,37 @@ def test_bundled_demo_experiment_is_valid():
     assert exp.name == "demo" and exp.train.families == ("mlp", "svr", "par", "xgb")
 
 
+def test_bundled_study_runs_the_demos_stages_at_a_larger_size():
+    from importlib import resources
+
+    presets = resources.files("joulepath.experiment") / "presets"
+    demo = load_experiment(str(presets / "demo.toml"))
+    study = load_experiment(str(presets / "study.toml"))
+    assert study.name == "study"
+    # every stage the demo runs, the study runs too, on at least as much data and work
+    assert study.synth.methods and study.bench.tasks and study.identify.enabled and study.optimize.reference
+    assert set(demo.synth.methods) <= set(study.synth.methods)
+    assert study.train.families == demo.train.families and study.train.targets == demo.train.targets
+    for a, b in (
+        (demo.data.train_moves, study.data.train_moves),
+        (demo.data.test_moves, study.data.test_moves),
+        (demo.data.sim_moves, study.data.sim_moves),
+        (demo.synth.rows, study.synth.rows),
+        (demo.train.cv, study.train.cv),
+        (demo.importance.max_rows, study.importance.max_rows),
+        (demo.optimize.tasks, study.optimize.tasks),
+        (demo.bench.tasks, study.bench.tasks),
+        (demo.bench.generations, study.bench.generations),
+        (demo.identify.loop_tasks, study.identify.loop_tasks),
+    ):
+        assert a <= b
+    assert (study.data.train_moves, study.optimize.tasks, study.bench.tasks) > (
+        demo.data.train_moves,
+        demo.optimize.tasks,
+        demo.bench.tasks,
+    )
+
+
 def test_bundled_thesis_experiment_is_the_full_plan():
     from importlib import resources
 
