@@ -1,6 +1,7 @@
 # make demo : set up .venv (if missing), install joulepath with its extras, run demo.toml -> runs/demo/report.html
 #             (the folder of `joulepath run demo` too, so either reuses what the other computed)
 # make test : set up .venv (if missing), install joulepath with its extras, build the docs site strictly, run all tests
+#             on 2 workers (pytest-xdist, one test file per worker at a time), listing the 15 slowest
 # make docs : build the documentation site into build/site (open build/site/index.html)
 PYTHON ?= python3
 VENV := .venv
@@ -25,7 +26,7 @@ test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks scripts docs
 	$(BIN)/mypy src
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir build/site  # no -q: it hides the warnings --strict counts
-	$(BIN)/python -m pytest -q -p no:cacheprovider
+	$(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --dist loadfile --durations=15
 
 docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir build/site

@@ -118,7 +118,8 @@ def test_main_demo_and_run_demo_and_make_demo_share_one_folder(monkeypatch, tmp_
     monkeypatch.chdir(tmp_path)
     assert main(["demo", "--quiet"]) == 0
     assert main(["run", "demo", "--quiet"]) == 0
-    assert folders == [Path("runs/demo"), Path("runs/demo")]
+    assert main(["run", "study", "--quiet"]) == 0  # the bundled larger study
+    assert folders == [Path("runs/demo"), Path("runs/demo"), Path("runs/study")]
     makefile = (Path(__file__).parents[2] / "Makefile").read_text()
     recipe = re.search(r"^demo:.*\n((?:\t.*\n)+)", makefile, re.M)
     assert recipe is not None

@@ -12,7 +12,7 @@ import typer
 from joulepath.cli._common import check_out_folder, console
 from joulepath.errors import InvalidInput
 
-BUNDLED = ("demo", "thesis")
+BUNDLED = ("demo", "study", "thesis")
 RUNS = Path("runs")
 """Where runs go unless ``--out`` says otherwise: ``runs/<name>`` (``make demo`` too: ``runs/demo``)."""
 
@@ -87,7 +87,9 @@ def _run(experiment: str, out: Path | None, quiet: bool, scheduler: str | None) 
 
 def run(
     experiment: str = typer.Argument(
-        ..., help="Experiment TOML file, or a bundled one: demo (minutes), thesis (the full plan)."
+        ...,
+        help="Experiment TOML file, or a bundled one: demo (minutes), study (a larger demo), "
+        "thesis (the full plan).",
     ),
     out: Path = typer.Option(None, "--out", help="Run folder (default: runs/<name>)."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress; print only the last line."),

@@ -9,14 +9,14 @@ Example (``joulepath/experiment/presets/demo.toml``, abridged)::
 
     [data]                # simulate on a plant, or ingest logs (train_logs / test_logs)
     plant = "lab"
-    train_moves = 40
-    test_moves = 15
+    train_moves = 30
+    test_moves = 10
     micro_moves = 10      # the thesis' small real sample that synthesis grows (0: none)
-    sim_moves = 40        # the thesis' simulated dataset, on the nominal "sim" plant (0: none)
+    sim_moves = 20        # the thesis' simulated dataset, on the nominal "sim" plant (0: none)
 
     [synth]               # optional: grow synthetic rows from a small real sample
-    methods = ["copula", "tvae"]
-    rows = 3000
+    methods = ["copula"]  # or "tvae", "ctgan", "copulagan"
+    rows = 2000
 
     [train]
     families = ["mlp", "svr", "par", "xgb"]
@@ -27,19 +27,19 @@ Example (``joulepath/experiment/presets/demo.toml``, abridged)::
     targets = ["E", "E1", "E2", "E3", "E4", "E5", "E6"]
 
     [optimize]
-    tasks = 3
+    tasks = 1
     algorithm = "auto"     # gradient on physics, cmaes on a learned model; or ga, de, ma-*
     fitness = "physics"
     energy = "thesis"      # or "mechanical", "electrical" (needs the robot's drive data)
     reference = true       # also solve each task to the optimum (needs the `reference` extra)
 
     [bench]               # optional: every GA/DE/MA configuration on the same random tasks
-    tasks = 3
-    generations = 30
+    tasks = 2
+    generations = 15
 
     [identify]            # optional: a calibrated twin from the training logs (joulepath identify)
     enabled = true
-    loop_tasks = 3        # tasks optimized on the twin: predicted against realized saving
+    loop_tasks = 1        # tasks optimized on the twin: predicted against realized saving
 
     [cycle]               # optional: a robot program's whole cycle (joulepath cycle)
     program = "pick_and_place.mod"   # RAPID module or plain cycle TOML, relative to this file

@@ -12,7 +12,7 @@ from joulepath.learn._families import (
 )
 from joulepath.learn._features import INPUTS, PhysicsFeatures, input_columns, physics_transform
 from joulepath.learn._importance import feature_importance, plot_importance, rank_joints
-from joulepath.learn._model import TRUSTED_TYPES, EnergyModel
+from joulepath.learn._model import TRUSTED_TYPES, EnergyModel, check_finite_predictions
 from joulepath.learn._search import CandidateResult, SearchResult, grid_search, make_splits
 from joulepath.learn._svr import KERNEL_SVR_MAX_ROWS, ScalableSVR, SubsampleWarning
 from joulepath.learn._train import (
@@ -24,7 +24,7 @@ from joulepath.learn._train import (
     load_models,
     train,
 )
-from joulepath.learn._validate import check_finite_predictions, read_joints_json
+from joulepath.learn._validate import read_joints_json
 
 __all__ = [
     "CandidateResult",

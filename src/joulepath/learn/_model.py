@@ -11,7 +11,8 @@ Files (one folder per model):
   hyperparameters, library versions.
 
 Loading checks the card and the model file against each other before either
-reaches a library (:mod:`joulepath.learn._validate`).
+reaches a library (:mod:`joulepath.learn._validate`); :func:`check_finite_predictions`
+refuses a model's NaN or infinite predictions.
 """
 
 from __future__ import annotations
@@ -328,3 +329,36 @@ class EnergyModel:
             raise InvalidModel(f"{file}: holds a {type(pipeline).__name__}, not a Pipeline")
         check_pipeline(pipeline, card, file)
         return cls(pipeline, card, source=src)
+
+
+def check_finite_predictions(model: EnergyModel, X: FloatArray) -> FloatArray:
+    """Predict rows with ``model`` and refuse NaN or infinite predictions.
+
+    Parameters
+    ----------
+    model : EnergyModel
+    X : ndarray of shape (n_rows, n_inputs)
+        Rows in ``model.input_columns`` order.
+
+    Returns
+    -------
+    ndarray of shape (n_rows,)
+        The predictions, all finite.
+
+    Raises
+    ------
+    InvalidModel
+        When any prediction is NaN or infinite (the model diverges on these inputs).
+    """
+    with np.errstate(all="ignore"):
+        pred = model.predict_rows(X)
+    bad = ~np.isfinite(pred)
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        where = f"{model.source}: " if model.source is not None else ""
+        raise InvalidModel(
+            f"{where}the {model.family} model for {model.target} predicts {pred[row]} for "
+            f"{int(bad.sum())} of {pred.size} rows (first: row {row}); its energies cannot be "
+            "trusted, train the model again or use another family"
+        )
+    return pred

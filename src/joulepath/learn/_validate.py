@@ -15,7 +15,6 @@ that names the file, what is wrong and how to fix it:
   and ``num_feature`` equal to what the card's inputs give (XGBoost itself does
   not check these and crashes the process at prediction time);
 * scikit-learn pipelines: the steps and array shapes the card implies;
-* predictions: :func:`check_finite_predictions`;
 * ``joints.json``: :func:`read_joints_json`.
 """
 
@@ -27,7 +26,7 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -37,9 +36,6 @@ from joulepath.data._schema import MAX_JOINTS, card_joints
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._families import FAMILIES
 from joulepath.learn._features import INPUTS, input_columns, n_physics_terms
-
-if TYPE_CHECKING:
-    from joulepath.learn._model import EnergyModel
 
 _ROOT_PARENT = 2147483647
 """What XGBoost writes as the parent of a tree's root."""
@@ -443,40 +439,7 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
     _finite(model, ("coef_", "intercept_"), where)
 
 
-# --------------------------------------------------------------------------- predictions, joints.json
-def check_finite_predictions(model: EnergyModel, X: FloatArray) -> FloatArray:
-    """Predict rows with ``model`` and refuse NaN or infinite predictions.
-
-    Parameters
-    ----------
-    model : EnergyModel
-    X : ndarray of shape (n_rows, n_inputs)
-        Rows in ``model.input_columns`` order.
-
-    Returns
-    -------
-    ndarray of shape (n_rows,)
-        The predictions, all finite.
-
-    Raises
-    ------
-    InvalidModel
-        When any prediction is NaN or infinite (the model diverges on these inputs).
-    """
-    with np.errstate(all="ignore"):
-        pred = model.predict_rows(X)
-    bad = ~np.isfinite(pred)
-    if bad.any():
-        row = int(np.flatnonzero(bad)[0])
-        where = f"{model.source}: " if model.source is not None else ""
-        raise InvalidModel(
-            f"{where}the {model.family} model for {model.target} predicts {pred[row]} for "
-            f"{int(bad.sum())} of {pred.size} rows (first: row {row}); its energies cannot be "
-            "trusted, train the model again or use another family"
-        )
-    return pred
-
-
+# --------------------------------------------------------------------------- joints.json
 def read_joints_json(path: str | os.PathLike[str], n_joints: int) -> tuple[int, ...]:
     """Joints (1-based) ordered by influence, from a ``joints.json`` written by training or importance.
 

@@ -12,6 +12,7 @@ from joulepath.optimize._execute import EXECUTION_TOLERANCES, Execution, rapid_e
 from joulepath.optimize._features import path_features
 from joulepath.optimize._gradient import GradientResult, GradientSettings, SplineProblem, optimize_spline
 from joulepath.optimize._problem import (
+    FINE_FACTOR,
     FITNESS,
     FITNESS_KINDS,
     PARAMETRIZATIONS,
@@ -56,7 +57,6 @@ from joulepath.optimize._segment_reference import (
     segment_optimum,
 )
 from joulepath.optimize._verify import (
-    FINE_FACTOR,
     LimitExcess,
     LimitReport,
     check_limits,

@@ -89,6 +89,12 @@ def fitness_kind(name: str) -> FitnessKind:
 
 PENALTY = 1000.0
 """J per unit of limit violation (see the module docstring)."""
+FINE_FACTOR = 10
+"""Limits and the energy integral are checked on a grid this many times finer than the samples.
+
+The one definition of the fine grid: the jerk penalty here, the searches and the
+verification (:mod:`joulepath.optimize._verify`) all measure on it.
+"""
 
 
 @dataclass(frozen=True, slots=True)
@@ -254,8 +260,6 @@ class TrajectoryProblem:
             viol = limit_violation(self.robot, traj, tau, acceleration_limit=amax)
             total = viol.total
         else:
-            from joulepath.optimize._verify import FINE_FACTOR  # _verify imports this module
-
             fine = self.trajectory(X, dt=self.dt / FINE_FACTOR)
             kin = limit_violation(self.robot, fine, None, acceleration_limit=amax, jerk_limit=jmax)
             total = kin.range + kin.speed + limit_violation(self.robot, traj, tau).torque

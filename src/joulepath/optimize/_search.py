@@ -10,7 +10,9 @@
 
 Every search returns a :class:`SearchOutcome`: the path on the samples and on the
 fine verification grid, the parameters, and its own record. Verification and
-reporting are not its business.
+reporting are not its business. A search reads its settings through
+:class:`SearchSettings`, which :class:`joulepath.optimize.OptimizeConfig` satisfies
+(this module does not import the one that runs and writes an optimization).
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -27,13 +29,8 @@ from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.evolve import DE, GA, MA, Termination, minimize
 from joulepath.optimize._gradient import GRID_SEARCH, GradientSettings, solve_move
-from joulepath.optimize._problem import FITNESS, PENALTY, TrajectoryProblem, limit_violation
-from joulepath.optimize._verify import FINE_FACTOR
+from joulepath.optimize._problem import FINE_FACTOR, FITNESS, PENALTY, TrajectoryProblem, limit_violation
 from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk, rest_to_rest, thesis_quintic
-
-if TYPE_CHECKING:
-    from joulepath.optimize._run import OptimizeConfig
-
 
 CMAES_KNOT_FACTOR = 4
 """CMA-ES searches knots this many times wider apart than ``knot_spacing`` (fewer variables)."""
@@ -68,7 +65,46 @@ class SearchTask:
     jerk_limit: FloatArray | None = None
 
 
-Search = Callable[["SearchTask", "OptimizeConfig", np.random.Generator], SearchOutcome]
+class SearchSettings(Protocol):
+    """The settings a search reads (:class:`joulepath.optimize.OptimizeConfig` has them all)."""
+
+    @property
+    def fitness(self) -> str: ...
+    @property
+    def energy(self) -> str: ...
+    @property
+    def parametrization(self) -> str: ...
+    @property
+    def knot_spacing(self) -> float: ...
+    @property
+    def n_starts(self) -> int: ...
+    @property
+    def evaluations(self) -> int: ...
+    @property
+    def max_deviation_mm(self) -> float | None: ...
+    @property
+    def pop_size(self) -> int: ...
+    @property
+    def max_gen(self) -> int: ...
+    @property
+    def n_stagnant(self) -> int: ...
+    @property
+    def p_crossover(self) -> float: ...
+    @property
+    def p_mutation(self) -> float: ...
+    @property
+    def recombination(self) -> str: ...
+    @property
+    def F(self) -> float: ...  # the thesis' name of the DE weight
+    @property
+    def n_local(self) -> int: ...
+    @property
+    def inject_default(self) -> bool: ...
+    @property
+    def seed(self) -> int: ...
+
+
+Search = Callable[["SearchTask", SearchSettings, np.random.Generator], SearchOutcome]
 
 
 @dataclass(frozen=True, slots=True)
@@ -86,22 +122,22 @@ FAST_KNOT_FACTOR = 2
 """``gradient-fast`` searches knots this many times wider apart than ``knot_spacing``, on one level."""
 
 
-def _gradient(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+def _gradient(task: SearchTask, config: SearchSettings, rng: np.random.Generator) -> SearchOutcome:
     return _gradient_with(task, config, rng, {})
 
 
-def _gradient_fast(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+def _gradient_fast(task: SearchTask, config: SearchSettings, rng: np.random.Generator) -> SearchOutcome:
     return _gradient_with(
         task, config, rng, {"knot_spacing": FAST_KNOT_FACTOR * config.knot_spacing, "coarse_factor": 1}
     )
 
 
-def _gradient_grid(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+def _gradient_grid(task: SearchTask, config: SearchSettings, rng: np.random.Generator) -> SearchOutcome:
     return _gradient_with(task, config, rng, GRID_SEARCH)
 
 
 def _gradient_with(
-    task: SearchTask, config: OptimizeConfig, rng: np.random.Generator, overrides: dict[str, Any]
+    task: SearchTask, config: SearchSettings, rng: np.random.Generator, overrides: dict[str, Any]
 ) -> SearchOutcome:
     settings = GradientSettings(
         **{
@@ -138,7 +174,7 @@ def _gradient_with(
     )
 
 
-def _fitness_problem(task: SearchTask, config: OptimizeConfig, parametrization: str) -> TrajectoryProblem:
+def _fitness_problem(task: SearchTask, config: SearchSettings, parametrization: str) -> TrajectoryProblem:
     return TrajectoryProblem(
         robot=task.robot,
         q_start=task.q_start,
@@ -210,7 +246,7 @@ class _FineKinematics:
         return out
 
 
-def _cmaes(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+def _cmaes(task: SearchTask, config: SearchSettings, rng: np.random.Generator) -> SearchOutcome:
     try:
         import cma
     except ImportError as err:  # pragma: no cover - cma is a core dependency
@@ -275,7 +311,7 @@ def _cmaes(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -
 
 
 def _evolutionary(name: str) -> Search:
-    def run(task: SearchTask, config: OptimizeConfig, rng: np.random.Generator) -> SearchOutcome:
+    def run(task: SearchTask, config: SearchSettings, rng: np.random.Generator) -> SearchOutcome:
         ga = GA(
             pop_size=config.pop_size,
             p_crossover=config.p_crossover,
@@ -408,7 +444,7 @@ def resolve_algorithm(name: str, fitness: str) -> AlgorithmSpec:
 
 
 def timed(
-    run: Search, task: SearchTask, config: OptimizeConfig, rng: np.random.Generator
+    run: Search, task: SearchTask, config: SearchSettings, rng: np.random.Generator
 ) -> tuple[SearchOutcome, float]:
     """Run a search and measure its wall time (s).
 

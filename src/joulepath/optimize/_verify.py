@@ -21,11 +21,9 @@ import numpy as np
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Friction, Robot
 from joulepath.energy import DEFAULT_MEASURE, MeasuredEnergy, measure_energy
-from joulepath.optimize._problem import physics_energy
+from joulepath.optimize._problem import FINE_FACTOR, physics_energy
 from joulepath.trajectory import Trajectory, minimum_jerk, sample_times
 
-FINE_FACTOR = 10
-"""Limits and the energy integral are checked on a grid this many times finer than the samples."""
 TOLERANCE = 1e-7
 """Relative (speed, effort) or absolute (rad) excess below which a limit counts as held."""
 
