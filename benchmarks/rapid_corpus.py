@@ -74,15 +74,21 @@ def run(name: str, paths: list[Path], io: dict[str, object], routine: str | None
             saved_pct=c["saved_pct"] if "saved_pct" in c else None,
             default_J=c.get("energy_default_J"),
             optimized_J=c.get("energy_optimized_J"),
-            written="RAPID"
-            if (out / "optimized.mod").is_file()
-            else "EGM"
-            if (out / "egm.mod").is_file()
-            else "none",
+            written=_written(out, c),
+            rapid_executed_pct=c.get("executed_saved_pct"),
         )
     else:
         row["error"] = (err.strip().splitlines() or [""])[-1][:160]
     return row
+
+
+def _written(out: Path, c: dict[str, object]) -> str:
+    parts = []
+    if (out / "optimized.mod").is_file() or (out / "optimized_task").is_dir():
+        parts.append(f"RAPID ({c.get('rapid_written_from')})")
+    if (out / "egm.mod").is_file():
+        parts.append("EGM")
+    return " + ".join(parts) or "none"
 
 
 def main() -> None:
@@ -97,13 +103,14 @@ def main() -> None:
         print(json.dumps(row), file=sys.stderr, flush=True)
     print(f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}\n")
     print(
-        "| program | exit | moves | optimized | kept (run time) | open % | saved % (plan) | written | CPU s | wall s |"
+        "| program | exit | moves | optimized | kept (run time) | open % | saved % (EGM plan) "
+        "| RAPID saved % (executed) | written | CPU s | wall s |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         if r.get("moves") is None:
             print(
-                f"| {r['name']} | {r['exit']} | refused: {r.get('error', '')} | | | | | | {r['cpu_s']:.1f} | {r['wall_s']:.1f} |"
+                f"| {r['name']} | {r['exit']} | refused: {r.get('error', '')} | | | | | | | {r['cpu_s']:.1f} | {r['wall_s']:.1f} |"
             )
             continue
         saved = "" if r["saved_pct"] is None else f"{r['saved_pct']:.1f}"
