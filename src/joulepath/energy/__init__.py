@@ -28,6 +28,7 @@ from joulepath.energy._chain import (
 from joulepath.energy._drives import (
     BUS_KINDS,
     DRIVES_SUFFIX,
+    IDLE_MODES,
     TWIN_DRIVES_FILE,
     DriveModel,
     drives_toml,
@@ -56,6 +57,7 @@ __all__ = [
     "DriveModel",
     "Drivetrain",
     "EnergyMeasure",
+    "IDLE_MODES",
     "MEASURES",
     "MODES",
     "MeasuredEnergy",

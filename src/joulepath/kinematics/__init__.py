@@ -7,6 +7,7 @@ from joulepath.kinematics._fk import (
     geometric_jacobian,
     link_frames,
 )
+from joulepath.kinematics._ik import check_layout, confdata, ik_branches, solve_ik
 from joulepath.kinematics._rotations import (
     axis_angle_matrix,
     euler_zyx_to_rotation,
@@ -18,12 +19,16 @@ from joulepath.kinematics._rotations import (
 __all__ = [
     "Pose",
     "axis_angle_matrix",
+    "check_layout",
     "check_q",
+    "confdata",
     "euler_zyx_to_rotation",
     "forward_kinematics",
     "geometric_jacobian",
+    "ik_branches",
     "link_frames",
     "quaternion_to_rotation",
     "rotation_to_euler_zyx",
     "rotation_to_quaternion",
+    "solve_ik",
 ]

@@ -10,7 +10,14 @@ from joulepath.optimize._bench import (
 from joulepath.optimize._cycle_reference import CycleLeg, CycleOptimum, cycle_optimum
 from joulepath.optimize._execute import EXECUTION_TOLERANCES, Execution, rapid_execution
 from joulepath.optimize._features import path_features
-from joulepath.optimize._gradient import GradientResult, GradientSettings, SplineProblem, optimize_spline
+from joulepath.optimize._gradient import (
+    GRID_SEARCH,
+    GradientResult,
+    GradientSettings,
+    SplineProblem,
+    optimize_spline,
+    solve_move,
+)
 from joulepath.optimize._problem import (
     FINE_FACTOR,
     FITNESS,
@@ -62,6 +69,7 @@ from joulepath.optimize._verify import (
     check_limits,
     path_jerk,
     shortest_feasible_duration,
+    tcp_deviation_mm,
 )
 from joulepath.sim import ACCEL_TIME, JERK_TIME, acceleration_limit, jerk_limit
 
@@ -80,6 +88,7 @@ __all__ = [
     "FITNESS_KINDS",
     "FOLLOW",
     "FitnessKind",
+    "GRID_SEARCH",
     "GradientResult",
     "GradientSettings",
     "JERK_TIME",
@@ -127,7 +136,9 @@ __all__ = [
     "segment_optimum",
     "shortest_feasible_duration",
     "shortest_on_path",
+    "solve_move",
     "summarize_bench",
+    "tcp_deviation_mm",
     "tcp_velocity",
     "thesis_configurations",
     "verify_move",

@@ -113,7 +113,7 @@ def _split_json(s: EnergySplit) -> dict[str, Any]:
 
 
 def _idle_modes(robot: Any, split: EnergySplit, measure: str) -> dict[str, Any]:
-    from joulepath.energy._drives import IDLE_MODES
+    from joulepath.energy import IDLE_MODES
 
     drives = robot.drivetrain.drives
     if measure != REPORT_MEASURE or drives is None:

@@ -18,7 +18,7 @@ from joulepath.program._parse import parse_module, read_module
 from joulepath.program._resolve import CycleSpec, read_cycle_program, read_cycle_toml, resolve_module
 from joulepath.program._simulate import ProgramMotion, ProgramRun, program_motion, simulate_program
 from joulepath.program._write import format_move, write_module
-from joulepath.sim._timing import plan_cycle
+from joulepath.sim import plan_cycle
 
 __all__ = [
     "Breakdown",

@@ -48,29 +48,37 @@ from joulepath.energy import DEFAULT_MEASURE, MEASURES, energy_measure, measure_
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize import (
     ACCEL_TIME,
+    GRID_SEARCH,
     GradientSettings,
     MeasureSummary,
+    SplineProblem,
     acceleration_limit,
     check_limits,
     jerk_limit,
+    optimize_spline,
+    retime_on_path,
+    shortest_feasible_duration,
+    shortest_on_path,
+    solve_move,
+    tcp_deviation_mm,
+    tcp_velocity,
 )
-from joulepath.optimize._gradient import GRID_SEARCH, SplineProblem, optimize_spline, solve_move
-from joulepath.optimize._retime import retime_on_path, shortest_on_path, tcp_velocity
-from joulepath.optimize._verify import shortest_feasible_duration, tcp_deviation_mm
 from joulepath.program._cell import Cell, clearance
 from joulepath.program._resolve import CycleSpec, Step, check_moves_arm
-from joulepath.sim import ControllerConfig, Plant, make_plant
-from joulepath.sim._timing import (
+from joulepath.sim import (
     FINE_DT,
+    RAPID_ACCEL_SHARE,
+    ControllerConfig,
     PlannedCycle,
     PlannedMove,
-    _tcp,
+    Plant,
     check_motion_time,
     evaluate_cycle,
+    make_plant,
     plan_cycle,
+    via_layout,
 )
-from joulepath.sim._via import RAPID_ACCEL_SHARE
-from joulepath.sim._via import layout as via_layout
+from joulepath.sim import tcp_pose as _tcp
 from joulepath.trajectory import SplineBasis, Trajectory, quintic_hermite
 from joulepath.units import SAMPLE_PERIOD
 

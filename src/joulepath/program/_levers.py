@@ -58,9 +58,18 @@ from joulepath.program._model import Module, MotionSetting, Move, WaitTime
 from joulepath.program._parse import PREDEFINED_SPEEDS, PREDEFINED_ZONES, _statements, parse_module
 from joulepath.program._resolve import CycleSpec, resolve_module
 from joulepath.rapid.interpreter import Motion
-from joulepath.sim import ControllerConfig, Plant, make_plant
-from joulepath.sim._steps import Step
-from joulepath.sim._timing import FINE_DT, PathCache, PlannedCycle, evaluate_cycle, plan_cycle, stops_after
+from joulepath.sim import (
+    FINE_DT,
+    ControllerConfig,
+    PathCache,
+    PlannedCycle,
+    Plant,
+    Step,
+    evaluate_cycle,
+    make_plant,
+    plan_cycle,
+    stops_after,
+)
 from joulepath.trajectory import Trajectory
 
 ACC_CHOICES = (100.0, 70.0, 50.0, 35.0, 25.0)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from joulepath.rapid import RapidError  # noqa: E402  (one definition: the RAPID language's)
-from joulepath.sim._steps import SpeedData
+from joulepath.sim import SpeedData
 
 __all__ = ["RapidError"]
 

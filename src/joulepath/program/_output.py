@@ -131,8 +131,8 @@ def check_written(result: CycleResult, text: str, cell: Cell | None = None) -> d
 
     from joulepath.program._cycle import _energy
     from joulepath.program._task import as_sequence, read_written
-    from joulepath.sim import ControllerConfig, make_plant
-    from joulepath.sim._timing import FINE_DT, _tcp, evaluate_cycle, plan_cycle
+    from joulepath.sim import FINE_DT, ControllerConfig, evaluate_cycle, make_plant, plan_cycle
+    from joulepath.sim import tcp_pose as _tcp
 
     spec = result.spec
     config = ControllerConfig()

@@ -66,7 +66,7 @@ from joulepath.program._model import (
     WObjData,
     ZoneData,
 )
-from joulepath.sim._steps import SpeedData
+from joulepath.sim import SpeedData
 
 READ_TYPES = ("jointtarget", "robtarget", "speeddata", "zonedata", "tooldata", "wobjdata", "num")
 MOVES = ("MoveAbsJ", "MoveJ", "MoveL")

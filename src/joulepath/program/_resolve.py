@@ -23,8 +23,7 @@ from joulepath._typing import FloatArray
 from joulepath._work import check_work
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
-from joulepath.kinematics import quaternion_to_rotation
-from joulepath.kinematics._ik import check_layout, confdata, solve_ik
+from joulepath.kinematics import check_layout, confdata, quaternion_to_rotation, solve_ik
 from joulepath.program._model import (
     Branch,
     Call,
@@ -52,7 +51,7 @@ from joulepath.program._parse import (
     WOBJ0,
     parse_module,
 )
-from joulepath.sim._steps import SpeedData, Step
+from joulepath.sim import SpeedData, Step
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -459,7 +458,7 @@ def robtarget_joints(
             f"{s.target} at {where} mm is out of the robot's reach with this orientation "
             "and tool (no joint solution within the ranges); move the target",
         )
-    from joulepath.kinematics._ik import ik_branches
+    from joulepath.kinematics import ik_branches
 
     qs, valid = ik_branches(robot.chain, flange)
     confs = sorted(

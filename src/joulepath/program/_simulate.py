@@ -28,8 +28,17 @@ from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
 from joulepath.program._parse import read_module
 from joulepath.program._resolve import CycleSpec, resolve_module
-from joulepath.sim import ControllerConfig, log_text, log_times, make_plant, run_plant
-from joulepath.sim._timing import PlannedCycle, check_motion_time, evaluate_cycle, plan_cycle
+from joulepath.sim import (
+    ControllerConfig,
+    PlannedCycle,
+    check_motion_time,
+    evaluate_cycle,
+    log_text,
+    log_times,
+    make_plant,
+    plan_cycle,
+    run_plant,
+)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -22,13 +22,13 @@ from joulepath._typing import FloatArray
 from joulepath._work import check_work
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
-from joulepath.kinematics._ik import check_layout, confdata, solve_ik
+from joulepath.kinematics import check_layout, confdata, solve_ik
 from joulepath.rapid import RapidError
 from joulepath.rapid import _geometry as geo
 from joulepath.rapid.interpreter import Action, Interpreter, Motion, Trace, Wait
 from joulepath.rapid.task import Task, load_task
 from joulepath.rapid.values import Record, num, pos_values
-from joulepath.sim._steps import SpeedData, Step
+from joulepath.sim import SpeedData, Step
 
 RAPID_AXES = 6
 

@@ -53,8 +53,7 @@ from joulepath.rapid.writer import (
     replace_argument,
     set_optional,
 )
-from joulepath.sim import ControllerConfig
-from joulepath.sim._timing import stops_after
+from joulepath.sim import ControllerConfig, stops_after
 
 _SPEED_NAMES = {f"v{v}" for v in SPEEDS}
 _ZONE_NAMES = {f"z{z}" for z in ZONES}

@@ -27,19 +27,33 @@ from joulepath.sim._run import (
     simulate_plan,
 )
 from joulepath.sim._steps import SpeedData, Step, StepSequence
-from joulepath.sim._timing import PlannedCycle, evaluate_cycle, plan_cycle
+from joulepath.sim._timing import (
+    FINE_DT,
+    PathCache,
+    PlannedCycle,
+    PlannedMove,
+    check_motion_time,
+    evaluate_cycle,
+    plan_cycle,
+    stops_after,
+    tcp_pose,
+)
 from joulepath.sim._via import RAPID_ACCEL_SHARE, FollowedPath, follow_path, timed_move
+from joulepath.sim._via import layout as via_layout
 
 __all__ = [
     "ACCEL_TIME",
     "ControllerConfig",
+    "FINE_DT",
     "FollowedPath",
     "JERK_TIME",
     "LabFriction",
     "Measured",
     "MotionPlan",
     "PLANTS",
+    "PathCache",
     "PlannedCycle",
+    "PlannedMove",
     "Plant",
     "RAPID_ACCEL_SHARE",
     "Segment",
@@ -49,6 +63,7 @@ __all__ = [
     "StepSequence",
     "THESIS_PLAN",
     "acceleration_limit",
+    "check_motion_time",
     "evaluate_cycle",
     "evaluate_plan",
     "follow_path",
@@ -63,5 +78,8 @@ __all__ = [
     "run_plant",
     "simulate",
     "simulate_plan",
+    "stops_after",
+    "tcp_pose",
     "timed_move",
+    "via_layout",
 ]

@@ -107,11 +107,15 @@ class SegmentPath:
         return self.spline(s), self.spline(s, 1), self.spline(s, 2)
 
 
-def _tcp(robot: Robot, q: FloatArray, tcp: FloatArray) -> tuple[FloatArray, FloatArray]:
+def tcp_pose(robot: Robot, q: FloatArray, tcp: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """TCP position (m) and rotation of joint values ``q`` (..., n) with the flange-to-TCP ``tcp``."""
     pose = robot.fk(q)
     pos = pose.position_m + np.einsum("...ij,j->...i", pose.rotation, tcp[:3, 3])
     rot = pose.rotation @ tcp[:3, :3]
     return pos, rot
+
+
+_tcp = tcp_pose
 
 
 def _angle_deg(r0: FloatArray, r1: FloatArray) -> float:
