@@ -113,7 +113,7 @@ CASES = [
     # ---- bounded reading: not a regular file, or too large, refused by name before it is opened
     C("mod-dev-zero", "cycle /dev/zero --out {out}", 2, "is a character device, not a regular file", {}),
     C("mod-fifo", CYC, 2, "is a FIFO (named pipe), not a regular file", {"p.mod": FIFO}),
-    C("mod-folder", "cycle {in} --out {out}", 2, "is a folder, not a regular file", {}),
+    C("mod-folder", "cycle {in} --out {out}", 2, "the folder holds no RAPID module", {}),  # a folder is a task
     C("mod-sparse-3gib", CYC, 2, "larger than the 8 MiB accepted", {"p.mod": SPARSE}),
     C("cycle-toml-fifo", CYT, 2, "is a FIFO (named pipe)", {"c.toml": FIFO}),
     C("cycle-toml-sparse-3gib", CYT, 2, "larger than the 4 MiB accepted", {"c.toml": SPARSE}),

@@ -183,7 +183,7 @@ def test_a_loop_in_another_routine_is_the_cycle_too():
 @pytest.mark.parametrize(
     ("body", "extra", "io", "match"),
     [
-        ("    WHILE n >= 0 DO\n      n := n + 1;\n    ENDWHILE", "", None, "turns without"),
+        ("    WHILE n >= 0 DO\n      n := n + 1;\n    ENDWHILE", "", None, "statements without finishing"),
         ("    Rec 1;", "  PROC Rec(num k)\n    Rec k + 1;\n  ENDPROC\n", None, "recursion"),
         ("    WaitDI diGo, 1;", "", {"diGo": 0}, "never ends"),
         ("    MoveJ p10, v100, fine, tWelder;", "", None, "tWelder is declared nowhere"),

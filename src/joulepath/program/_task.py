@@ -97,9 +97,12 @@ def _robot_for(robot: Robot, m: Motion, cache: dict[tuple[float, ...], Robot]) -
             cog = (mass * cog + gm * gc_flange) / (mass + gm)
             mass += gm
     key = (round(mass, 9), *(round(float(v), 9) for v in cog))
+    what = f"tool {m.tool_name}" + (
+        "" if m.settings.grip_load is None else f" with GripLoad {m.settings.grip_load_name}"
+    )
     if key not in cache:
         try:
-            cache[key] = robot.with_payload(mass, com=cog, what="the tool's load") if mass > 0 else robot
+            cache[key] = robot.with_payload(mass, com=cog, what=what) if mass > 0 else robot
         except InvalidInput as err:
             raise RapidError(f"{m.pos}: {err}") from err
     return cache[key]
@@ -109,8 +112,11 @@ def _speed(rec: Record) -> SpeedData:
     return SpeedData(*(float(num(v)) for v in rec.values))
 
 
-def steps_of(trace: Trace, robot: Robot) -> tuple[tuple[Step, ...], tuple[tuple[str, str], ...]]:
-    """The cycle's steps from a trace run on ``robot``'s kinematics, and the kept moves with a reason."""
+def steps_of(
+    trace: Trace, robot: Robot, *, progress: Callable[[str], None] | None = None, source: str = ""
+) -> tuple[tuple[Step, ...], tuple[tuple[str, str], ...]]:
+    """The cycle's steps from a trace run on ``robot``'s kinematics, and the kept moves with a reason;
+    ``progress`` is told each move (``reading SOURCE: move k/N``) as its step is made."""
     cycle = trace.cycle
     counts: dict[tuple[str, int], int] = {}
     for e in cycle:
@@ -119,9 +125,13 @@ def steps_of(trace: Trace, robot: Robot) -> tuple[tuple[Step, ...], tuple[tuple[
     robots: dict[tuple[float, ...], Robot] = {}
     steps: list[Step] = []
     kept: list[tuple[str, str]] = []
+    n_moves, k = sum(isinstance(e, Motion) for e in cycle), 0
     for e in cycle:
         if isinstance(e, Motion):
             assert e.joints is not None
+            k += 1
+            if progress is not None:
+                progress(f"reading {source}: move {k}/{n_moves}")
             label = f"{e.instruction} {e.target_text}"
             tcp = tool_transform(e.tool) if bool(e.tool.get("robhold")) else np.eye(4)
             zone_mm = None if e.fine else e.zone_mm
@@ -188,7 +198,7 @@ def read_task_cycle(
     except InvalidInput as err:
         raise RapidError(f"{', '.join(map(str, paths))}: {err}") from err
     task = load_task(paths)
-    interp = Interpreter(task, io=io, seed=seed, kinematics=RobotKinematics(robot), progress=progress)
+    interp = Interpreter(task, io=io, seed=seed, kinematics=RobotKinematics(robot))
     trace = interp.run(routine)
     moves = [e for e in trace.cycle if isinstance(e, Motion)]
     if not moves:
@@ -206,7 +216,7 @@ def read_task_cycle(
         task.source,
         "the cycle (calls and loops run) has that many moves; split it into shorter programs",
     )
-    steps, kept = steps_of(trace, robot)
+    steps, kept = steps_of(trace, robot, progress=progress, source=task.source)
     unused = sorted(set(k.lower() for k in (io or {})) - interp.io_used)
     notes = list(trace.notes)
     for k in unused:

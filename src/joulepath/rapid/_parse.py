@@ -9,12 +9,15 @@ Parsing never executes anything.
 from __future__ import annotations
 
 import functools
+import math
+import re
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import lark
 
+from joulepath._io import read_capped
 from joulepath.errors import InvalidInput
 from joulepath.rapid import nodes as n
 
@@ -64,13 +67,7 @@ def _blank_header(text: str) -> str:
 def read_module_file(path: str | Path) -> n.Module:
     """Parse one module file; :class:`RapidError` (``file:line: what; how to fix``) otherwise."""
     p = Path(path)
-    try:
-        size = p.stat().st_size
-        if size > MAX_BYTES:
-            raise RapidError(f"{p}: {size} bytes is larger than any RAPID module ({MAX_BYTES} at most)")
-        data = p.read_bytes()
-    except OSError as err:
-        raise RapidError(f"{p}: cannot read it ({err.strerror}); give a RAPID module file") from err
+    data = read_capped(p, max_bytes=MAX_BYTES, what="a RAPID module (.mod, .sys)", error=RapidError)
     if b"\x00" in data:
         raise RapidError(f"{p}:1: a binary file, not RAPID text; give a .mod / .sys module")
     text, encoding, newline = decode(data)
@@ -82,11 +79,17 @@ def parse_module(
 ) -> n.Module:
     """Parse a module's text (line ends ``\\n``) into a :class:`~joulepath.rapid.nodes.Module`."""
     source = _blank_header(text)
+    _check_nesting(source, path)
     try:
         tree = _parser().parse(source)
     except lark.exceptions.UnexpectedInput as err:
         raise RapidError(_syntax_message(err, source, path)) from None
-    module = _Builder(path, text, encoding, newline).transform(tree)
+    try:
+        module = _Builder(path, text, encoding, newline).transform(tree)
+    except lark.exceptions.VisitError as err:
+        if isinstance(err.orig_exc, RapidError):
+            raise err.orig_exc from None
+        raise
     assert isinstance(module, n.Module)
     return module
 
@@ -118,10 +121,68 @@ def _syntax_message(err: lark.exceptions.UnexpectedInput, text: str, path: str) 
     return f"{path}:{line}: not RAPID text; give a RAPID module (MODULE name ... ENDMODULE)"
 
 
+MAX_NESTING = 32
+"""Deepest nesting of brackets, signs and blocks (IF, FOR, WHILE, TEST) a module may hold."""
+
+_OPENERS = re.compile(r"\b(IF|FOR|WHILE|TEST|ENDIF|ENDFOR|ENDWHILE|ENDTEST|THEN)\b", re.IGNORECASE)
+
+
+def _check_nesting(text: str, path: str) -> None:
+    """Refuse, before parsing, brackets, signs or blocks nested deeper than :data:`MAX_NESTING`
+    (no program nests so deep; the parse tree would be as deep)."""
+    depth, line, run = 0, 1, 0
+    in_string = in_comment = False
+    for ch in text:
+        if ch == "\n":
+            line += 1
+            in_comment = False
+            continue
+        if in_comment:
+            continue
+        if ch == '"':
+            in_string = not in_string
+            continue
+        if in_string:
+            continue
+        if ch == "!":
+            in_comment = True
+            continue
+        if ch in "([{":
+            depth += 1
+            if depth > MAX_NESTING:
+                raise RapidError(
+                    f"{path}:{line}: brackets nested more than {MAX_NESTING} deep; write it flatter"
+                )
+        elif ch in ")]}":
+            depth = max(0, depth - 1)
+        if ch in "+-":
+            run += 1
+            if run > MAX_NESTING:
+                raise RapidError(
+                    f"{path}:{line}: signs nested more than {MAX_NESTING} deep; simplify the expression"
+                )
+        elif not ch.isspace():
+            run = 0
+    blocks = 0
+    for k, raw in enumerate(text.split("\n"), start=1):
+        code = raw.split("!", 1)[0]
+        words = [w.upper() for w in _OPENERS.findall(code)]
+        for w in words:
+            if w in ("FOR", "WHILE", "TEST") or (w == "IF" and "THEN" in words):
+                blocks += 1
+                if blocks > MAX_NESTING:
+                    raise RapidError(
+                        f"{path}:{k}: blocks and calls nest more than {MAX_NESTING} deep; split the routine"
+                    )
+            elif w.startswith("END"):
+                blocks = max(0, blocks - 1)
+
+
 def _number(text: str) -> float:
-    if text[:2].lower() == "0x":
-        return float(int(text, 16))
-    return float(text)
+    value = float(int(text, 16)) if text[:2].lower() == "0x" else float(text)
+    if not math.isfinite(value):
+        raise RapidError(f"{text} is not a finite number")
+    return value
 
 
 def _string(text: str) -> str:
@@ -170,7 +231,10 @@ class _Builder(lark.Transformer[Any, Any]):
     # ---- expressions
     @lark.v_args(meta=True)
     def number(self, meta: Any, c: list[Any]) -> n.Num:
-        return n.Num(self._pos(meta), _number(str(c[0])))
+        try:
+            return n.Num(self._pos(meta), _number(str(c[0])))
+        except RapidError as err:
+            raise RapidError(f"{self.path}:{meta.line}: {err}; give a finite number") from None
 
     @lark.v_args(meta=True)
     def string(self, meta: Any, c: list[Any]) -> n.Str:

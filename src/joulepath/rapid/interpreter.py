@@ -64,11 +64,11 @@ from joulepath.rapid.values import (
 Taint = frozenset[str]
 CLEAN: Taint = frozenset()
 
-MAX_STEPS = 2_000_000
+MAX_STEPS = 200_000
 """Statements and expression calls one run may take before it is stopped as never ending."""
 MAX_SECONDS = 60.0
 """Wall time one run may take (s)."""
-MAX_DEPTH = 100
+MAX_DEPTH = 32
 """Deepest routine call (recursion) one run may take."""
 MAX_LOOP_TURNS = 200_000
 """Turns one loop may take."""
@@ -601,9 +601,9 @@ class Interpreter:
             self.steps % 4096 == 0 and time.perf_counter() - self.t0 > self.max_seconds
         ):
             raise RapidError(
-                f"{pos}: the program runs on without finishing a cycle ({self.steps} steps, "
-                f"{time.perf_counter() - self.t0:.0f} s): a loop that never ends or never moves; give the "
-                "inputs it waits for (--io) or check the loop's condition"
+                f"{pos}: the program runs more than {self.max_steps} statements without finishing a cycle "
+                f"({time.perf_counter() - self.t0:.0f} s): a loop that never ends or never moves, or calls "
+                "that multiply; give the inputs it waits for (--io) or check the loop's condition"
             )
 
     def source_of(self, pos: n.Pos) -> str:
@@ -811,7 +811,7 @@ class Interpreter:
         a, b = self._signal_value(a, e.pos), self._signal_value(b, e.pos)
         taint = ta | tb
         try:
-            return _apply(op, a, b), taint
+            result = _apply(op, a, b)
         except (TypeErrorRapid, ZeroDivisionError, ValueError) as err:
             if taint and isinstance(err, (ZeroDivisionError, ValueError)):
                 self.note(f"{e.pos}: {op} of a stand-in value fails ({err}); its result is assumed 0")
@@ -820,6 +820,12 @@ class Interpreter:
             raise RapidError(
                 f"{e.pos}: {describe(a)} {op} {describe(b)}: {why}; correct the expression"
             ) from None
+        if isinstance(result, float) and not math.isfinite(result):
+            if taint:
+                self.note(f"{e.pos}: {op} of a stand-in value is not finite; its result is assumed 0")
+                return 0.0, taint
+            raise RapidError(f"{e.pos}: {describe(a)} {op} {describe(b)} is not a finite number; correct it")
+        return result, taint
 
     def ref(self, e: n.Expr) -> Cell | _Ref:
         if isinstance(e, n.Name):
@@ -1107,10 +1113,15 @@ class Interpreter:
 
     # ---- routines
     def invoke(self, r: n.Routine, m: n.Module, args: tuple[n.Arg, ...], pos: n.Pos) -> tuple[Value, Taint]:
-        if len(self.stack) >= MAX_DEPTH:
+        if len(self.stack) - 1 >= MAX_DEPTH:  # (the module's frame, then one per routine entered)
+            if any(f.routine is r for f in self.stack):
+                raise RapidError(
+                    f"{pos}: {r.name} calls itself, and calls nest more than {MAX_DEPTH} deep: a recursion "
+                    "that never ends; check its end condition"
+                )
             raise RapidError(
-                f"{pos}: {r.name} calls itself deeper than {MAX_DEPTH} levels: a recursion that never ends; "
-                "check its end condition"
+                f"{pos}: {r.name}: calls nest more than {MAX_DEPTH} deep (a chain of routines); call fewer "
+                "routines from each other"
             )
         frame = _Frame(r, m, {}, set(), f"{r.name} ({pos.file}:{pos.line})")
         positional = [p for p in r.params if not p.optional]
@@ -2106,12 +2117,12 @@ def _apply(op: str, a: Value, b: Value) -> Value:
     if op == "/":
         return x / y
     if op == "DIV":
-        if x != int(x) or y != int(y):
-            raise TypeErrorRapid("DIV takes whole numbers")
+        if not (math.isfinite(x) and math.isfinite(y)) or x != int(x) or y != int(y):
+            raise TypeErrorRapid("DIV needs whole numbers")
         return float(math.trunc(x / y)) if y != 0 else x / y
     if op == "MOD":
-        if x != int(x) or y != int(y):
-            raise TypeErrorRapid("MOD takes whole numbers")
+        if not (math.isfinite(x) and math.isfinite(y)) or x != int(x) or y != int(y):
+            raise TypeErrorRapid("MOD needs whole numbers")
         return float(math.fmod(x, y)) if y != 0 else x / y
     if op == "<":
         return x < y

@@ -14,8 +14,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from joulepath._io import read_capped
 from joulepath.rapid import nodes as n
-from joulepath.rapid._parse import RapidError, decode, read_module_file
+from joulepath.rapid._parse import MAX_BYTES, RapidError, decode, read_module_file
 
 MODULE_SUFFIXES = (".mod", ".modx", ".sys", ".sysx", ".prg")
 """File suffixes read as RAPID modules."""
@@ -38,7 +39,8 @@ class Task:
 
 
 def _signals_of_eio(path: Path) -> frozenset[str]:
-    text, _, _ = decode(path.read_bytes())
+    data = read_capped(path, max_bytes=MAX_BYTES, what="an I/O configuration (EIO.cfg)", error=RapidError)
+    text, _, _ = decode(data)
     names = re.findall(r"-Name\s+\"?([A-Za-z][A-Za-z0-9_]*)\"?", text)
     return frozenset(name.lower() for name in names)
 
@@ -57,11 +59,10 @@ def load_task(paths: Sequence[str | Path]) -> Task:
             if not found:
                 raise RapidError(f"{p}: the folder holds no RAPID module (.mod, .sys); give a task's folder")
             files.extend(found)
-        elif p.is_file():
-            if p.suffix.lower() == ".cfg":
-                eio.append(p)
-            else:
-                files.append(p)
+        elif p.suffix.lower() == ".cfg" and p.is_file():
+            eio.append(p)
+        elif p.exists() or p.is_symlink():
+            files.append(p)  # a regular file, or refused by name when read (a device, a FIFO ...)
         else:
             raise RapidError(
                 f"{p}: no such file or folder; give a module file (.mod, .sys) or a task's folder"
@@ -75,8 +76,9 @@ def load_task(paths: Sequence[str | Path]) -> Task:
     unique: list[Path] = []
     resolved: set[Path] = set()
     for f in files:
-        if f.resolve() not in resolved:
-            resolved.add(f.resolve())
+        where = f.resolve() if f.is_file() else f
+        if where not in resolved:
+            resolved.add(where)
             unique.append(f)
     modules = [read_module_file(f) for f in unique]
     names: dict[str, n.Module] = {}
