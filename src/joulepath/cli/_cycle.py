@@ -26,6 +26,10 @@ def _cycle_time(text: str) -> float | None:
     return value
 
 
+LEVERS_SECONDS = 30.0
+"""s of wall time the search of the controller's levers takes at most (then what it found is written)."""
+
+
 def _scenario(pairs: list[str], path: Path | None) -> dict[str, float | str | bool]:
     """The I/O scenario: ``--scenario`` file values, then ``--io NAME=VALUE`` pairs over them."""
     out: dict[str, float | str | bool] = {}
@@ -226,9 +230,18 @@ def cycle(
 
             say("searching the controller's levers (AccSet, speed data, zones) on the controller emulation")
             if spec.module is not None:
-                levers = levers_module(spec, r, energy=energy, use_waits=use_waits)
+                levers = levers_module(
+                    spec, r, energy=energy, use_waits=use_waits, max_seconds=LEVERS_SECONDS
+                )
             else:
-                levers = task_levers(spec, r, energy=energy, io=scenario_values or None, routine=routine)
+                levers = task_levers(
+                    spec,
+                    r,
+                    energy=energy,
+                    io=scenario_values or None,
+                    routine=routine,
+                    max_seconds=LEVERS_SECONDS,
+                )
         say(f"writing {out} (the written program is checked on the controller emulation)")
         files = write_cycle_run(
             out,

@@ -390,11 +390,17 @@ class _Evaluator:
                 steps[i] = _apply(steps[i], setting, slot.taught)
         return replace(self.spec, steps=tuple(steps))
 
+    deadline: float | None = None
+    """``time.perf_counter()`` past which no new plan counts as within the budget: the search stops
+    at its next check (``n`` is set past any ``max_evaluations``)."""
+
     def __call__(self, state: tuple[Setting, ...]) -> tuple[PlannedCycle, float, float]:
         found = self.memo.get(state)
         if found is None:
             self.n += 1
             found = self.memo[state] = self.run(self.spec_with(state))
+            if self.deadline is not None and time.perf_counter() > self.deadline:
+                self.n = max(self.n, 1 << 40)
         return found
 
     def run(self, spec: CycleSpec) -> tuple[PlannedCycle, float, float]:
@@ -773,6 +779,7 @@ def levers_module(
     pairs: int = 8,
     use_waits: bool = False,
     config: ControllerConfig | None = None,
+    max_seconds: float | None = None,
 ) -> LeverResult:
     """Search the controller's levers of a RAPID program's cycle and write them into its text.
 
@@ -799,6 +806,8 @@ def levers_module(
         their argument changed in place.
     config : ControllerConfig, optional
         The emulated controller (default: :class:`joulepath.sim.ControllerConfig`).
+    max_seconds : float, optional
+        Wall time (s) after which the search takes no new step (what it found by then is written).
 
     Returns
     -------
@@ -831,6 +840,7 @@ def levers_module(
     taught_state = tuple(s.taught for s in slots)
     plan0, t0, _ = ev(taught_state)
     e0, lab0 = ev.energies(plan0)
+    ev.deadline = None if max_seconds is None else start + max_seconds
     target = t0 if cycle_time_s is None else min(cycle_time_s, t0)
     if cycle_time_s is not None and not cycle_time_s > 0:
         raise InvalidInput(f"cycle_time_s must be positive, got {cycle_time_s}")

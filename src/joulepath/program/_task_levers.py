@@ -253,6 +253,7 @@ def task_levers(
     max_evaluations: int = 1500,
     pairs: int = 8,
     config: ControllerConfig | None = None,
+    max_seconds: float | None = None,
 ) -> LeverResult:
     """Search the controller's levers of a RAPID task's cycle and write them into its modules.
 
@@ -266,7 +267,7 @@ def task_levers(
         The energy measure minimised.
     io, routine
         The scenario and routine the task was read with (the written task is read again with them).
-    max_evaluations, pairs, config
+    max_evaluations, pairs, config, max_seconds
         As :func:`joulepath.program.levers_module`.
 
     Returns
@@ -283,6 +284,7 @@ def task_levers(
     taught_state = tuple(s.taught for s in slots)
     plan0, t0, _ = ev(taught_state)
     e0, lab0 = ev.energies(plan0)
+    ev.deadline = None if max_seconds is None else start + max_seconds
     chosen = _search(ev, slots, t0, max_evaluations, pairs)
     _, t_search, e_search = ev(chosen)
     tc = spec.task
