@@ -39,6 +39,7 @@ from joulepath.program._levers import (
     Setting,
     _Evaluator,
     _key,
+    _num,
     _search,
     _Slot,
 )
@@ -165,11 +166,6 @@ def _slots(spec: CycleSpec) -> tuple[list[_Slot], list[_Where]]:
         )
         wheres.append(w)
     return slots, wheres
-
-
-def _num(value: float) -> str:
-    text = f"{value:.3f}".rstrip("0").rstrip(".")
-    return "0" if text in ("-0", "") else text
 
 
 def _edits(slots: list[_Slot], wheres: list[_Where], chosen: tuple[Setting, ...]) -> list[Edit]:
