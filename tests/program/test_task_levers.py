@@ -66,3 +66,25 @@ def test_levers_written_into_the_task_as_written(name, tmp_path):
     a = [s.q for s in spec.steps if s.kind == "move"]
     b = [s.q for s in again.steps if s.kind == "move"]
     assert len(a) == len(b) and all(np.abs(x - y).max() < 1e-9 for x, y in zip(a, b, strict=True))
+
+
+@pytest.mark.parametrize("name", ["08_conveyor_gitype_open", "32_vision_socket_runtime"])
+def test_moves_known_only_at_run_time_are_never_changed(name):
+    """A move the interpreter marked (its branch decided by an input with no value) runs as taught in
+    the optimized cycle: not reshaped, not re-timed, its energy the taught energy."""
+    from joulepath.optimize import GradientSettings
+    from joulepath.program import CycleSettings, optimize_cycle
+
+    folder = CORPUS / name
+    e = tomllib.loads((folder / "expect.toml").read_text(encoding="utf-8"))
+    robot = joulepath.load_robot("irb120")
+    spec, _ = read_cycle_program([folder / p for p in e["program"]], robot)
+    kept = [s.kept != () for s in spec.steps if s.kind == "move"]
+    assert any(kept)
+    settings = CycleSettings(table_points=2, gradient=GradientSettings(knot_spacing=0.2), max_time_s=60)
+    result, _ = optimize_cycle(spec, settings)
+    assert len(result.moves) == len(kept)
+    for m, k in zip(result.moves, kept, strict=True):
+        if k:
+            assert not m.optimized and m.note.startswith("kept as taught")
+            assert m.optimized_energy_J == pytest.approx(m.default_energy_J, rel=1e-9)

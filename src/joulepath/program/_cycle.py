@@ -1649,6 +1649,8 @@ class CycleOptimizer:
                 continue  # a MoveL from rest to rest: its own unit re-times it along its line
             if any(self.default_clearance.get(j, np.inf) < 0.0 for j in moving):
                 continue  # a taught move within the cell's margin: reported, left as it is
+            if any(self.by_index[j].step.kept for j in moving):
+                continue  # a move known only at run time (the RAPID interpreter's mark) runs as taught
             if seg.span > RETIME_MAX_SPAN_S:
                 continue  # SLSQP's dense QP grows with the rows (2.5 ms samples) times variables squared
             first = self.by_index[moving[0]].step
