@@ -1150,7 +1150,7 @@ class Interpreter:
                 frame.locals[key] = Cell(p.name, "switch", "IN", True, CLEAN, None)
                 continue
             if p.access in ("INOUT", "VAR", "PERS") and isinstance(a.value, (n.Name, n.Index, n.Field)):
-                frame.locals[key] = self._reference(a.value)
+                frame.locals[key] = self.ref(a.value)
                 continue
             value, taint = self.ev(a.value)
             type_ = self.types.resolve(p.type)
@@ -1184,10 +1184,6 @@ class Interpreter:
         if r.kind == "FUNC":
             raise RapidError(f"{r.pos}: the function {r.name} ends without RETURN; add RETURN value;")
         return None, CLEAN
-
-    def _reference(self, e: n.Expr) -> Cell | _Ref:
-        target = self.ref(e)
-        return target
 
     # ---- statements
     def exec_body(self, body: tuple[n.Stmt, ...]) -> None:
@@ -1805,8 +1801,6 @@ class Interpreter:
         conc = "conc" in args_opt
         if conc:
             kept.add(f"{s.pos}: \\Conc: the instructions after it run while it moves")
-        if self.kin is not None and self.settings.grip_load is not None:
-            pass
         joints = circle_joints = None
         if self.kin is not None:
             if kind == "absjoint":
