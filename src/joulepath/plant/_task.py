@@ -52,7 +52,6 @@ def cycle_settings(settings: Mapping[str, Any]) -> Any:
     InvalidInput
         A value out of its range (one line).
     """
-    from joulepath.optimize import GradientSettings
     from joulepath.program import CycleSettings
 
     s = dict(settings)
@@ -71,7 +70,8 @@ def cycle_settings(settings: Mapping[str, Any]) -> Any:
         rapid_plan=bool(s.get("rapid_plan", True)),
         retime_segments=bool(s.get("retime_segments", True)),
         corridor_mm=corridor or None,
-        gradient=GradientSettings(knot_spacing=float(s.get("knot_spacing", 0.05))),
+        # the cycle's own search, as `joulepath cycle` builds it (only the knot spacing set)
+        gradient=replace(CycleSettings().gradient, knot_spacing=float(s.get("knot_spacing", 0.05))),
         energy=str(s.get("energy", "thesis")),
     )
     if "jerk_time" in s:
