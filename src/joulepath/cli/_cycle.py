@@ -242,6 +242,19 @@ def cycle(
                     routine=routine,
                     max_seconds=LEVERS_SECONDS,
                 )
+        via = None
+        if rapid and export != "egm" and result.limits_ok and spec.module is not None and result.paths:
+            from joulepath.program import via_levers
+
+            say("searching the levers of the plan's via points on the controller emulation")
+            via = via_levers(
+                result,
+                r,
+                energy=energy,
+                corridor_mm=settings.corridor_mm,
+                cell=cell_data,
+                max_seconds=LEVERS_SECONDS,
+            )
         say(f"writing {out} (the written program is checked on the controller emulation)")
         files = write_cycle_run(
             out,
@@ -252,6 +265,7 @@ def cycle(
             write_anyway=write_anyway,
             egm="always" if export == "egm" else "fallback" if export == "auto" else "never",
             levers=levers,
+            via_levers=via,
         )
     if use_waits and not any(s.idle for s in spec.steps if s.kind == "wait"):
         console.print(
@@ -281,6 +295,10 @@ def cycle(
                 f"written with the controller's levers ({saved['rapid_levers']['moves_changed']} move "
                 "statements changed: AccSet, speed data, zones)"
                 if saved["rapid_written_from"] == "levers"
+                else "the plan's via points with the controller's levers "
+                f"({saved['rapid_via_levers']['moves_changed']} via-point statements changed: AccSet, \\T, "
+                "zones), searched on the controller emulation"
+                if saved["rapid_written_from"] == "via points + levers"
                 else f"its via points follow {saved['rapid_follows']}"
             )
         )

@@ -17,6 +17,7 @@ from joulepath.program._output import CYCLE_FILES, optimized_module, write_cycle
 from joulepath.program._parse import parse_module, read_module
 from joulepath.program._resolve import CycleSpec, read_cycle_program, read_cycle_toml, resolve_module
 from joulepath.program._simulate import ProgramMotion, ProgramRun, program_motion, simulate_program
+from joulepath.program._via_levers import ViaLevers, via_levers
 from joulepath.program._write import format_move, write_module
 from joulepath.sim import plan_cycle
 
@@ -28,6 +29,7 @@ __all__ = [
     "CycleSettings",
     "CycleSpec",
     "LeverResult",
+    "ViaLevers",
     "Module",
     "MoveLever",
     "MoveOutcome",
@@ -37,6 +39,7 @@ __all__ = [
     "RapidError",
     "format_move",
     "levers_module",
+    "via_levers",
     "optimize_cycle",
     "optimized_module",
     "pareto",

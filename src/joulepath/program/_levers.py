@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import re
 import time
+from collections.abc import Collection
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -151,6 +152,10 @@ class LeverResult:
     wall_s: float
     waits: tuple[tuple[int, float, float], ...] = ()
     written_files: tuple[tuple[str, bytes], ...] = ()  # a task's modules (path, bytes); else written_text
+    base: str = "taught"
+    """What the levers were searched on: ``"taught"`` (the program as written) or ``"via points"`` (the
+    plan's via-point module, :func:`joulepath.program.via_levers`; ``default_*`` and ``taught_cycle_s``
+    are then still the taught program's)."""
 
     @property
     def saved_pct(self) -> float:
@@ -780,6 +785,8 @@ def levers_module(
     use_waits: bool = False,
     config: ControllerConfig | None = None,
     max_seconds: float | None = None,
+    baseline: tuple[float, float, float] | None = None,
+    only_lines: Collection[int] | None = None,
 ) -> LeverResult:
     """Search the controller's levers of a RAPID program's cycle and write them into its text.
 
@@ -808,6 +815,12 @@ def levers_module(
         The emulated controller (default: :class:`joulepath.sim.ControllerConfig`).
     max_seconds : float, optional
         Wall time (s) after which the search takes no new step (what it found by then is written).
+    baseline : (cycle s, energy J, lab J), optional
+        The program this module replaces, as the controller emulation runs it (the taught one, where
+        ``spec`` is a rewrite of it): the cycle may run up to its cycle time (also where the module
+        itself runs shorter), and the result's ``taught_cycle_s`` and ``default_*`` are its.
+    only_lines : collection of int, optional
+        Only the move statements on these lines get levers; the others stay as written.
 
     Returns
     -------
@@ -836,12 +849,19 @@ def levers_module(
     config = config or ControllerConfig()
     lines = text.splitlines(keepends=True)
     slots = _slots(spec, lines)
+    if only_lines is not None:
+        open_lines = set(only_lines)
+        slots = [
+            s if s.line in open_lines else replace(s, open=(), closed=("acc, speed, zone: kept as written",))
+            for s in slots
+        ]
     ev = _Evaluator(spec, slots, energy, config)
     taught_state = tuple(s.taught for s in slots)
     plan0, t0, _ = ev(taught_state)
     e0, lab0 = ev.energies(plan0)
     ev.deadline = None if max_seconds is None else start + max_seconds
-    target = t0 if cycle_time_s is None else min(cycle_time_s, t0)
+    own = t0 if baseline is None else max(t0, baseline[0])
+    target = own if cycle_time_s is None else min(cycle_time_s, own)
     if cycle_time_s is not None and not cycle_time_s > 0:
         raise InvalidInput(f"cycle_time_s must be positive, got {cycle_time_s}")
     idle = _idle_waits(spec, lines) if use_waits else {}
@@ -879,6 +899,8 @@ def levers_module(
     moves = tuple(
         MoveLever(s.line, s.label, s.taught, c, s.open, s.closed) for s, c in zip(slots, chosen, strict=True)
     )
+    if baseline is not None:  # reported against the program this module replaces
+        t0, e0, lab0 = baseline
     return LeverResult(
         source=spec.source,
         energy_measure=energy,

@@ -528,6 +528,19 @@ def _levers_json(levers: Any) -> dict[str, Any]:
     }
 
 
+def _via_levers_json(via: Any) -> dict[str, Any]:
+    out: dict[str, Any] = {
+        "note": via.note,
+        "via_points_executed_cycle_s": via.via_cycle_s,
+        "via_points_executed_energy_J": via.via_energy_J,
+        "tcp_from_taught_path_mm": via.deviation_mm,
+        "cell_clearance_mm": via.clearance_mm,
+    }
+    if via.levers is not None:
+        out.update(_levers_json(via.levers))
+    return out
+
+
 def _export_choice(
     egm: str, written_from: str | None, rapid_saved: float | None, plan: float, stream: bool, name: str
 ) -> str:
@@ -553,6 +566,7 @@ def write_cycle_run(
     write_anyway: bool = False,
     egm: str = "never",
     levers: Any | None = None,
+    via_levers: Any | None = None,
 ) -> dict[str, Path]:
     """Write the run folder; the module only when every limit holds, the controller emulation
     runs it as the checks ask (:data:`CHECK_TOLERANCES`; ``write_anyway``: written all the same,
@@ -563,8 +577,10 @@ def write_cycle_run(
     half of what the EGM plan saves; "never": not.
 
     ``levers`` (a :class:`~joulepath.program.LeverResult`): the program with the controller's own
-    levers (``AccSet``, speed data, zones), read back and run by the controller emulation. The
-    RAPID module written is the better of it and the via-point module, as executed."""
+    levers (``AccSet``, speed data, zones), read back and run by the controller emulation;
+    ``via_levers`` (a :class:`~joulepath.program.ViaLevers`): the plan's via-point module with the
+    levers of its via points, searched on the controller emulation. The RAPID module written is
+    the best of them and the via-point module kept to the plan, as executed."""
     if egm not in ("always", "fallback", "never"):
         raise ValueError(f"egm must be always, fallback or never, got {egm!r}")
     files: dict[str, Path] = {}
@@ -610,22 +626,33 @@ def write_cycle_run(
         and levers.cycle_s <= levers.taught_cycle_s + 1e-9
         and result.limits_ok
     )
+    offered: list[Any] = [levers] if lever_ok else []
+    if via_levers is not None and via_levers.levers is not None and result.limits_ok:
+        offered.append(via_levers.levers)
     written_from = None if text is None else "via points"
     data_bytes: bytes | None = None
     task_files: tuple[tuple[str, bytes], ...] = ()
-    if lever_ok and levers is not None and (via_saved is None or levers.saved_pct > via_saved):
-        written_from = "levers"
-        if levers.written_files:
-            task_files = levers.written_files
+    chosen = max(offered, key=lambda lv: lv.saved_pct, default=None)
+    if chosen is not None and (via_saved is None or chosen.saved_pct > via_saved):
+        levers_of_via = chosen.base == "via points"
+        written_from = "via points + levers" if levers_of_via else "levers"
+        if chosen.written_files:
+            task_files = chosen.written_files
         else:
-            data_bytes = levers.written_bytes()
+            data_bytes = chosen.written_bytes()
         check = {
-            "emulated_cycle_s": levers.cycle_s,
-            "emulated_energy_J": levers.energy_J,
-            "emulated_energy_lab_J": levers.energy_lab_J,
+            "emulated_cycle_s": chosen.cycle_s,
+            "emulated_energy_J": chosen.energy_J,
+            "emulated_energy_lab_J": chosen.energy_lab_J,
             "within_tolerances": True,
-            "written_by": "levers: the controller's own plan of the written program (AccSet, speed data, "
-            "zones), read back and run by the controller emulation",
+            "written_by": (
+                "via points + levers: the plan's via-point module with the controller's levers of its via "
+                "points (AccSet, \\T, zones), searched on the controller emulation; the written text read "
+                "again by the RAPID interpreter and run again by the emulation"
+                if levers_of_via
+                else "levers: the controller's own plan of the written program (AccSet, speed data, "
+                "zones), read back and run by the controller emulation"
+            ),
         }
         layout = None
     make_folder(out)
@@ -648,9 +675,9 @@ def write_cycle_run(
         remove_output(stale)
     written_name = OPTIMIZED_TASK if task_files else "optimized.mod"
     rapid_saved = via_saved
-    if written_from == "levers" and result.default_energy_J > 0:
-        assert levers is not None  # on the same basis as the via points': the taught cycle as emulated
-        rapid_saved = 100.0 * (1.0 - levers.energy_J / result.default_energy_J)
+    if written_from in ("levers", "via points + levers") and result.default_energy_J > 0:
+        assert chosen is not None  # on the same basis as the via points': the taught cycle as emulated
+        rapid_saved = 100.0 * (1.0 - chosen.energy_J / result.default_energy_J)
     files["optimized_cycle.csv"] = atomic_write_text(out / "optimized_cycle.csv", optimized_cycle_csv(result))
     files["cycle_path.csv"] = atomic_write_text(out / "cycle_path.csv", cycle_path_csv(result))
     half_of_plan = rapid_saved is not None and rapid_saved < 0.5 * result.saved_pct
@@ -667,19 +694,20 @@ def write_cycle_run(
         files["pareto.csv"] = atomic_write_text(out / "pareto.csv", pareto_csv(pareto, default))
         files["pareto.png"] = pareto_plot(pareto, default, out / "pareto.png")
     data = cycle_json(result, pareto, written_name if written_from is not None else None, refused, check)
-    if written_from == "levers":
-        assert levers is not None
+    if written_from in ("levers", "via points + levers"):
+        assert chosen is not None
         data["executed_saved_lab_pct"] = (
-            100.0 * (1.0 - levers.energy_lab_J / levers.default_lab_J) if levers.default_lab_J else None
+            100.0 * (1.0 - chosen.energy_lab_J / chosen.default_lab_J) if chosen.default_lab_J else None
         )
         data["executed_note"] = (
-            "optimized.mod (the program with the controller's levers) as the controller emulation runs it, "
+            f"optimized.mod (written from: {written_from}) as the controller emulation runs it, "
             "against the taught program run by the same emulation, both on energy_measure (the lab robot's "
             "on the same measure)"
         )
     data["rapid_written_from"] = written_from
     data["rapid_via_points_executed_saved_pct"] = via_saved
     data["rapid_levers"] = None if levers is None else _levers_json(levers)
+    data["rapid_via_levers"] = None if via_levers is None else _via_levers_json(via_levers)
     data["egm_plan_saved_pct"] = result.saved_pct
     data["export_choice"] = _export_choice(
         egm,

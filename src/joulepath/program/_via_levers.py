@@ -1,0 +1,271 @@
+"""A plan for RAPID made on the controller emulation: the plan's via points, and the controller's levers
+searched on them.
+
+The via-point module of a cycle's plan (:func:`joulepath.program._output.written_rapid`: each optimized
+move a call of an added procedure of ``MoveAbsJ`` via points with ``\\T`` and zones) carries a shape
+the controller's own planning of the taught statements cannot make. The controller runs it its own
+way: the zones cut the corners between the via points, its ramps start and end each chain. So the
+module rarely keeps the plan's path to the 5 mm of the written-program check; it makes a motion of its
+own, whose cycle time and energy the controller emulation measures.
+
+Here that motion is the plan, and it is improved where it stands: the module, read as written, is
+run by the controller emulation, and the levers of its via-point statements (``AccSet``, ``\\T``,
+zones; :func:`joulepath.program.levers_module`) are searched on it for the least energy within the
+taught program's cycle time (the module often runs shorter than the taught cycle: that time is
+spent too). The program's own statements stay as written, so that the module still reads back as
+the program it was written from (:func:`joulepath.program._rapid_write.restore_program`).
+
+Before it is offered, the written text (with its header) is read again by the RAPID interpreter and
+run again by the emulation, and must give the searched cycle time and energy; its TCP path must stay
+within ``corridor_mm`` of the taught cycle's path (the corridor the plan itself keeps), and, with a
+cell, clear the cell's margin. The figures are those of the module as executed, against the taught
+program run by the same emulation, on the run's energy measure.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, replace
+from typing import Any
+
+from joulepath._typing import FloatArray
+from joulepath.dynamics import Robot
+from joulepath.errors import InvalidInput, JoulepathError, LimitViolation
+from joulepath.program._levers import LeverResult, _Evaluator, cycle_motion, levers_module
+from joulepath.program._parse import parse_module
+from joulepath.program._resolve import CycleSpec, resolve_module
+from joulepath.sim import ControllerConfig, PlannedCycle, tcp_pose
+from joulepath.trajectory import Trajectory
+
+_TOL_S = 1e-6
+_TOL_REL = 1e-6
+TIME_FITS = 4
+"""Tries, at most, to fit a via-point module that runs longer than the taught cycle into its time by
+shortening every via point's ``\\T`` by the same factor."""
+_T_ARG = re.compile(r"(\\T\s*:=\s*)(\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)")
+
+
+@dataclass(frozen=True, slots=True)
+class ViaLevers:
+    """The via-point module with levers (``levers``, ``base`` ``"via points"``), or None and why not.
+
+    ``via_cycle_s``/``via_energy_J``: the via-point module before the levers, as executed;
+    ``deviation_mm``: the largest distance of the written module's TCP from the taught cycle's
+    path; ``clearance_mm``: from the cell's margin (None without a cell)."""
+
+    levers: LeverResult | None
+    note: str
+    via_cycle_s: float | None = None
+    via_energy_J: float | None = None
+    deviation_mm: float | None = None
+    clearance_mm: float | None = None
+
+
+def _plain(text: str) -> str:
+    """The module without joulepath's header lines: read as itself, not as the program it came from."""
+    from joulepath.program._rapid_write import HEADERS
+
+    return "".join(ln for ln in text.splitlines(keepends=True) if not ln.strip().startswith(HEADERS))
+
+
+def _added_lines(spec: CycleSpec) -> set[int]:
+    """Lines of the procedures the via-point writer added (``jp_opt_*``)."""
+    module = spec.module
+    assert module is not None
+    out: set[int] = set()
+    for p in module.procedures:
+        if p.name.lower().startswith("jp_opt_"):
+            out.update(range(p.line, p.end_line + 1))
+    return out
+
+
+def _scaled(text: str, lines: set[int], factor: float) -> str:
+    """``text`` with every ``\\T`` on ``lines`` times ``factor`` (to 0.1 ms, at least 1 ms)."""
+
+    def times(m: re.Match[str]) -> str:
+        return f"{m.group(1)}{max(0.001, round(float(m.group(2)) * factor, 4)):.4f}"
+
+    out = text.splitlines(keepends=True)
+    for k in lines:
+        if 1 <= k <= len(out):
+            out[k - 1] = _T_ARG.sub(times, out[k - 1])
+    return "".join(out)
+
+
+def _with_header(text: str, header: list[str]) -> str:
+    lines = text.splitlines(keepends=True)
+    at = next(k for k, ln in enumerate(lines) if re.match(r"\s*MODULE\b", ln, re.IGNORECASE))
+    nxt = lines[at + 1] if at + 1 < len(lines) else "    "
+    indent = nxt[: len(nxt) - len(nxt.lstrip())] or "    "
+    newline = "\r\n" if lines[at].endswith("\r\n") else "\n"
+    return "".join([*lines[: at + 1], *(indent + h + newline for h in header), *lines[at + 1 :]])
+
+
+def _tcp_path(plan: PlannedCycle) -> tuple[FloatArray, Trajectory]:
+    """The cycle's TCP positions (m) and motion on the 2.5 ms grid (the first move's robot and tool)."""
+    traj = cycle_motion(plan)
+    first = plan.moves[0].step
+    assert first.robot is not None and first.tcp is not None
+    pos, _ = tcp_pose(first.robot, traj.q, first.tcp)
+    return pos, traj
+
+
+def via_levers(
+    result: Any,
+    robot: Robot,
+    *,
+    energy: str,
+    corridor_mm: float | None = 100.0,
+    cell: Any = None,
+    max_seconds: float | None = None,
+    config: ControllerConfig | None = None,
+) -> ViaLevers:
+    """The via-point module of ``result``'s plan with the controller's levers of its via points,
+    as the controller emulation runs it (module docstring).
+
+    Parameters
+    ----------
+    result : CycleResult
+        The optimized cycle of a one-module RAPID program (``result.spec.module``).
+    robot : Robot
+        The robot the program was read on.
+    energy : str
+        The energy measure minimised (the run's).
+    corridor_mm : float, optional
+        The written module's TCP stays within this distance (mm) of the taught cycle's TCP path
+        (None: not checked).
+    cell : Cell, optional
+        Obstacles: the written module's motion must keep the cell's margin.
+    max_seconds : float, optional
+        Wall time of the lever search (what it found by then is written).
+    config : ControllerConfig, optional
+        The emulated controller.
+
+    Returns
+    -------
+    ViaLevers
+        ``levers`` None (and ``note`` why) where no such module runs within the taught cycle time
+        for less energy, reads back as searched, and keeps the corridor and the cell.
+    """
+    from joulepath.program._output import written_rapid
+    from joulepath.program._rapid_write import HEADERS
+    from joulepath.program._task import as_sequence, read_written
+
+    config = config or ControllerConfig()
+    spec = result.spec
+    if spec.module is None:
+        return ViaLevers(None, "not a program of one module")
+    plan = result.unretimed or result
+    if not plan.paths or not result.limits_ok:
+        return ViaLevers(None, "no optimized move within the limits to write as via points")
+    try:
+        text = _plain(written_rapid(plan).text)
+    except LimitViolation as err:
+        return ViaLevers(None, str(err))
+    taught = _Evaluator(spec, [], energy, config)
+    plan_t, t_taught, _ = taught(())
+    e_taught, lab_taught = taught.energies(plan_t)
+    path = f"{spec.module.path} (via points)"
+    try:
+        via_spec = resolve_module(parse_module(text, path=path), robot)
+        _, t_via, e_via = _Evaluator(via_spec, [], energy, config)(())
+        added = _added_lines(via_spec)
+        as_planned, factor = text, 1.0
+        for _ in range(TIME_FITS):  # over the taught cycle time: every via point's \T shortened alike
+            if t_via <= t_taught + _TOL_S:
+                break
+            factor *= t_taught / t_via * (1.0 - 1e-3)
+            scaled = _scaled(as_planned, added, factor)
+            spec_s = resolve_module(parse_module(scaled, path=path), robot)
+            _, t_s, e_s = _Evaluator(spec_s, [], energy, config)(())
+            if t_s >= t_via:
+                break
+            text, via_spec, t_via, e_via = scaled, spec_s, t_s, e_s
+    except JoulepathError as err:
+        return ViaLevers(None, f"the via-point module cannot be read: {err}")
+    if t_via > t_taught + _TOL_S:
+        return ViaLevers(
+            None,
+            f"the via-point module takes {t_via:.3f} s per cycle, longer than the taught {t_taught:.3f} s",
+            t_via,
+            e_via,
+        )
+    try:
+        found = levers_module(
+            via_spec,
+            robot,
+            energy=energy,
+            text=text,
+            config=config,
+            max_seconds=max_seconds,
+            baseline=(t_taught, e_taught, lab_taught),
+            only_lines=added,
+        )
+    except InvalidInput as err:
+        return ViaLevers(None, f"the levers of the via points: {err}", t_via, e_via)
+    if not (found.cycle_s <= t_taught + _TOL_S and found.energy_J < e_taught):
+        return ViaLevers(
+            None,
+            f"the via-point module runs {found.cycle_s:.3f} s for {found.energy_J:.2f} J against the taught "
+            f"{t_taught:.3f} s and {e_taught:.2f} J",
+            t_via,
+            e_via,
+        )
+    saved = 100.0 * (1.0 - found.energy_J / e_taught)
+    header = [
+        f"{HEADERS[0]} {_version()} for energy: the plan's via points with the controller's levers (AccSet, "
+        f"\\T, zones), as the controller emulation runs this module: {found.cycle_s:.3f} s per cycle "
+        f"(taught {t_taught:.3f} s), {found.energy_J:.2f} J against the taught {e_taught:.2f} J on "
+        f"{energy} energy ({saved:.1f} % saved). See cycle.json.",
+        f"{HEADERS[1]} each optimized move calls jp_opt_<proc>_<n> (at the module's end). Re-teaching a "
+        "target: optimize the re-taught module again.",
+    ]
+    written = _with_header(found.written_text, header)
+    # read again by the other reader (the interpreter) and run again: the searched motion, or nothing
+    again = read_written(written, f"{spec.module.path} (optimized)", robot)
+    plan_a, t_again, e_again = _Evaluator(as_sequence(again), [], energy, config)(())  # type: ignore[arg-type]
+    pos, traj = _tcp_path(plan_a)
+    if abs(t_again - found.cycle_s) > 1e-3 or abs(e_again - found.energy_J) > _TOL_REL * max(1.0, e_taught):
+        return ViaLevers(
+            None,
+            f"the written module, read again, runs {t_again:.3f} s and {e_again:.3f} J against the searched "
+            f"{found.cycle_s:.3f} s and {found.energy_J:.3f} J; not written",
+            t_via,
+            e_via,
+        )
+    from scipy.spatial import cKDTree
+
+    taught_pos, _ = _tcp_path(plan_t)
+    dev = 1000.0 * float(cKDTree(taught_pos).query(pos)[0].max())
+    clear = None
+    if cell is not None:
+        from joulepath.program._cell import clearance
+
+        first = plan_a.moves[0].step
+        assert first.robot is not None and first.tcp is not None
+        clear = 1000.0 * (clearance(cell, first.robot, traj.q, first.tcp).distance - cell.margin)
+    figures = {"via_cycle_s": t_via, "via_energy_J": e_via, "deviation_mm": dev, "clearance_mm": clear}
+    if corridor_mm is not None and dev > corridor_mm:
+        return ViaLevers(
+            None,
+            f"the via-point module's TCP leaves the taught path by {dev:.1f} mm (the corridor is "
+            f"{corridor_mm:g} mm)",
+            **figures,
+        )
+    if clear is not None and clear < 0.0:
+        return ViaLevers(
+            None, f"the via-point module comes {-clear:.1f} mm inside the cell's margin", **figures
+        )
+    shift = len(header)
+    moves = tuple(replace(m, line=m.line + shift) for m in found.moves)
+    return ViaLevers(
+        replace(found, written_text=written, moves=moves, base="via points"),
+        f"via points with levers: {saved:.1f} % saved as executed",
+        **figures,
+    )
+
+
+def _version() -> str:
+    from joulepath import __version__
+
+    return __version__

@@ -1,0 +1,134 @@
+"""A plan for RAPID made on the controller emulation: the plan's via points with the levers of its via points.
+
+Invariants and agreement only: the written module, read again by the RAPID interpreter (not the reader
+the search used) and run by the controller emulation, gives the cycle time and energy the result
+reports, recomputed here from its own motion; it keeps the taught cycle time and spends less; only the
+added via-point procedures change, so the module still reads back as the program it was written from;
+and a corridor it leaves refuses it.
+"""
+
+import re
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from joulepath import load_robot
+from joulepath.dynamics import NOMINAL_FRICTION
+from joulepath.energy import measure_power
+from joulepath.program import CycleSettings, optimize_cycle, parse_module, resolve_module, via_levers
+from joulepath.program._rapid_write import restore_program
+from joulepath.program._task import as_sequence, read_written
+from joulepath.program._via_levers import _plain, _scaled, _with_header
+from joulepath.sim import FINE_DT, ControllerConfig, evaluate_cycle, plan_cycle
+
+EXT = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
+PROGRAM = f"""MODULE T
+    ! a cell of three joint moves, two stops with a gripper's wait
+    CONST robtarget pB := [[300, 200, 400], [0, 0, 1, 0], [0, 0, 0, 0], {EXT}];
+    CONST robtarget pC := [[300, -200, 350], [0, 0, 1, 0], [-1, 0, -1, 0], {EXT}];
+    CONST jointtarget jH := [[0, 0, 0, 0, 30, 0], {EXT}];
+    PROC main()
+        MoveAbsJ jH, v1000, fine, tool0;
+        WHILE TRUE DO
+            MoveJ pB, v1000, fine, tool0;
+            WaitTime 0.3;
+            MoveJ pC, v1000, z20, tool0;
+            MoveAbsJ jH, v1000, fine, tool0;
+            WaitTime 0.3;
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return load_robot("irb120")
+
+
+@pytest.fixture(scope="module")
+def planned(robot):
+    spec = resolve_module(parse_module(PROGRAM, path="cell.mod"), robot)
+    settings = CycleSettings(table_points=2, pass_search=0)
+    settings = replace(settings, gradient=replace(settings.gradient, knot_spacing=0.1))
+    result, _ = optimize_cycle(spec, settings)
+    return result, via_levers(result, robot, energy="thesis", max_seconds=60)
+
+
+def _executed(text: str, robot) -> tuple[float, float]:
+    """``text`` read by the RAPID interpreter, run by the controller emulation: cycle time, energy (J)."""
+    plan = plan_cycle(as_sequence(read_written(text, "written.mod", robot)), ControllerConfig())
+    n = int(np.ceil(plan.cycle_time / FINE_DT)) + 1
+    traj = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
+    r = plan.moves[0].step.robot
+    tau = r.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
+    power = measure_power("thesis", tau, traj.qd, r.drivetrain).value
+    return plan.cycle_time, float((power * np.append(np.diff(traj.t), 0.0)).sum())  # each sample to the next
+
+
+def test_written_module_runs_within_the_taught_cycle_and_saves_as_executed(robot, planned):
+    result, via = planned
+    assert via.levers is not None, via.note
+    lv = via.levers
+    assert lv.base == "via points" and lv.reads_back is None
+    t, e = _executed(lv.written_text, robot)  # recomputed from the written module's own motion
+    t0, e0 = _executed(PROGRAM, robot)
+    assert t == pytest.approx(lv.cycle_s, abs=1e-9)
+    assert e == pytest.approx(lv.energy_J, rel=1e-9)
+    assert (t0, e0) == pytest.approx((lv.taught_cycle_s, lv.default_energy_J), rel=1e-9)
+    assert t <= t0 + 1e-6
+    assert e < e0
+    assert lv.saved_pct == pytest.approx(100.0 * (1.0 - e / e0), rel=1e-9)
+    # the levers only ever lower the via-point module's energy, within the taught cycle
+    assert e <= via.via_energy_J * (1 + 1e-12)
+
+
+def test_only_the_added_via_point_procedures_change(robot, planned):
+    result, via = planned
+    lv = via.levers
+    assert lv is not None
+    # the module reads back as the program it was written from: byte for byte
+    assert restore_program(lv.written_text) == PROGRAM
+    spec = resolve_module(parse_module(_plain(lv.written_text), path="w.mod"), robot)
+    procs = {p.name: (p.line, p.end_line) for p in spec.module.procedures}
+    added = [rng for name, rng in procs.items() if name.lower().startswith("jp_opt_")]
+    assert added
+    shift = len(lv.written_text.splitlines()) - len(_plain(lv.written_text).splitlines())
+    for m in lv.moves:
+        if m.changed:
+            line = m.line - shift  # MoveLever lines are the written file's (its header included)
+            assert any(a <= line <= b for a, b in added), m
+    assert lv.n_changed >= 1
+
+
+def test_a_corridor_it_leaves_refuses_it(robot, planned):
+    result, via = planned
+    assert via.deviation_mm is not None and via.deviation_mm > 0.5
+    narrow = via_levers(result, robot, energy="thesis", corridor_mm=0.5, max_seconds=60)
+    assert narrow.levers is None
+    assert "corridor" in narrow.note and f"{narrow.deviation_mm:.1f} mm" in narrow.note
+
+
+def test_scaling_changes_only_the_t_of_the_given_lines():
+    text = (
+        "MODULE M\n"
+        "    PROC jp_opt_main_1()\n"
+        "        MoveAbsJ j{1}, v7000 \\T:=0.25, z200, tool0;\n"
+        "        MoveAbsJ j{2}, v7000 \\T := 1.5, fine, tool0;\n"
+        "    ENDPROC\n"
+        "    PROC main()\n"
+        "        MoveJ p, v1000 \\T:=2, z10, tool0;\n"
+        "    ENDPROC\n"
+        "ENDMODULE\n"
+    )
+    out = _scaled(text, {3, 4}, 0.5)
+    assert re.findall(r"\\T\s*:=\s*([\d.]+)", out) == ["0.1250", "0.7500", "2"]
+    assert [a for a, b in zip(text.splitlines(), out.splitlines(), strict=True) if a != b] == text.splitlines()[2:4]
+
+
+def test_header_goes_under_the_module_line_with_its_line_ends():
+    text = "MODULE M\r\n    PROC main()\r\n    ENDPROC\r\nENDMODULE\r\n"
+    out = _with_header(text, ["! one", "! two"])
+    assert out.splitlines(keepends=True)[1:3] == ["    ! one\r\n", "    ! two\r\n"]
+    assert _plain(_with_header(text, ["! Optimized by joulepath x"])) == text
