@@ -17,9 +17,9 @@ from joulepath import load_robot
 from joulepath.dynamics import NOMINAL_FRICTION
 from joulepath.energy import measure_power
 from joulepath.program import CycleSettings, optimize_cycle, parse_module, resolve_module, via_levers
-from joulepath.program._rapid_write import restore_program
+from joulepath.program._rapid_write import HEADERS, restore_program
 from joulepath.program._task import as_sequence, read_written
-from joulepath.program._via_levers import _plain, _scaled, _with_header
+from joulepath.program._via_levers import _CALL, _plain, _reverted, _scaled, _units, _with_header
 from joulepath.sim import FINE_DT, ControllerConfig, evaluate_cycle, plan_cycle
 
 EXT = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
@@ -133,3 +133,22 @@ def test_header_goes_under_the_module_line_with_its_line_ends():
     out = _with_header(text, ["! one", "! two"])
     assert out.splitlines(keepends=True)[1:3] == ["    ! one\r\n", "    ! two\r\n"]
     assert _plain(_with_header(text, ["! Optimized by joulepath x"])) == text
+
+
+def test_a_unit_put_back_as_taught_is_the_taught_statement(robot, planned):
+    from joulepath.program._output import written_rapid
+
+    result, _ = planned
+    text = _plain(written_rapid(result.unretimed or result).text)
+    units = _units(text)
+    assert units  # every optimized move of this program is a call under its `was:` lines
+    for u in units:
+        back = _reverted(text, u)
+        assert len(back.splitlines()) == len(text.splitlines()) - 1
+        assert not _CALL.match(back.splitlines()[u - 1])
+        assert restore_program(_with_header(back, [HEADERS[1]])) == PROGRAM
+        # the statement put back runs as the taught program ran it: the same target
+        again = resolve_module(parse_module(back, path="b.mod"), robot)
+        taught = [s for s in result.spec.steps if s.kind == "move"]
+        moved = [s.q for s in again.steps if s.kind == "move"]
+        assert any(np.allclose(q, taught[-1].q) for q in moved)

@@ -25,6 +25,7 @@ program run by the same emulation, on the run's energy measure.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -51,7 +52,8 @@ class ViaLevers:
 
     ``via_cycle_s``/``via_energy_J``: the via-point module before the levers, as executed;
     ``deviation_mm``: the largest distance of the written module's TCP from the taught cycle's
-    path; ``clearance_mm``: from the cell's margin (None without a cell)."""
+    path; ``clearance_mm``: from the cell's margin (None without a cell); ``taught_units``: optimized
+    moves put back as taught (their statement instead of the via points) to keep the cycle time."""
 
     levers: LeverResult | None
     note: str
@@ -59,6 +61,7 @@ class ViaLevers:
     via_energy_J: float | None = None
     deviation_mm: float | None = None
     clearance_mm: float | None = None
+    taught_units: int = 0
 
 
 def _plain(text: str) -> str:
@@ -90,6 +93,57 @@ def _scaled(text: str, lines: set[int], factor: float) -> str:
         if 1 <= k <= len(out):
             out[k - 1] = _T_ARG.sub(times, out[k - 1])
     return "".join(out)
+
+
+def _fitted(
+    text: str,
+    spec: CycleSpec,
+    t: float,
+    e: float,
+    t_taught: float,
+    run: Callable[[str], tuple[CycleSpec, float, float]],
+) -> tuple[str, CycleSpec, float, float]:
+    """A module over the taught cycle time with every via point's ``\\T`` shortened by one factor,
+    until it fits (at most :data:`TIME_FITS` tries; as it was where shortening does not help)."""
+    as_planned, factor = text, 1.0
+    added = _added_lines(spec)
+    for _ in range(TIME_FITS):
+        if t <= t_taught + _TOL_S:
+            break
+        factor *= t_taught / t * (1.0 - 1e-3)
+        scaled = _scaled(as_planned, added, factor)
+        spec_s, t_s, e_s = run(scaled)
+        if t_s >= t:
+            break
+        text, spec, t, e = scaled, spec_s, t_s, e_s
+    return text, spec, t, e
+
+
+_CALL = re.compile(r"^\s*jp_opt_\w+\s*;\s*$", re.IGNORECASE)
+
+
+def _units(text: str) -> list[int]:
+    """The via-point calls that can go back to the taught statement: line indices (0-based) of calls
+    of an added procedure standing directly under the ``! joulepath: was:`` lines of what they replace."""
+    from joulepath.program._rapid_write import WAS
+
+    lines = text.splitlines()
+    return [k for k, ln in enumerate(lines) if _CALL.match(ln) and k and lines[k - 1].strip().startswith(WAS)]
+
+
+def _reverted(text: str, call: int) -> str:
+    """``text`` with the call on line index ``call`` replaced by the taught statement it replaced."""
+    from joulepath.program._rapid_write import WAS
+
+    lines = text.splitlines(keepends=True)
+    first = call
+    while first and lines[first - 1].strip().startswith(WAS):
+        first -= 1
+    raw = lines[first]
+    indent = raw[: len(raw) - len(raw.lstrip())]
+    end = "\r\n" if raw.endswith("\r\n") else "\n"
+    taught = [indent + ln.strip()[len(WAS) :] + end for ln in lines[first:call]]
+    return "".join([*lines[:first], *taught, *lines[call + 1 :]])
 
 
 def _with_header(text: str, header: list[str]) -> str:
@@ -169,18 +223,25 @@ def via_levers(
     try:
         via_spec = resolve_module(parse_module(text, path=path), robot)
         _, t_via, e_via = _Evaluator(via_spec, [], energy, config)(())
+
+        def run(candidate: str) -> tuple[CycleSpec, float, float]:
+            spec_c = resolve_module(parse_module(candidate, path=path), robot)
+            _, t_c, e_c = _Evaluator(spec_c, [], energy, config)(())
+            return spec_c, t_c, e_c
+
+        via_spec, t_via, e_via = run(text)
+        text, via_spec, t_via, e_via = _fitted(text, via_spec, t_via, e_via, t_taught, run)
+        reverted = 0
+        while t_via > t_taught + _TOL_S:  # still longer: the unit whose taught move saves most time
+            tries = [run(_reverted(text, u)) + (u,) for u in _units(text)]
+            if not tries:
+                break
+            spec_r, t_r, e_r, u = min(tries, key=lambda x: x[1])
+            if t_r >= t_via - _TOL_S:
+                break
+            text, via_spec, t_via, e_via = _fitted(_reverted(text, u), spec_r, t_r, e_r, t_taught, run)
+            reverted += 1
         added = _added_lines(via_spec)
-        as_planned, factor = text, 1.0
-        for _ in range(TIME_FITS):  # over the taught cycle time: every via point's \T shortened alike
-            if t_via <= t_taught + _TOL_S:
-                break
-            factor *= t_taught / t_via * (1.0 - 1e-3)
-            scaled = _scaled(as_planned, added, factor)
-            spec_s = resolve_module(parse_module(scaled, path=path), robot)
-            _, t_s, e_s = _Evaluator(spec_s, [], energy, config)(())
-            if t_s >= t_via:
-                break
-            text, via_spec, t_via, e_via = scaled, spec_s, t_s, e_s
     except JoulepathError as err:
         return ViaLevers(None, f"the via-point module cannot be read: {err}")
     if t_via > t_taught + _TOL_S:
@@ -244,24 +305,24 @@ def via_levers(
         first = plan_a.moves[0].step
         assert first.robot is not None and first.tcp is not None
         clear = 1000.0 * (clearance(cell, first.robot, traj.q, first.tcp).distance - cell.margin)
-    figures = {"via_cycle_s": t_via, "via_energy_J": e_via, "deviation_mm": dev, "clearance_mm": clear}
+
+    def with_figures(levers: LeverResult | None, note: str) -> ViaLevers:
+        return ViaLevers(levers, note, t_via, e_via, dev, clear, reverted)
+
     if corridor_mm is not None and dev > corridor_mm:
-        return ViaLevers(
+        return with_figures(
             None,
             f"the via-point module's TCP leaves the taught path by {dev:.1f} mm (the corridor is "
             f"{corridor_mm:g} mm)",
-            **figures,
         )
     if clear is not None and clear < 0.0:
-        return ViaLevers(
-            None, f"the via-point module comes {-clear:.1f} mm inside the cell's margin", **figures
-        )
+        return with_figures(None, f"the via-point module comes {-clear:.1f} mm inside the cell's margin")
     shift = len(header)
     moves = tuple(replace(m, line=m.line + shift) for m in found.moves)
-    return ViaLevers(
+    return with_figures(
         replace(found, written_text=written, moves=moves, base="via points"),
-        f"via points with levers: {saved:.1f} % saved as executed",
-        **figures,
+        f"via points with levers: {saved:.1f} % saved as executed"
+        + (f" ({reverted} optimized move(s) kept as taught to keep the cycle time)" if reverted else ""),
     )
 
 
