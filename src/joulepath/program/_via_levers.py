@@ -43,6 +43,9 @@ _TOL_REL = 1e-6
 TIME_FITS = 4
 """Tries, at most, to fit a via-point module that runs longer than the taught cycle into its time by
 shortening every via point's ``\\T`` by the same factor."""
+MAX_PLANS = 4000
+"""Cycle plans the lever search of the via points makes at most (each a few ms per move; ``max_seconds``
+bounds it too): a via-point module has many more statements than the program it was written from."""
 _T_ARG = re.compile(r"(\\T\s*:=\s*)(\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)")
 
 
@@ -232,11 +235,13 @@ def via_levers(
         via_spec, t_via, e_via = run(text)
         text, via_spec, t_via, e_via = _fitted(text, via_spec, t_via, e_via, t_taught, run)
         reverted = 0
-        while t_via > t_taught + _TOL_S:  # still longer: the unit whose taught move saves most time
+        while t_via > t_taught + _TOL_S:  # still longer: put a unit back as taught (the cheapest that
+            # fits, else the one that saves most time)
             tries = [run(_reverted(text, u)) + (u,) for u in _units(text)]
             if not tries:
                 break
-            spec_r, t_r, e_r, u = min(tries, key=lambda x: x[1])
+            fits = [x for x in tries if x[1] <= t_taught + _TOL_S]
+            spec_r, t_r, e_r, u = min(fits, key=lambda x: x[2]) if fits else min(tries, key=lambda x: x[1])
             if t_r >= t_via - _TOL_S:
                 break
             text, via_spec, t_via, e_via = _fitted(_reverted(text, u), spec_r, t_r, e_r, t_taught, run)
@@ -259,6 +264,7 @@ def via_levers(
             text=text,
             config=config,
             max_seconds=max_seconds,
+            max_evaluations=MAX_PLANS,
             baseline=(t_taught, e_taught, lab_taught),
             only_lines=added,
         )
