@@ -152,3 +152,20 @@ def test_a_unit_put_back_as_taught_is_the_taught_statement(robot, planned):
         taught = [s for s in result.spec.steps if s.kind == "move"]
         moved = [s.q for s in again.steps if s.kind == "move"]
         assert any(np.allclose(q, taught[-1].q) for q in moved)
+
+
+def test_calls_with_arguments_go_back_to_the_statement_they_replaced():
+    text = (
+        "MODULE M\n"
+        "    PROC Transfer(robtarget pFrom, robtarget pTo, num jpRun)\n"
+        "        ! joulepath: was: MoveJ Offs(pTo, 0, 0, 100), v1000, z20, tool0;\n"
+        "        jp_opt_Transfer_4 pFrom, pTo, jpRun;\n"
+        "        jp_opt_Transfer_5 pFrom, pTo, jpRun;\n"
+        "    ENDPROC\n"
+        "ENDMODULE\n"
+    )
+    assert _units(text) == [3]  # the second call stands under no `was:` line: it stays
+    assert _reverted(text, 3).splitlines()[2:4] == [
+        "        MoveJ Offs(pTo, 0, 0, 100), v1000, z20, tool0;",
+        "        jp_opt_Transfer_5 pFrom, pTo, jpRun;",
+    ]

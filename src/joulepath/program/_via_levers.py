@@ -122,7 +122,7 @@ def _fitted(
     return text, spec, t, e
 
 
-_CALL = re.compile(r"^\s*jp_opt_\w+\s*;\s*$", re.IGNORECASE)
+_CALL = re.compile(r"^\s*jp_opt_\w+(?:\s+[\w\s,]*)?;\s*$", re.IGNORECASE)
 
 
 def _units(text: str) -> list[int]:
