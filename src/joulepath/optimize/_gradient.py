@@ -396,6 +396,16 @@ class SplineProblem:
         g = self.egrid.B.T @ a + self.egrid.Bd.T @ b + self.egrid.Bdd.T @ c
         return float(power.value.sum() * self.edt), g.ravel()
 
+    def smooth_energy_value(self, x: FloatArray, eps: float) -> float:
+        """The smoothed energy (J) of :meth:`smooth_energy` without its gradient: the torques alone
+        (Pinocchio's RNEA, about a fifth of the cost of its derivatives). SLSQP asks for the gradient
+        only at the points its line search accepts; its trial steps need the value only."""
+        self.n_evaluations += 1
+        p = self._energy_path(x)
+        tau = self.robot.inverse_dynamics(p.q, p.qd, p.qdd, friction=self.friction)
+        power = self.energy_measure_def.power(tau, p.qd, self.drivetrain, eps)
+        return float(power.value.sum() * self.edt)
+
     # ------------------------------------------------------------- constraints
     @property
     def rate_hull(self) -> bool:
@@ -763,9 +773,11 @@ def _solve_from(
     for share in settings.continuation:
         eps = share * eps_unit
 
-        def fun(z: FloatArray, eps: float = eps) -> tuple[float, FloatArray]:
-            f, g = problem.smooth_energy(z, eps)
-            return f / scale, g / scale
+        def fun(z: FloatArray, eps: float = eps) -> float:
+            return problem.smooth_energy_value(z, eps) / scale
+
+        def jac(z: FloatArray, eps: float = eps) -> FloatArray:
+            return problem.smooth_energy(z, eps)[1] / scale
 
         W = _preconditioner(problem, x, eps, scale, settings.precondition)
         for _ in range(settings.max_rounds):
@@ -773,7 +785,7 @@ def _solve_from(
                 res = minimize(
                     fun,
                     x,
-                    jac=True,
+                    jac=jac,
                     method="SLSQP",
                     constraints=problem.constraints(active),
                     options={"maxiter": settings.max_iter, "ftol": settings.ftol},
@@ -783,16 +795,17 @@ def _solve_from(
             else:  # the same problem in y, x = x + W y: its Hessian near the identity at y = 0
                 x_at, Wm = x, W
 
-                def fun_y(
-                    y: FloatArray, x_at: FloatArray = x_at, Wm: FloatArray = Wm
-                ) -> tuple[float, FloatArray]:
-                    f, g = fun(x_at + Wm @ y)
-                    return f, Wm.T @ g
+                def fun_y(y: FloatArray, x_at: FloatArray = x_at, Wm: FloatArray = Wm) -> float:
+                    return fun(x_at + Wm @ y)
+
+                def jac_y(y: FloatArray, x_at: FloatArray = x_at, Wm: FloatArray = Wm) -> FloatArray:
+                    out: FloatArray = Wm.T @ jac(x_at + Wm @ y)
+                    return out
 
                 res = minimize(
                     fun_y,
                     np.zeros(x.size),
-                    jac=True,
+                    jac=jac_y,
                     method="SLSQP",
                     constraints=problem.constraints(active, (x_at, Wm)),
                     options={"maxiter": settings.max_iter, "ftol": settings.ftol},
