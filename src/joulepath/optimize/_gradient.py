@@ -386,15 +386,33 @@ class SplineProblem:
         """
         self.n_evaluations += 1
         p = self._energy_path(x)
-        d = inverse_dynamics_derivatives(self.robot, p.q, p.qd, p.qdd, friction=self.friction)
-        power = self.energy_measure_def.power(d.tau, p.qd, self.drivetrain, eps)
+        value, per_state = self._state_gradient(p.q, p.qd, p.qdd, eps)
+        g = (
+            self.egrid.B.T @ per_state[:, 0]
+            + self.egrid.Bd.T @ per_state[:, 1]
+            + self.egrid.Bdd.T @ per_state[:, 2]
+        )
+        return value, g.ravel()
+
+    def _state_gradient(
+        self, q: FloatArray, qd: FloatArray, qdd: FloatArray, eps: float
+    ) -> tuple[float, FloatArray]:
+        """The smoothed energy over the energy grid's states and its gradient by each state,
+        ``(N, 3, n)``: by ``q``, ``qd`` and ``qdd`` at each point (the measure's derivatives by torque
+        and speed chained through the inverse dynamics' derivatives)."""
+        d = inverse_dynamics_derivatives(self.robot, q, qd, qdd, friction=self.friction)
+        power = self.energy_measure_def.power(d.tau, qd, self.drivetrain, eps)
         wq = power.d_tau * self.edt  # dE/dtau
         # dE/dq_k = Tq_kᵀ wq_k, dE/dqd_k = Tv_kᵀ wq_k + dE/dqd_k (direct), dE/dqdd_k = Ta_kᵀ wq_k
-        a = np.einsum("kij,ki->kj", d.dq, wq)
-        b = np.einsum("kij,ki->kj", d.dqd, wq) + power.d_qd * self.edt
-        c = np.einsum("kij,ki->kj", d.dqdd, wq)
-        g = self.egrid.B.T @ a + self.egrid.Bd.T @ b + self.egrid.Bdd.T @ c
-        return float(power.value.sum() * self.edt), g.ravel()
+        out = np.stack(
+            [
+                np.einsum("kij,ki->kj", d.dq, wq),
+                np.einsum("kij,ki->kj", d.dqd, wq) + power.d_qd * self.edt,
+                np.einsum("kij,ki->kj", d.dqdd, wq),
+            ],
+            axis=1,
+        )
+        return float(power.value.sum() * self.edt), out
 
     def smooth_energy_value(self, x: FloatArray, eps: float) -> float:
         """The smoothed energy (J) of :meth:`smooth_energy` without its gradient: the torques alone
@@ -681,15 +699,36 @@ def _rate_control_blocks(
 
 
 def smooth_energy_hessian(problem: SplineProblem, x: FloatArray, eps: float) -> FloatArray:
-    """The smoothed energy's Hessian (J) at ``x``: forward differences of the exact gradient, symmetrized."""
+    """The smoothed energy's Hessian (J) at ``x``, symmetrized.
+
+    The energy is a sum over the grid's points of a function of each point's state
+    ``(q, qd, qdd)``, each linear in ``x`` through the spline basis; so the Hessian is
+    ``Σ_k J_kᵀ H_k J_k`` with ``H_k`` the ``3n × 3n`` Hessian of point ``k``'s term by its state:
+    forward differences of the exact per-state gradient, ``3n`` evaluations on all points at
+    once (against one per variable, ``n_free · n``, when differencing the gradient by ``x``).
+    """
     x = np.asarray(x, dtype=float)
-    g0 = problem.smooth_energy(x, eps)[1]
-    h = 1e-6 * max(1.0, float(np.abs(x).max(initial=0.0)))
-    H = np.empty((x.size, x.size))
-    for j in range(x.size):
-        xp = x.copy()
-        xp[j] += h
-        H[:, j] = (problem.smooth_energy(xp, eps)[1] - g0) / h
+    problem.n_evaluations += 1
+    p = problem._energy_path(x)
+    states = np.stack([p.q, p.qd, p.qdd], axis=1)  # (N, 3, n)
+    g0 = problem._state_gradient(p.q, p.qd, p.qdd, eps)[1]
+    N, _, n = states.shape
+    Hk = np.empty((N, 3, n, 3, n))
+    for b in range(3):
+        h = 1e-6 * max(1.0, float(np.abs(states[:, b]).max(initial=0.0)))
+        for j in range(n):
+            problem.n_evaluations += 1
+            moved = states.copy()
+            moved[:, b, j] += h
+            Hk[:, :, :, b, j] = (
+                problem._state_gradient(moved[:, 0], moved[:, 1], moved[:, 2], eps)[1] - g0
+            ) / h
+    Hk = 0.5 * (Hk + Hk.transpose(0, 3, 4, 1, 2))
+    g = problem.egrid
+    D = np.stack([g.B, g.Bd, g.Bdd], axis=1)  # (N, 3, m): d state / d coefficient
+    m = D.shape[2]
+    Y = np.einsum("kaibc,kbl->kailc", Hk, D)  # (N, 3, n, m, n)
+    H = (D.reshape(N * 3, m).T @ Y.reshape(N * 3, n * m * n)).reshape(m * n, m * n)
     out: FloatArray = 0.5 * (H + H.T)
     return out
 
