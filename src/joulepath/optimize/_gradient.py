@@ -818,8 +818,8 @@ def _solve_from(
         def jac(z: FloatArray, eps: float = eps) -> FloatArray:
             return problem.smooth_energy(z, eps)[1] / scale
 
-        W = _preconditioner(problem, x, eps, scale, settings.precondition)
         for _ in range(settings.max_rounds):
+            W = _preconditioner(problem, x, eps, scale, settings.precondition)
             if W is None:
                 res = minimize(
                     fun,
