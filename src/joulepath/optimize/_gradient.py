@@ -33,9 +33,9 @@ Constraints (not penalties), solved by SLSQP:
   a chain of fly-by targets solved as one move; exactly (equalities), or within a
   box of given half-widths per joint (``waypoint_radius``: a zone, inequalities).
 
-Each continuation stage solves in coordinates in which the smoothed energy's Hessian at the
-stage's start is near the identity (``GradientSettings.precondition``): SLSQP's quasi-Newton
-model starts from the identity, and on the fine knots' many variables it needs far fewer
+Each continuation stage, and each round of it (see below), solves in coordinates in which the
+smoothed energy's Hessian at its start is near the identity (``GradientSettings.precondition``):
+SLSQP's quasi-Newton model starts from the identity, and on the fine knots' many variables it needs far fewer
 iterations so.
 
 Constraints are generated lazily (active-set style): each solve includes
@@ -112,8 +112,8 @@ class GradientSettings:
     (about ten times the rows). A move added to a given ``base`` motion (not a spline) always
     takes the grid rows.
 
-    ``precondition``: each continuation stage solves in coordinates ``y`` with ``x = x_at + W y``,
-    ``Wᵀ H W`` near the identity for the smoothed energy's Hessian ``H`` at the stage's start (its
+    ``precondition``: each continuation stage's round solves in coordinates ``y`` with ``x = x_at + W y``,
+    ``Wᵀ H W`` near the identity for the smoothed energy's Hessian ``H`` at the round's start (its
     eigenvalues' magnitudes held at least this share of the largest; 0: the plain coefficients).
     SLSQP's quasi-Newton model starts from the identity, so it starts near the curvature there.
     Measured on the random tasks of ``benchmarks/optimizer_speed.py`` against the search before

@@ -532,7 +532,8 @@ def _search(
     maxiter: int = MAX_ITERATIONS,
     deadline: float | None = None,
 ) -> FloatArray:
-    """SLSQP from ``x0`` (past ``deadline``, a ``time.perf_counter()``, it stops at its iterate)."""
+    """SLSQP from ``x0`` (past ``deadline``, a ``time.perf_counter()``, it stops at its iterate), the
+    limit rows taken lazily (:data:`SCREEN_BAND`, at most :data:`MAX_ROUNDS` solves)."""
     problem = _problem(robot, at, timing, t, limits, margin)
     n = x0.size
     order = np.zeros((n + 1, n))  # x_0 >= lo, x_{i+1} - x_i >= 0, hi - x_{n-1} >= 0 (the fixed neighbours)
