@@ -62,9 +62,10 @@ from joulepath.trajectory import minimum_jerk  # noqa: E402
 from joulepath.units import SAMPLE_PERIOD  # noqa: E402
 
 SECTION = "optimizer_speed"
-METHODS = ("gradient", "gradient-fast", "gradient-grid")
+METHODS = ("gradient", "gradient-before", "gradient-fast", "gradient-grid")
 LABELS = {
     "gradient": "default (`gradient`: hull rows, preconditioned SLSQP)",
+    "gradient-before": "the default before (`gradient` of the code given by `--before`, run back to back)",
     "gradient-fast": "`gradient-fast` (`--algo gradient-fast`: one level of knots 0.1 s apart)",
     "gradient-grid": "the search before (`gradient-grid`: fine-grid rows, plain SLSQP)",
 }
@@ -162,18 +163,31 @@ def run(args: argparse.Namespace) -> Path:
     return out_csv
 
 
-def _table(path: Path) -> tuple[list[str], list[float], int]:
-    """The summary table of one run (its methods against the first one's CPU), its loads and task count."""
+def _rows(path: Path, before: Path | None = None) -> list[dict[str, str]]:
+    """A run's rows; with ``before``, that run's ``gradient`` rows too, as ``gradient-before``."""
     with path.open() as fh:
         rows = list(csv.DictReader(fh))
+    if before is not None:
+        with before.open() as fh:
+            rows += [
+                {**r, "method": "gradient-before"} for r in csv.DictReader(fh) if r["method"] == "gradient"
+            ]
+    return rows
+
+
+def _table(path: Path, before: Path | None = None) -> tuple[list[str], list[float], int]:
+    """The summary table of one run (its methods against the first one's CPU), its loads and task count."""
+    rows = _rows(path, before)
     by: dict[str, dict[str, dict[str, Any]]] = {}
     for r in rows:
         by.setdefault(r["task"], {})[r["method"]] = r
     methods = [m for m in METHODS if all(m in by[t] for t in by)]
     tasks = list(by)
-    base = "gradient-grid" if "gradient-grid" in methods else methods[0]
+    base = next(m for m in ("gradient-before", "gradient-grid", methods[0]) if m in methods)
     lines = [
-        f"Run `{path.relative_to(ROOT) if path.is_relative_to(ROOT) else path}` ({len(tasks)} tasks):",
+        f"Run `{_name(path)}`"
+        + ("" if before is None else f" with the before run `{_name(before)}`")
+        + f" ({len(tasks)} tasks):",
         "",
         "| method | tasks | median CPU per move | mean CPU | max CPU | mean share of the optimum | "
         f"min share | within limits (10x grid) | median of CPU / {base}'s on the same task |",
@@ -200,15 +214,19 @@ def _table(path: Path) -> tuple[list[str], list[float], int]:
     return lines, [float(r["load1"]) for r in rows], len(tasks)
 
 
-def report(paths: list[Path]) -> str:
+def _name(path: Path) -> str:
+    return str(path.relative_to(ROOT) if path.is_relative_to(ROOT) else path)
+
+
+def report(paths: list[Path], before: Path | None = None) -> str:
     lines = [
         "## One move, jerk limits on: the default search against the search before (issue 36)",
         "",
     ]
     loads: list[float] = []
     tables: list[str] = []
-    for path in paths:
-        table, load, _ = _table(path)
+    for k, path in enumerate(paths):
+        table, load, _ = _table(path, before if k == 0 else None)
         loads += load
         tables += [*table, ""]
     with paths[0].open() as fh:
@@ -223,6 +241,13 @@ def report(paths: list[Path]) -> str:
         f"(target 100 %: {'met' if ok == 100 else 'not met'}).",
         "",
     ]
+    if before is not None:
+        lines += [
+            f"The before run (`{before.name}`): this script's `gradient` on the source of the code before "
+            "the change (`PYTHONPATH=<its src>`, the commit in the file's name), at the same time as the first "
+            "run (the same load), its rows joined to the first run's table as `gradient-before`.",
+            "",
+        ]
     lines += [
         f"Machine: {machine()}; one BLAS/OpenMP thread; CPU time of the process during `optimize_move` "
         "(`time.process_time`). The machine was shared with other jobs (1-minute load average "
@@ -255,10 +280,17 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     parser.add_argument("--no-report", action="store_true")
     parser.add_argument("--report-only", type=Path, nargs="+", default=None, help="CSVs of earlier runs")
+    parser.add_argument(
+        "--before",
+        type=Path,
+        default=None,
+        help="CSV of a run of the code before a change (PYTHONPATH=<its src>), on the same tasks: its "
+        "gradient rows join the first run's table as gradient-before, the yardstick of the CPU ratio",
+    )
     args = parser.parse_args()
     paths = args.report_only if args.report_only is not None else [run(args)]
     if not args.no_report:
-        write_section(SECTION, report(paths))
+        write_section(SECTION, report(paths, args.before))
 
 
 if __name__ == "__main__":

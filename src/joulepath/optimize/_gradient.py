@@ -33,9 +33,9 @@ Constraints (not penalties), solved by SLSQP:
   a chain of fly-by targets solved as one move; exactly (equalities), or within a
   box of given half-widths per joint (``waypoint_radius``: a zone, inequalities).
 
-Each continuation stage solves in coordinates in which the smoothed energy's Hessian at the
-stage's start is near the identity (``GradientSettings.precondition``): SLSQP's quasi-Newton
-model starts from the identity, and on the fine knots' many variables it needs far fewer
+Each continuation stage, and each round of it (see below), solves in coordinates in which the
+smoothed energy's Hessian at its start is near the identity (``GradientSettings.precondition``):
+SLSQP's quasi-Newton model starts from the identity, and on the fine knots' many variables it needs far fewer
 iterations so.
 
 Constraints are generated lazily (active-set style): each solve includes
@@ -112,8 +112,8 @@ class GradientSettings:
     (about ten times the rows). A move added to a given ``base`` motion (not a spline) always
     takes the grid rows.
 
-    ``precondition``: each continuation stage solves in coordinates ``y`` with ``x = x_at + W y``,
-    ``Wᵀ H W`` near the identity for the smoothed energy's Hessian ``H`` at the stage's start (its
+    ``precondition``: each continuation stage's round solves in coordinates ``y`` with ``x = x_at + W y``,
+    ``Wᵀ H W`` near the identity for the smoothed energy's Hessian ``H`` at the round's start (its
     eigenvalues' magnitudes held at least this share of the largest; 0: the plain coefficients).
     SLSQP's quasi-Newton model starts from the identity, so it starts near the curvature there.
     Measured on the random tasks of ``benchmarks/optimizer_speed.py`` against the search before
@@ -386,15 +386,43 @@ class SplineProblem:
         """
         self.n_evaluations += 1
         p = self._energy_path(x)
-        d = inverse_dynamics_derivatives(self.robot, p.q, p.qd, p.qdd, friction=self.friction)
-        power = self.energy_measure_def.power(d.tau, p.qd, self.drivetrain, eps)
+        value, per_state = self._state_gradient(p.q, p.qd, p.qdd, eps)
+        g = (
+            self.egrid.B.T @ per_state[:, 0]
+            + self.egrid.Bd.T @ per_state[:, 1]
+            + self.egrid.Bdd.T @ per_state[:, 2]
+        )
+        return value, g.ravel()
+
+    def _state_gradient(
+        self, q: FloatArray, qd: FloatArray, qdd: FloatArray, eps: float
+    ) -> tuple[float, FloatArray]:
+        """The smoothed energy over the energy grid's states and its gradient by each state,
+        ``(N, 3, n)``: by ``q``, ``qd`` and ``qdd`` at each point (the measure's derivatives by torque
+        and speed chained through the inverse dynamics' derivatives)."""
+        d = inverse_dynamics_derivatives(self.robot, q, qd, qdd, friction=self.friction)
+        power = self.energy_measure_def.power(d.tau, qd, self.drivetrain, eps)
         wq = power.d_tau * self.edt  # dE/dtau
         # dE/dq_k = Tq_kᵀ wq_k, dE/dqd_k = Tv_kᵀ wq_k + dE/dqd_k (direct), dE/dqdd_k = Ta_kᵀ wq_k
-        a = np.einsum("kij,ki->kj", d.dq, wq)
-        b = np.einsum("kij,ki->kj", d.dqd, wq) + power.d_qd * self.edt
-        c = np.einsum("kij,ki->kj", d.dqdd, wq)
-        g = self.egrid.B.T @ a + self.egrid.Bd.T @ b + self.egrid.Bdd.T @ c
-        return float(power.value.sum() * self.edt), g.ravel()
+        out = np.stack(
+            [
+                np.einsum("kij,ki->kj", d.dq, wq),
+                np.einsum("kij,ki->kj", d.dqd, wq) + power.d_qd * self.edt,
+                np.einsum("kij,ki->kj", d.dqdd, wq),
+            ],
+            axis=1,
+        )
+        return float(power.value.sum() * self.edt), out
+
+    def smooth_energy_value(self, x: FloatArray, eps: float) -> float:
+        """The smoothed energy (J) of :meth:`smooth_energy` without its gradient: the torques alone
+        (Pinocchio's RNEA, about a fifth of the cost of its derivatives). SLSQP asks for the gradient
+        only at the points its line search accepts; its trial steps need the value only."""
+        self.n_evaluations += 1
+        p = self._energy_path(x)
+        tau = self.robot.inverse_dynamics(p.q, p.qd, p.qdd, friction=self.friction)
+        power = self.energy_measure_def.power(tau, p.qd, self.drivetrain, eps)
+        return float(power.value.sum() * self.edt)
 
     # ------------------------------------------------------------- constraints
     @property
@@ -671,15 +699,36 @@ def _rate_control_blocks(
 
 
 def smooth_energy_hessian(problem: SplineProblem, x: FloatArray, eps: float) -> FloatArray:
-    """The smoothed energy's Hessian (J) at ``x``: forward differences of the exact gradient, symmetrized."""
+    """The smoothed energy's Hessian (J) at ``x``, symmetrized.
+
+    The energy is a sum over the grid's points of a function of each point's state
+    ``(q, qd, qdd)``, each linear in ``x`` through the spline basis; so the Hessian is
+    ``Σ_k J_kᵀ H_k J_k`` with ``H_k`` the ``3n × 3n`` Hessian of point ``k``'s term by its state:
+    forward differences of the exact per-state gradient, ``3n`` evaluations on all points at
+    once (against one per variable, ``n_free · n``, when differencing the gradient by ``x``).
+    """
     x = np.asarray(x, dtype=float)
-    g0 = problem.smooth_energy(x, eps)[1]
-    h = 1e-6 * max(1.0, float(np.abs(x).max(initial=0.0)))
-    H = np.empty((x.size, x.size))
-    for j in range(x.size):
-        xp = x.copy()
-        xp[j] += h
-        H[:, j] = (problem.smooth_energy(xp, eps)[1] - g0) / h
+    problem.n_evaluations += 1
+    p = problem._energy_path(x)
+    states = np.stack([p.q, p.qd, p.qdd], axis=1)  # (N, 3, n)
+    g0 = problem._state_gradient(p.q, p.qd, p.qdd, eps)[1]
+    N, _, n = states.shape
+    Hk = np.empty((N, 3, n, 3, n))
+    for b in range(3):
+        h = 1e-6 * max(1.0, float(np.abs(states[:, b]).max(initial=0.0)))
+        for j in range(n):
+            problem.n_evaluations += 1
+            moved = states.copy()
+            moved[:, b, j] += h
+            Hk[:, :, :, b, j] = (
+                problem._state_gradient(moved[:, 0], moved[:, 1], moved[:, 2], eps)[1] - g0
+            ) / h
+    Hk = 0.5 * (Hk + Hk.transpose(0, 3, 4, 1, 2))
+    g = problem.egrid
+    D = np.stack([g.B, g.Bd, g.Bdd], axis=1)  # (N, 3, m): d state / d coefficient
+    m = D.shape[2]
+    Y = np.einsum("kaibc,kbl->kailc", Hk, D)  # (N, 3, n, m, n)
+    H = (D.reshape(N * 3, m).T @ Y.reshape(N * 3, n * m * n)).reshape(m * n, m * n)
     out: FloatArray = 0.5 * (H + H.T)
     return out
 
@@ -763,17 +812,19 @@ def _solve_from(
     for share in settings.continuation:
         eps = share * eps_unit
 
-        def fun(z: FloatArray, eps: float = eps) -> tuple[float, FloatArray]:
-            f, g = problem.smooth_energy(z, eps)
-            return f / scale, g / scale
+        def fun(z: FloatArray, eps: float = eps) -> float:
+            return problem.smooth_energy_value(z, eps) / scale
 
-        W = _preconditioner(problem, x, eps, scale, settings.precondition)
+        def jac(z: FloatArray, eps: float = eps) -> FloatArray:
+            return problem.smooth_energy(z, eps)[1] / scale
+
         for _ in range(settings.max_rounds):
+            W = _preconditioner(problem, x, eps, scale, settings.precondition)
             if W is None:
                 res = minimize(
                     fun,
                     x,
-                    jac=True,
+                    jac=jac,
                     method="SLSQP",
                     constraints=problem.constraints(active),
                     options={"maxiter": settings.max_iter, "ftol": settings.ftol},
@@ -783,16 +834,17 @@ def _solve_from(
             else:  # the same problem in y, x = x + W y: its Hessian near the identity at y = 0
                 x_at, Wm = x, W
 
-                def fun_y(
-                    y: FloatArray, x_at: FloatArray = x_at, Wm: FloatArray = Wm
-                ) -> tuple[float, FloatArray]:
-                    f, g = fun(x_at + Wm @ y)
-                    return f, Wm.T @ g
+                def fun_y(y: FloatArray, x_at: FloatArray = x_at, Wm: FloatArray = Wm) -> float:
+                    return fun(x_at + Wm @ y)
+
+                def jac_y(y: FloatArray, x_at: FloatArray = x_at, Wm: FloatArray = Wm) -> FloatArray:
+                    out: FloatArray = Wm.T @ jac(x_at + Wm @ y)
+                    return out
 
                 res = minimize(
                     fun_y,
                     np.zeros(x.size),
-                    jac=True,
+                    jac=jac_y,
                     method="SLSQP",
                     constraints=problem.constraints(active, (x_at, Wm)),
                     options={"maxiter": settings.max_iter, "ftol": settings.ftol},

@@ -84,6 +84,10 @@ MAX_ITERATIONS = 200
 """SLSQP iterations at most."""
 MAX_STRETCHES = 8
 """With a jerk limit, :func:`shortest_on_path` stretches the sin² duration by 25 % this often at most."""
+SCREEN_BAND = 0.5
+"""A limit row enters the search's solve when its relative margin is below this (:func:`_search`)."""
+MAX_ROUNDS = 4
+"""Solves of :func:`_search`, at most, each with the rows the last one broke or neared added."""
 _EPS_POWER = 1e-3  # W: smoothing of |P| in the search's objective only
 _MARGIN = 1e-3  # the search keeps its limits this fraction below the checked ones
 _TCP_TOLERANCE = 1e-7  # relative excess of the TCP speed that still counts as held
@@ -528,7 +532,8 @@ def _search(
     maxiter: int = MAX_ITERATIONS,
     deadline: float | None = None,
 ) -> FloatArray:
-    """SLSQP from ``x0`` (past ``deadline``, a ``time.perf_counter()``, it stops at its iterate)."""
+    """SLSQP from ``x0`` (past ``deadline``, a ``time.perf_counter()``, it stops at its iterate), the
+    limit rows taken lazily (:data:`SCREEN_BAND`, at most :data:`MAX_ROUNDS` solves)."""
     problem = _problem(robot, at, timing, t, limits, margin)
     n = x0.size
     order = np.zeros((n + 1, n))  # x_0 >= lo, x_{i+1} - x_i >= 0, hi - x_{n-1} >= 0 (the fixed neighbours)
@@ -549,19 +554,42 @@ def _search(
             last[key] = problem.constraints(x)
         return last[key]
 
-    result = minimize(
-        lambda x: tuple(v / scale for v in problem.energy(x)),
-        x0,
-        jac=True,
-        method="SLSQP",
-        bounds=[(0.0, 1.0)] * n,
-        constraints=[
-            {"type": "ineq", "fun": lambda x: order @ x + shift, "jac": lambda x: order},
-            {"type": "ineq", "fun": lambda x: limits_at(x)[0], "jac": lambda x: limits_at(x)[1]},
-        ],
-        options={"maxiter": maxiter, "ftol": 1e-9},
-        callback=None if deadline is None else lambda _: _stop_past(deadline),
-    )
+    # the limit rows enter lazily: those within SCREEN_BAND of their limit at the start, then
+    # those the solve's result breaks or nears, re-solved from there (SLSQP's dense QP grows with
+    # the rows: a fine grid holds thousands, of which few bind)
+    x = np.asarray(x0, dtype=float)
+    rows = np.flatnonzero(limits_at(x)[0] < SCREEN_BAND)
+    for _ in range(MAX_ROUNDS):
+        chosen = rows
+        result = minimize(
+            lambda x: tuple(v / scale for v in problem.energy(x)),
+            x,
+            jac=True,
+            method="SLSQP",
+            bounds=[(0.0, 1.0)] * n,
+            constraints=[{"type": "ineq", "fun": lambda x: order @ x + shift, "jac": lambda x: order}]
+            + (
+                [
+                    {
+                        "type": "ineq",
+                        "fun": lambda x, r=chosen: limits_at(x)[0][r],
+                        "jac": lambda x, r=chosen: limits_at(x)[1][r],
+                    }
+                ]
+                if chosen.size
+                else []
+            ),
+            options={"maxiter": maxiter, "ftol": 1e-9},
+            callback=None if deadline is None else lambda _: _stop_past(deadline),
+        )
+        x = np.asarray(result.x, dtype=float)
+        g = limits_at(x)[0]
+        if g.min() >= -1e-9 or (deadline is not None and time.perf_counter() > deadline):
+            break
+        grown = np.union1d(rows, np.flatnonzero(g < SCREEN_BAND))
+        if grown.size == rows.size:  # what it breaks it already had: another solve would not help
+            break
+        rows = grown
     out: FloatArray = np.clip(np.asarray(result.x, dtype=float), 0.0, 1.0)
     return np.maximum.accumulate(out)
 
