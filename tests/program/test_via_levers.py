@@ -19,7 +19,7 @@ from joulepath.energy import measure_power
 from joulepath.program import CycleSettings, optimize_cycle, parse_module, resolve_module, via_levers
 from joulepath.program._rapid_write import HEADERS, restore_program
 from joulepath.program._task import as_sequence, read_written
-from joulepath.program._via_levers import _CALL, _plain, _reverted, _scaled, _units, _with_header
+from joulepath.program._via_levers import _CALL, _marked, _plain, _reverted, _scaled, _units, _with_header
 from joulepath.sim import FINE_DT, ControllerConfig, evaluate_cycle, plan_cycle
 
 EXT = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
@@ -84,22 +84,59 @@ def test_written_module_runs_within_the_taught_cycle_and_saves_as_executed(robot
     assert e <= via.via_energy_J * (1 + 1e-12)
 
 
-def test_only_the_added_via_point_procedures_change(robot, planned):
+def test_it_restores_to_the_program_and_every_change_is_marked(robot, planned):
     result, via = planned
     lv = via.levers
     assert lv is not None
     # the module reads back as the program it was written from: byte for byte
     assert restore_program(lv.written_text) == PROGRAM
+    lines = lv.written_text.splitlines()
     spec = resolve_module(parse_module(_plain(lv.written_text), path="w.mod"), robot)
-    procs = {p.name: (p.line, p.end_line) for p in spec.module.procedures}
-    added = [rng for name, rng in procs.items() if name.lower().startswith("jp_opt_")]
+    shift = len(lines) - len(_plain(lv.written_text).splitlines())
+    added = [
+        (p.line + shift, p.end_line + shift) for p in spec.module.procedures if p.name.startswith("jp_opt_")
+    ]
     assert added
-    shift = len(lv.written_text.splitlines()) - len(_plain(lv.written_text).splitlines())
     for m in lv.moves:
-        if m.changed:
-            line = m.line - shift  # MoveLever lines are the written file's (its header included)
-            assert any(a <= line <= b for a, b in added), m
+        if m.changed:  # in an added procedure, or a statement of the program under its `was:` lines
+            assert any(a <= m.line <= b for a, b in added) or lines[m.line - 2].strip().startswith(
+                "! joulepath: was:"
+            ), m
     assert lv.n_changed >= 1
+
+
+def test_marked_edits_restore_and_run_as_edited():
+    before = (
+        "MODULE M\n"
+        "    PROC main()\n"
+        "        MoveJ p, v1000, z50, tool0; ! to the pick\n"
+        "        WaitTime 0.2;\n"
+        "        jp_opt_main_3;\n"
+        "    ENDPROC\n"
+        "    PROC jp_opt_main_3()\n"
+        "        MoveAbsJ j{1}, v7000 \\T:=0.25, z200, tool0;\n"
+        "    ENDPROC\n"
+        "ENDMODULE\n"
+    )
+    after = (
+        before.replace("        MoveJ p, v1000, z50,", "        AccSet 50, 100;\n        MoveJ p, v800, z20,")
+        .replace("        WaitTime 0.2;\n", "        AccSet 100, 100;\n        WaitTime 0.2;\n")
+        .replace("\\T:=0.25", "\\T:=0.3")
+    )
+    marked, where = _marked(before, after, added=set(range(7, 10)))
+    out = marked.splitlines()
+    assert out[2:5] == [  # the statement and the AccSet lines around it on one line, the comment at its end
+        "        ! joulepath: was: MoveJ p, v1000, z50, tool0; ! to the pick",
+        "        AccSet 50, 100; MoveJ p, v800, z20, tool0; AccSet 100, 100; ! to the pick",
+        "        WaitTime 0.2;",
+    ]
+    assert (where[3], where[4], where[5]) == (4, 5, 6)
+    assert "\\T:=0.3" in out[where[8] - 1]  # the added procedure as the levers wrote it
+    assert restore_program(_with_header(marked, [HEADERS[1]])).splitlines()[:5] == before.splitlines()[:5]
+    from joulepath.rapid import parse_module as parse_rapid
+
+    calls = [c.name for c in parse_rapid(marked, path="m.mod").routines[0].body]
+    assert calls == ["AccSet", "MoveJ", "AccSet", "WaitTime", "jp_opt_main_3"]
 
 
 def test_a_corridor_it_leaves_refuses_it(robot, planned):

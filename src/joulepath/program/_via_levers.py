@@ -24,6 +24,7 @@ program run by the same emulation, on the run's energy measure.
 
 from __future__ import annotations
 
+import difflib
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -149,6 +150,82 @@ def _reverted(text: str, call: int) -> str:
     return "".join([*lines[:first], *taught, *lines[call + 1 :]])
 
 
+_BLOCK_WORDS = re.compile(
+    r"^\s*(PROC|ENDPROC|FUNC|ENDFUNC|TRAP|ENDTRAP|MODULE|ENDMODULE|WHILE|ENDWHILE|FOR|ENDFOR|IF|ELSEIF|ELSE|"
+    r"ENDIF|TEST|CASE|DEFAULT|ENDTEST|ERROR|UNDO|BACKWARD)\b",
+    re.IGNORECASE,
+)
+
+
+def _is_statement(line: str) -> bool:
+    s = line.strip()
+    return bool(s) and not s.startswith("!") and not _BLOCK_WORDS.match(s)
+
+
+def _code_and_comment(line: str) -> tuple[str, str]:
+    """A line's code and its comment (from a ``!`` outside a string)."""
+    quoted = False
+    for i, ch in enumerate(line):
+        if ch == '"':
+            quoted = not quoted
+        elif ch == "!" and not quoted:
+            return line[:i].strip(), line[i:].strip()
+    return line.strip(), ""
+
+
+def _marked(before: str, after: str, added: set[int]) -> tuple[str, dict[int, int]]:
+    """``after`` (``before`` with levers written) with each edit of the program's own statements made
+    restorable: the lines that stood there as ``! joulepath: was:`` comments, and what stands now on
+    the one line under them (what :func:`joulepath.program._rapid_write.restore_program` drops);
+    edits inside the added procedures (``added``: their lines in ``before``) as they are. Also where
+    each line of ``before`` stands in the result (1-based)."""
+    from joulepath.program._rapid_write import WAS
+
+    a = before.splitlines(keepends=True)
+    b = after.splitlines(keepends=True)
+    now: list[list[str]] = [[ln] for ln in a]  # what stands for each line of ``before``
+    touched = [False] * len(a)
+    for tag, i1, i2, j1, j2 in difflib.SequenceMatcher(a=a, b=b, autojunk=False).get_opcodes():
+        if tag == "equal":
+            continue
+        if tag in ("replace", "delete"):
+            for i in range(i1, i2):
+                now[i], touched[i] = [], True
+            now[i1] = list(b[j1:j2])
+            continue
+        at = i1 if i1 < len(a) and _is_statement(a[i1]) else i1 - 1  # an insertion: to its statement
+        now[at] = [*b[j1:j2], *now[at]] if at == i1 else [*now[at], *b[j1:j2]]
+        touched[at] = True
+    out: list[str] = []
+    where: dict[int, int] = {}
+    i = 0
+    while i < len(a):
+        if not touched[i] or (i + 1) in added:
+            for ln in now[i]:
+                out.append(ln)
+            where[i + 1] = len(out)
+            i += 1
+            continue
+        j = i
+        while j + 1 < len(a) and touched[j + 1] and (j + 2) not in added:
+            j += 1
+        first = a[i]
+        indent = first[: len(first) - len(first.lstrip())]
+        end = "\r\n" if first.endswith("\r\n") else "\n"
+        for raw in a[i : j + 1]:
+            body = raw.rstrip("\r\n")
+            body = body[len(indent) :] if body.startswith(indent) else body.lstrip()
+            out.append(indent + WAS + body + end)
+        parts = [_code_and_comment(ln) for k in range(i, j + 1) for ln in now[k]]
+        code = " ".join(c for c, _ in parts if c)
+        comment = " ".join(c for _, c in parts if c)
+        out.append(indent + " ".join(x for x in (code, comment) if x) + end)
+        for k in range(i, j + 1):
+            where[k + 1] = len(out)
+        i = j + 1
+    return "".join(out), where
+
+
 def _with_header(text: str, header: list[str]) -> str:
     lines = text.splitlines(keepends=True)
     at = next(k for k, ln in enumerate(lines) if re.match(r"\s*MODULE\b", ln, re.IGNORECASE))
@@ -205,7 +282,7 @@ def via_levers(
         for less energy, reads back as searched, and keeps the corridor and the cell.
     """
     from joulepath.program._output import written_rapid
-    from joulepath.program._rapid_write import HEADERS
+    from joulepath.program._rapid_write import HEADERS, restore_program
     from joulepath.program._task import as_sequence, read_written
 
     config = config or ControllerConfig()
@@ -256,79 +333,96 @@ def via_levers(
             t_via,
             e_via,
         )
-    try:
-        found = levers_module(
-            via_spec,
-            robot,
-            energy=energy,
-            text=text,
-            config=config,
-            max_seconds=max_seconds,
-            max_evaluations=MAX_PLANS,
-            baseline=(t_taught, e_taught, lab_taught),
-            only_lines=added,
-        )
-    except InvalidInput as err:
-        return ViaLevers(None, f"the levers of the via points: {err}", t_via, e_via)
-    if not (found.cycle_s <= t_taught + _TOL_S and found.energy_J < e_taught):
-        return ViaLevers(
-            None,
-            f"the via-point module runs {found.cycle_s:.3f} s for {found.energy_J:.2f} J against the taught "
-            f"{t_taught:.3f} s and {e_taught:.2f} J",
-            t_via,
-            e_via,
-        )
-    saved = 100.0 * (1.0 - found.energy_J / e_taught)
-    header = [
-        f"{HEADERS[0]} {_version()} for energy: the plan's via points with the controller's levers (AccSet, "
-        f"\\T, zones), as the controller emulation runs this module: {found.cycle_s:.3f} s per cycle "
-        f"(taught {t_taught:.3f} s), {found.energy_J:.2f} J against the taught {e_taught:.2f} J on "
-        f"{energy} energy ({saved:.1f} % saved). See cycle.json.",
-        f"{HEADERS[1]} each optimized move calls jp_opt_<proc>_<n> (at the module's end). Re-teaching a "
-        "target: optimize the re-taught module again.",
-    ]
-    written = _with_header(found.written_text, header)
-    # read again by the other reader (the interpreter) and run again: the searched motion, or nothing
-    again = read_written(written, f"{spec.module.path} (optimized)", robot)
-    plan_a, t_again, e_again = _Evaluator(as_sequence(again), [], energy, config)(())  # type: ignore[arg-type]
-    pos, traj = _tcp_path(plan_a)
-    if abs(t_again - found.cycle_s) > 1e-3 or abs(e_again - found.energy_J) > _TOL_REL * max(1.0, e_taught):
-        return ViaLevers(
-            None,
-            f"the written module, read again, runs {t_again:.3f} s and {e_again:.3f} J against the searched "
-            f"{found.cycle_s:.3f} s and {found.energy_J:.3f} J; not written",
-            t_via,
-            e_via,
-        )
     from scipy.spatial import cKDTree
 
+    from joulepath.program._cell import clearance
+
+    original = list(spec.module.source)
     taught_pos, _ = _tcp_path(plan_t)
-    dev = 1000.0 * float(cKDTree(taught_pos).query(pos)[0].max())
-    clear = None
-    if cell is not None:
-        from joulepath.program._cell import clearance
-
-        first = plan_a.moves[0].step
-        assert first.robot is not None and first.tcp is not None
-        clear = 1000.0 * (clearance(cell, first.robot, traj.q, first.tcp).distance - cell.margin)
-
-    def with_figures(levers: LeverResult | None, note: str) -> ViaLevers:
-        return ViaLevers(levers, note, t_via, e_via, dev, clear, reverted)
-
-    if corridor_mm is not None and dev > corridor_mm:
-        return with_figures(
-            None,
-            f"the via-point module's TCP leaves the taught path by {dev:.1f} mm (the corridor is "
-            f"{corridor_mm:g} mm)",
+    dev: float | None = None
+    clear: float | None = None
+    header: list[str] = []
+    found: LeverResult | None = None
+    why = "no lever search ran"
+    for only in (None, added):  # every move statement; where that cannot be written back, the via points'
+        try:
+            lv = levers_module(
+                via_spec,
+                robot,
+                energy=energy,
+                text=text,
+                config=config,
+                max_seconds=max_seconds,
+                max_evaluations=MAX_PLANS,
+                baseline=(t_taught, e_taught, lab_taught),
+                only_lines=only,
+            )
+        except InvalidInput as err:
+            why = f"the levers of the via points: {err}"
+            continue
+        if not (lv.cycle_s <= t_taught + _TOL_S and lv.energy_J < e_taught):
+            why = (
+                f"the via-point module runs {lv.cycle_s:.3f} s for {lv.energy_J:.2f} J against the taught "
+                f"{t_taught:.3f} s and {e_taught:.2f} J"
+            )
+            continue
+        body, where = _marked(text, lv.written_text, added) if only is None else (lv.written_text, None)
+        saved = 100.0 * (1.0 - lv.energy_J / e_taught)
+        header = [
+            f"{HEADERS[0]} {_version()} for energy: the plan's via points and the controller's levers "
+            f"(AccSet, speed data or \\T, zones), as the controller emulation runs this module: "
+            f"{lv.cycle_s:.3f} s per cycle (taught {t_taught:.3f} s), {lv.energy_J:.2f} J against the taught "
+            f"{e_taught:.2f} J on {energy} energy ({saved:.1f} % saved). See cycle.json.",
+            f"{HEADERS[1]} each optimized move calls jp_opt_<proc>_<n> (at the module's end), each "
+            "changed statement stands under its 'was:' lines. Re-teaching a target: optimize the re-taught "
+            "module again.",
+        ]
+        written = _with_header(body, header)
+        restored = restore_program(written)
+        if restored is None or restored.splitlines() != original:
+            why = "the written module does not restore to the program it was written from"
+            continue
+        # read again by the other reader (the interpreter) and run again: the searched motion, or nothing
+        again = read_written(written, f"{spec.module.path} (optimized)", robot)
+        plan_a, t_again, e_again = _Evaluator(as_sequence(again), [], energy, config)(())  # type: ignore[arg-type]
+        if abs(t_again - lv.cycle_s) > 1e-3 or abs(e_again - lv.energy_J) > _TOL_REL * max(1.0, e_taught):
+            why = (
+                f"the written module, read again, runs {t_again:.3f} s and {e_again:.3f} J against the "
+                f"searched {lv.cycle_s:.3f} s and {lv.energy_J:.3f} J; not written"
+            )
+            continue
+        pos, traj = _tcp_path(plan_a)
+        dev = 1000.0 * float(cKDTree(taught_pos).query(pos)[0].max())
+        clear = None
+        if cell is not None:
+            first = plan_a.moves[0].step
+            assert first.robot is not None and first.tcp is not None
+            clear = 1000.0 * (clearance(cell, first.robot, traj.q, first.tcp).distance - cell.margin)
+        if corridor_mm is not None and dev > corridor_mm:
+            why = f"its TCP leaves the taught path by {dev:.1f} mm (the corridor is {corridor_mm:g} mm)"
+            continue
+        if clear is not None and clear < 0.0:
+            why = f"it comes {-clear:.1f} mm inside the cell's margin"
+            continue
+        shift = len(header)
+        moves = tuple(
+            replace(m, line=(m.line if where is None else where.get(m.line, m.line)) + shift)
+            for m in lv.moves
         )
-    if clear is not None and clear < 0.0:
-        return with_figures(None, f"the via-point module comes {-clear:.1f} mm inside the cell's margin")
-    shift = len(header)
-    moves = tuple(replace(m, line=m.line + shift) for m in found.moves)
-    return with_figures(
-        replace(found, written_text=written, moves=moves, base="via points"),
+        found = replace(lv, written_text=written, moves=moves, base="via points")
+        break
+    if found is None:
+        return ViaLevers(None, why, t_via, e_via, dev, clear, reverted)
+    saved = 100.0 * (1.0 - found.energy_J / e_taught)
+    return ViaLevers(
+        found,
         f"via points with levers: {saved:.1f} % saved as executed"
         + (f" ({reverted} optimized move(s) kept as taught to keep the cycle time)" if reverted else ""),
+        t_via,
+        e_via,
+        dev,
+        clear,
+        reverted,
     )
 
 
