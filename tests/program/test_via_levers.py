@@ -206,3 +206,29 @@ def test_calls_with_arguments_go_back_to_the_statement_they_replaced():
         "        MoveJ Offs(pTo, 0, 0, 100), v1000, z20, tool0;",
         "        jp_opt_Transfer_5 pFrom, pTo, jpRun;",
     ]
+
+
+def test_a_bundled_program_keeps_its_structure_and_saves_as_executed(robot):
+    from pathlib import Path
+
+    from joulepath.program import read_cycle_program
+
+    path = Path(__file__).parents[2] / "examples" / "approach_depart.mod"
+    spec, _ = read_cycle_program(path, robot)
+    settings = CycleSettings(table_points=2, pass_search=0)
+    settings = replace(settings, gradient=replace(settings.gradient, knot_spacing=0.1))
+    result, _ = optimize_cycle(spec, settings)
+    via = via_levers(result, robot, energy="thesis", max_seconds=10)
+    assert via.levers is not None, via.note
+    text = via.levers.written_text
+    # read again by the interpreter, run by the emulation: the figures, recomputed from its own motion
+    t, e = _executed(text, robot)
+    t0, e0 = _executed(path.read_text(), robot)
+    assert (t, e) == pytest.approx((via.levers.cycle_s, via.levers.energy_J), rel=1e-9)
+    assert t <= t0 + 1e-6 and e < e0
+    # the program as written: its procedures, its loop, its named targets, and it restores to it
+    original = path.read_text()
+    for word in re.findall(r"PROC\s+(\w+)", original) + re.findall(r"robtarget\s+(\w+)", original):
+        assert word in text
+    assert "WHILE TRUE DO" in text
+    assert restore_program(text) == original
