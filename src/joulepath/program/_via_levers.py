@@ -9,11 +9,13 @@ module rarely keeps the plan's path to the 5 mm of the written-program check; it
 own, whose cycle time and energy the controller emulation measures.
 
 Here that motion is the plan, and it is improved where it stands: the module, read as written, is
-run by the controller emulation, and the levers of its via-point statements (``AccSet``, ``\\T``,
+run by the controller emulation, and the controller's levers (``AccSet``, speed data or ``\\T``,
 zones; :func:`joulepath.program.levers_module`) are searched on it for the least energy within the
 taught program's cycle time (the module often runs shorter than the taught cycle: that time is
-spent too). The program's own statements stay as written, so that the module still reads back as
-the program it was written from (:func:`joulepath.program._rapid_write.restore_program`).
+spent too), twice: on every move statement, and on the via points alone (each search within
+``max_seconds``); the better as executed is kept. A statement of the program the levers change is
+written on one line under ``! joulepath: was:`` lines of what stood there, so that the module still
+reads back as the program it was written from (:func:`joulepath.program._rapid_write.restore_program`).
 
 Before it is offered, the written text (with its header) is read again by the RAPID interpreter and
 run again by the emulation, and must give the searched cycle time and energy; its TCP path must stay
@@ -344,7 +346,8 @@ def via_levers(
     header: list[str] = []
     found: LeverResult | None = None
     why = "no lever search ran"
-    for only in (None, added):  # every move statement; where that cannot be written back, the via points'
+    kept: tuple[float | None, float | None] = (None, None)
+    for only in (None, added):  # every move statement, and the via points' alone: the better as executed
         try:
             lv = levers_module(
                 via_spec,
@@ -409,8 +412,11 @@ def via_levers(
             replace(m, line=(m.line if where is None else where.get(m.line, m.line)) + shift)
             for m in lv.moves
         )
-        found = replace(lv, written_text=written, moves=moves, base="via points")
-        break
+        if found is None or lv.energy_J < found.energy_J:
+            found = replace(lv, written_text=written, moves=moves, base="via points")
+            kept = (dev, clear)
+    if found is not None:
+        dev, clear = kept
     if found is None:
         return ViaLevers(None, why, t_via, e_via, dev, clear, reverted)
     saved = 100.0 * (1.0 - found.energy_J / e_taught)
