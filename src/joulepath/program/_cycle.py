@@ -488,13 +488,18 @@ class CycleOptimizer:
         *,
         progress: Callable[[str], None] | None = None,
         deadline: float | None = None,
+        plan: PlannedCycle | None = None,
     ) -> None:
         self.spec = spec
         self.settings = settings
         self.progress = progress or (lambda msg: None)
         self.deadline = deadline  # time.perf_counter() after which no new move is solved
         self.timed_out = False
-        self.plan: PlannedCycle = plan_cycle(spec, settings.controller, progress=self.progress)
+        # ``plan``: the taught cycle as planned for ``spec`` under ``settings.controller`` (one
+        # already planned, e.g. by the plan for samples before the plan for via points)
+        self.plan: PlannedCycle = (
+            plan_cycle(spec, settings.controller, progress=self.progress) if plan is None else plan
+        )
         self.gradient = replace(settings.gradient, energy_every=settings.energy_every)
         check_motion_time(self.plan, spec.source, optimized=True)
         if spec.module is None:
@@ -1929,10 +1934,22 @@ def optimize_cycle(
     Never refused at the taught cycle time: each unit's taught motion is a candidate, so
     in the worst case the taught cycle itself is returned, 0 % saved.
     """
+    return _optimize_cycle(spec, settings, progress=progress)
+
+
+def _optimize_cycle(
+    spec: CycleSpec,
+    settings: CycleSettings,
+    *,
+    progress: Callable[[str], None] | None = None,
+    plan: PlannedCycle | None = None,
+) -> tuple[CycleResult, CycleOptimizer]:
+    """:func:`optimize_cycle`, on ``plan`` when given (the taught cycle planned under
+    ``settings.controller``: the plan for via points takes the one for samples had)."""
     check_moves_arm(spec)
     t_start = time.perf_counter()
     deadline = None if settings.max_time_s is None else t_start + settings.max_time_s
-    opt = CycleOptimizer(spec, settings, progress=progress, deadline=deadline)
+    opt = CycleOptimizer(spec, settings, progress=progress, deadline=deadline, plan=plan)
     plan = opt.plan
     target = plan.cycle_time if settings.cycle_time is None else settings.cycle_time
     check_work(  # the time the moves may take at this cycle time, before any of them is solved
@@ -1978,7 +1995,7 @@ def optimize_cycle(
         )
         via = replace(settings, follow="via-points", rapid_plan=False, max_time_s=left)
         try:
-            rapid, _ = optimize_cycle(spec, via, progress=progress)
+            rapid, _ = _optimize_cycle(spec, via, progress=progress, plan=plan)
         except LimitViolation:  # no plan for via points at this cycle time: EGM only
             rapid = None
         if rapid is not None and rapid.paths:
