@@ -14,7 +14,8 @@ and 105 % of its span, the best combination within the sum (``SHARED=0`` skips i
 
 Run: ``.venv/bin/python benchmarks/cycle_examples.py [PROGRAM ...]`` (one BLAS thread; about 25
 minutes on a shared 2-core machine, 16 of them the optimum's 13 segments of palletizing;
-``OPTIMUM=0``: the plans only, about 2 minutes; ``GRADIENT=hull``: the plans with the single move's
+``OPTIMUM=0``: the plans only, about 2 minutes; ``FAST=1``: the preset for interactive use;
+``GRADIENT=hull``: the plans with the single move's
 default search in place of the cycle's, ``joulepath.optimize._gradient.GRID_SEARCH``).
 Writes the table to stdout; BENCHMARKS.md holds a copy with the machine.
 
@@ -154,7 +155,12 @@ def shared_optimum(opt) -> tuple[float, float, str, float]:
 
 def plan_settings() -> CycleSettings:
     """The CLI's defaults; ``GRADIENT=hull``: with the single move's default search (hull rows,
-    preconditioned SLSQP; issue 36) in place of the cycle's (``GRID_SEARCH``)."""
+    preconditioned SLSQP; issue 36) in place of the cycle's (``GRID_SEARCH``); ``FAST=1``: the
+    preset for interactive use (``joulepath.program._cycle.FAST_CYCLE``)."""
+    if os.environ.get("FAST", "") == "1":
+        from joulepath.program._cycle import FAST_CYCLE
+
+        return CycleSettings(**FAST_CYCLE)
     if os.environ.get("GRADIENT", "") == "hull":
         from joulepath.optimize import GradientSettings
 
