@@ -14,16 +14,26 @@ and 105 % of its span, the best combination within the sum (``SHARED=0`` skips i
 
 Run: ``.venv/bin/python benchmarks/cycle_examples.py [PROGRAM ...]`` (one BLAS thread; about 25
 minutes on a shared 2-core machine, 16 of them the optimum's 13 segments of palletizing;
-``OPTIMUM=0``: the plans only, about 2 minutes; ``GRADIENT=hull``: the plans with the single move's
+``OPTIMUM=0``: the plans only, about 2 minutes; ``FAST=1``: the preset for interactive use;
+``GRADIENT=hull``: the plans with the single move's
 default search in place of the cycle's, ``joulepath.optimize._gradient.GRID_SEARCH``).
 Writes the table to stdout; BENCHMARKS.md holds a copy with the machine.
+
+``--before SRC``: the code before a change beside it, in the same run (issue 36): ``SRC`` a source
+folder of it (e.g. ``git archive <commit> src | tar -x -C /tmp/before``, then ``/tmp/before/src``).
+Each program's plan is also made by that code, in a child process (``PYTHONPATH=SRC``) started at
+the same time as this process's own plan (the same load on the machine), and its CPU time and
+saving join a second table beside this code's: CPU before and after, their ratio, both savings.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import platform
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -145,7 +155,12 @@ def shared_optimum(opt) -> tuple[float, float, str, float]:
 
 def plan_settings() -> CycleSettings:
     """The CLI's defaults; ``GRADIENT=hull``: with the single move's default search (hull rows,
-    preconditioned SLSQP; issue 36) in place of the cycle's (``GRID_SEARCH``)."""
+    preconditioned SLSQP; issue 36) in place of the cycle's (``GRID_SEARCH``); ``FAST=1``: the
+    preset for interactive use (``joulepath.program._cycle.FAST_CYCLE``)."""
+    if os.environ.get("FAST", "") == "1":
+        from joulepath.program._cycle import FAST_CYCLE
+
+        return CycleSettings(**FAST_CYCLE)
     if os.environ.get("GRADIENT", "") == "hull":
         from joulepath.optimize import GradientSettings
 
@@ -153,17 +168,55 @@ def plan_settings() -> CycleSettings:
     return CycleSettings()
 
 
+def plan_only(name: str) -> None:
+    """The plan of one program, as the table times it; prints {cpu_s, wall_s, saved_pct} (JSON).
+    The child process of ``--before``: it runs on whatever ``joulepath`` its PYTHONPATH gives."""
+    spec, _ = read_cycle_program(EXAMPLES / f"{name}.mod", load_robot("irb120"))
+    t0, w0 = time.process_time(), time.perf_counter()
+    result, _ = optimize_cycle(spec, plan_settings())
+    cpu, wall = time.process_time() - t0, time.perf_counter() - w0
+    print(json.dumps({"cpu_s": cpu, "wall_s": wall, "saved_pct": result.saved_pct}))
+
+
+def start_before(name: str, src: Path) -> subprocess.Popen[str]:
+    """The plan of ``name`` by the code in ``src``, in a child process (one BLAS thread)."""
+    env = {**os.environ, "PYTHONPATH": str(src), "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    return subprocess.Popen(
+        [sys.executable, __file__, "--plan-only", name], env=env, stdout=subprocess.PIPE, text=True
+    )
+
+
 def main(argv: list[str] | None = None) -> None:
-    names = tuple(argv) if argv else PROGRAMS
+    ap = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
+    ap.add_argument("programs", nargs="*", help="programs of examples/ (default: all six)")
+    ap.add_argument("--before", type=Path, help="source folder of the code before (see the docstring)")
+    ap.add_argument("--plan-only", metavar="PROGRAM", help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.plan_only:
+        plan_only(args.plan_only)
+        return
+    names = tuple(args.programs) or PROGRAMS
     robot = load_robot("irb120")
     rows = []
+    before: dict[str, dict[str, float]] = {}
     for name in names:
         spec, rapid = read_cycle_program(EXAMPLES / f"{name}.mod", robot)
+        child = None if args.before is None else start_before(name, args.before.resolve())
         t0 = time.process_time()
         w0 = time.perf_counter()
         result, opt = optimize_cycle(spec, plan_settings())
         cpu = time.process_time() - t0
         wall = time.perf_counter() - w0
+        if child is not None:
+            out, _ = child.communicate()
+            if child.returncode:
+                raise SystemExit(f"{name}: the plan of the code before failed ({child.returncode})")
+            before[name] = json.loads(out.strip().splitlines()[-1])
+            print(
+                f"{name}: before {before[name]['saved_pct']:.2f} % in {before[name]['cpu_s']:.1f} s CPU, "
+                f"after {result.saved_pct:.2f} % in {cpu:.1f} s CPU",
+                flush=True,
+            )
         with tempfile.TemporaryDirectory() as tmp:
             files = write_cycle_run(Path(tmp), result, pareto=None, write_rapid=rapid, egm="fallback")
             data = json.loads(files["cycle.json"].read_text())
@@ -218,9 +271,19 @@ def main(argv: list[str] | None = None) -> None:
     print()
     for name, *_, notes, _, _, _ in rows:
         print(f"- {name}: " + "; ".join(notes))
+    if before:
+        print()
+        print(f"The code before: `{args.before}`, each plan in a child process beside this code's.")
+        print()
+        print("| program | CPU before (s) | CPU after (s) | after / before | saved before | saved after |")
+        print("|---|---|---|---|---|---|")
+        for name, _, r, *_, cpu, _ in rows:
+            b = before[name]
+            print(
+                f"| {name} | {b['cpu_s']:.1f} | {cpu:.1f} | {cpu / b['cpu_s']:.2f}x | "
+                f"{b['saved_pct']:.2f} % | {r.saved_pct:.2f} % |"
+            )
 
 
 if __name__ == "__main__":
-    import sys
-
     main(sys.argv[1:])

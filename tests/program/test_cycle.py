@@ -21,7 +21,7 @@ from joulepath.program import (
     read_module,
     resolve_module,
 )
-from joulepath.program._cycle import CycleOptimizer
+from joulepath.program._cycle import FAST_CYCLE, CycleOptimizer
 from joulepath.sim import JERK_TIME, ControllerConfig
 from joulepath.sim._timing import FINE_DT, evaluate_cycle, standalone
 
@@ -470,3 +470,13 @@ def test_via_layout_of_a_gentle_move_is_run_as_planned(robot):
     assert 1000 * max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max()) < 5.0
     plant = make_plant("lab", robot)
     assert _energy(robot, plant, emu)[0] == pytest.approx(_energy(robot, plant, plan)[0], rel=0.05)
+
+
+def test_fast_preset_plans_within_limits(spec):
+    """The preset for interactive use (FAST_CYCLE): fewer solves, the same checks on its plan."""
+    settings = CycleSettings(**FAST_CYCLE, gradient=FAST, use_waits=True, cycle_time=REACHABLE)
+    assert settings.table_points == 3 and settings.pass_search == 2 and not settings.retime_segments
+    result, _ = optimize_cycle(spec, settings)
+    assert result.limits_ok
+    assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
+    assert result.optimized_energy_J <= result.default_energy_J + 1e-9

@@ -58,30 +58,40 @@ class Layout:
     g: tuple[float, float]  # joint 3 to the wrist centre in the arm plane (along, across)
 
 
+_Z_AXES = np.tile([0.0, 0.0, 1.0], (6, 1))
+_LAYOUT = np.concatenate([
+    np.eye(4).ravel(), _PLANE.ravel(), np.zeros(2), np.eye(3).ravel(), np.zeros(2),
+    _RX_M90.ravel(), np.zeros(2), _RX_P90.ravel(), np.zeros(2), (_RX_M90 @ _RZ_PI).ravel(), np.zeros(3),
+])  # fmt: skip
+"""The IRB 120 layout's frames as :func:`check_layout` compares them (rotations, and the parts of
+the translations that are zero)."""
+_LAYOUT_TOL = np.concatenate([
+    np.full(16, 1e-9), np.full(9, 1e-9), np.full(2, 1e-12), np.full(9, 1e-9), np.full(2, 1e-12),
+    np.full(9, 1e-9), np.full(2, 1e-12), np.full(9, 1e-9), np.full(2, 1e-12),
+    np.full(9, 1e-9), np.full(3, 1e-12),
+]) + 1e-5 * np.abs(_LAYOUT)  # fmt: skip
+"""Tolerances of :data:`_LAYOUT`: absolute 1e-9 (rotations) and 1e-12 (translations), plus 1e-5 of
+the expected value (``np.allclose``'s)."""
+
+
 def check_layout(chain: Chain) -> Layout:
     """The chain's lengths when it has the IRB 120 layout; ``InvalidInput`` otherwise."""
     how = (
         "closed-form inverse kinematics (robtargets, MoveL) supports the IRB 120 layout only "
         "(6 revolute joints, parallel joints 2 and 3, spherical wrist); use jointtargets (MoveAbsJ)"
     )
-    if chain.n_joints != 6 or not np.allclose(chain.axes, [[0.0, 0.0, 1.0]] * 6):
+    if chain.n_joints != 6 or not np.all(np.abs(np.asarray(chain.axes) - _Z_AXES) <= 1e-8 + 1e-5 * _Z_AXES):
         raise InvalidInput(f"{how}: the chain has {chain.n_joints} joints or axes other than z")
     p = chain.placements
     rot = [x[:3, :3] for x in p]
     tr = [x[:3, 3] for x in p]
-    expected = (
-        np.allclose(p[0], np.eye(4), atol=1e-9)
-        and np.allclose(rot[1], _PLANE, atol=1e-9)
-        and np.allclose(tr[1][:2], 0.0, atol=1e-12)
-        and np.allclose(rot[2], np.eye(3), atol=1e-9)
-        and np.allclose(tr[2][1:], 0.0, atol=1e-12)
-        and np.allclose(rot[3], _RX_M90, atol=1e-9)
-        and np.allclose(tr[3][1:], 0.0, atol=1e-12)
-        and np.allclose(rot[4], _RX_P90, atol=1e-9)
-        and np.allclose(tr[4][:2], 0.0, atol=1e-12)
-        and np.allclose(rot[5], _RX_M90 @ _RZ_PI, atol=1e-9)
-        and np.allclose(tr[5], 0.0, atol=1e-12)
-    )
+    # one comparison of every frame against the layout (np.allclose per part costs more than the
+    # closed form itself, and the check runs on every pose solved)
+    got = np.concatenate([
+        p[0].ravel(), rot[1].ravel(), tr[1][:2], rot[2].ravel(), tr[2][1:], rot[3].ravel(), tr[3][1:],
+        rot[4].ravel(), tr[4][:2], rot[5].ravel(), tr[5],
+    ])  # fmt: skip
+    expected = bool(np.all(np.abs(got - _LAYOUT) <= _LAYOUT_TOL))
     if not expected:
         raise InvalidInput(f"{how}: this chain's joint frames differ")
     return Layout(d1=float(tr[1][2]), a2=float(tr[2][0]), g=(float(tr[3][0]), float(tr[4][2])))

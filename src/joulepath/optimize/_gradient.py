@@ -963,6 +963,7 @@ def solve_move(
     base: Trajectory | None = None,
     energy_measure: str = DEFAULT_MEASURE,
     deadline: float | None = None,
+    initial: FloatArray | None = None,
 ) -> tuple[GradientResult, SplineProblem]:
     """Coarse-to-fine gradient search of one move; the result and the problem it lives in.
 
@@ -973,7 +974,9 @@ def solve_move(
     minimum-jerk move; its start and end states (q, qd, qdd) are kept.
     ``energy_measure``: the energy minimized (:data:`joulepath.energy.MEASURES`), its data
     from :attr:`Robot.drivetrain`. ``deadline`` (``time.perf_counter()``): past it the search
-    stops where it is (:func:`optimize_spline`).
+    stops where it is (:func:`optimize_spline`). ``initial``: the start (coefficients on the fine
+    knots, flat) in place of the smoothest path, for a search on one level of knots only
+    (``coarse_factor`` 1 or a move too short for two levels); refused otherwise.
     """
 
     def make(spacing: float) -> SplineProblem:
@@ -1003,7 +1006,9 @@ def solve_move(
     fine = make(spacing)
     coarse_spacing = spacing * settings.coarse_factor
     if settings.coarse_factor <= 1 or round(duration / coarse_spacing) < 2:
-        return optimize_spline(fine, settings, rng=rng, deadline=deadline), fine
+        return optimize_spline(fine, settings, rng=rng, initial=initial, deadline=deadline), fine
+    if initial is not None:
+        raise InvalidInput("an initial path needs a search on one level of knots (coarse_factor 1)")
     coarse = make(coarse_spacing)
     # the continuation runs coarse to fine: the wide knots take the stages before the last
     # `refine_stages`, the fine knots those (measured against every stage on the wide knots

@@ -414,15 +414,6 @@ class _Search:
             "dq1": dcut[0], "dq2": dcut[1], "dm": dcut[2], "dc": dcut[3], "dg": dcut[4], "dp1": der[:, 5 * n],
         }  # fmt: skip
 
-    def _chain(self, ds: FloatArray, dsd: FloatArray, dsdd: FloatArray) -> FloatArray:
-        """Jacobian (rows, n_free) of per-point quantities from their partials (n_t, k) in s, ṡ, s̈."""
-        out: FloatArray = (
-            np.einsum("tk,tf->tkf", ds, self.b0)
-            + np.einsum("tk,tf->tkf", dsd, self.b1)
-            + np.einsum("tk,tf->tkf", dsdd, self.b2)
-        )
-        return out
-
     def energy(self, x: FloatArray) -> tuple[float, FloatArray]:
         p = self._parts(x)
         sd, sdd = p["sd"][:, None], p["sdd"][:, None]
@@ -443,30 +434,33 @@ class _Search:
         grad = self.dt * (e_s @ self.b0 + e_sd @ self.b1 + e_sdd @ self.b2)
         return float(self.dt * power.value.sum()), grad
 
-    def constraints(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """``g(x) >= 0`` (relative margins to each limit) and its Jacobian."""
+    def _limit_blocks(self, x: FloatArray) -> list[_Block]:
+        """The limit rows by block: (values, ∂/∂s, ∂/∂ṡ, ∂/∂s̈, lag), each (n_rows_t, k); a row's
+        gradient in ``x`` is its partials times the basis rows at its point (``lag`` 1: a jerk row,
+        the difference of that at its point and at the point before, the partials of both stacked
+        (n_t, k) as the acceleration's, the values (n_t - 1, k))."""
         p = self._parts(x)
         sd, sdd = p["sd"][:, None], p["sdd"][:, None]
         lim = 1.0 - self.margin
-        rows: list[FloatArray] = []
-        jacs: list[FloatArray] = []
+        out: list[_Block] = []
         # joint speed: |q'| ṡ <= vmax (ṡ >= 0 by the monotone control points)
         a1 = np.abs(p["q1"]) / self.vmax
-        rows.append(lim - a1 * sd)
-        jacs.append(-self._chain(np.sign(p["q1"]) * p["dq1"] / self.vmax * sd, a1, np.zeros_like(a1)))
+        zero = np.zeros_like(a1)
+        out.append((lim - a1 * sd, -np.sign(p["q1"]) * p["dq1"] / self.vmax * sd, -a1, zero, 0))
         # acceleration: qdd = q'' ṡ² + q' s̈, both signs
         qdd = p["q2"] * sd * sd + p["q1"] * sdd
         d_s = p["dq2"] * sd * sd + p["dq1"] * sdd
         d_sd = 2.0 * p["q2"] * sd
         d_sdd = p["q1"]
-        ja = self._chain(d_s / self.amax, d_sd / self.amax, d_sdd / self.amax)
-        rows += [lim - qdd / self.amax, lim + qdd / self.amax]
-        jacs += [-ja, ja]
+        ja = (d_s / self.amax, d_sd / self.amax, d_sdd / self.amax)
+        out.append((lim - qdd / self.amax, -ja[0], -ja[1], -ja[2], 0))
+        out.append((lim + qdd / self.amax, ja[0], ja[1], ja[2], 0))
         if self.jmax is not None:  # the grid's own jerk: consecutive accelerations' difference / dt
             jerk = np.diff(qdd, axis=0) / self.dt / self.jmax
-            jj = np.diff(self._chain(d_s, d_sd, d_sdd), axis=0) / self.dt / self.jmax[None, :, None]
-            rows += [lim - jerk, lim + jerk]
-            jacs += [-jj, jj]
+            c = self.dt * self.jmax
+            jj = (d_s / c, d_sd / c, d_sdd / c)
+            out.append((lim - jerk, -jj[0], -jj[1], -jj[2], 1))
+            out.append((lim + jerk, jj[0], jj[1], jj[2], 1))
         if self.tcp_speed is not None:  # |dp/ds| ṡ <= bound(s)
             s = np.clip(p["s"], 0.0, 1.0)
             bound = _bound_at(self.tcp_speed, s)[:, None]
@@ -476,11 +470,49 @@ class _Search:
                 lo, hi = np.clip(s - _BOUND_STEP, 0.0, 1.0), np.clip(s + _BOUND_STEP, 0.0, 1.0)
                 slope = (_bound_at(self.tcp_speed, hi) - _bound_at(self.tcp_speed, lo)) / (hi - lo)
                 dv = dv - v / bound * slope[:, None]
-            rows.append(lim - v * sd)
-            jacs.append(-self._chain(dv * sd, v, np.zeros_like(v)))
-        g = np.concatenate([r.ravel() for r in rows])
-        jac = np.concatenate([j.reshape(-1, j.shape[-1]) for j in jacs])
-        return g, jac
+            out.append((lim - v * sd, -dv * sd, -v, np.zeros_like(v), 0))
+        return out
+
+    def constraints(self, x: FloatArray, rows: np.ndarray | None = None) -> tuple[FloatArray, FloatArray]:
+        """``g(x) >= 0`` (relative margins to each limit) and its Jacobian: every row's value, and
+        the Jacobian's rows ``rows`` (flat indices into ``g``; None: all)."""
+        blocks = self._limit_blocks(x)
+        g = _limit_values(blocks)
+        return g, self.limit_jacobian(blocks, np.arange(g.size) if rows is None else rows)
+
+    def limit_jacobian(self, blocks: list[_Block], rows: np.ndarray) -> FloatArray:
+        """The Jacobian's rows ``rows`` (flat indices into the values) of :meth:`_limit_blocks`' rows:
+        each row's partials times the basis at its point, not the whole grid's (a solve carries few
+        of its rows)."""
+        rows = np.asarray(rows, dtype=int)
+        jac = np.empty((rows.size, self.b0.shape[1]))
+        start = 0
+        for val, ds, dsd, dsdd, lag in blocks:
+            sel = (rows >= start) & (rows < start + val.size)
+            if sel.any():
+                t, k = np.divmod(rows[sel] - start, val.shape[1])
+                at = t + lag  # a jerk row: the later point of its pair
+                jac[sel] = (
+                    ds[at, k][:, None] * self.b0[at]
+                    + dsd[at, k][:, None] * self.b1[at]
+                    + dsdd[at, k][:, None] * self.b2[at]
+                )
+                if lag:
+                    jac[sel] -= (
+                        ds[t, k][:, None] * self.b0[t]
+                        + dsd[t, k][:, None] * self.b1[t]
+                        + dsdd[t, k][:, None] * self.b2[t]
+                    )
+            start += val.size
+        return jac
+
+
+_Block = tuple[FloatArray, FloatArray, FloatArray, FloatArray, int]
+"""A block of limit rows (:meth:`_Search._limit_blocks`): values, partials in s, ṡ, s̈, lag."""
+
+
+def _limit_values(blocks: list[_Block]) -> FloatArray:
+    return np.concatenate([b[0].ravel() for b in blocks])
 
 
 def _stop_past(deadline: float) -> None:
@@ -545,20 +577,27 @@ def _search(
     shift[0] = -float(timing.lo_values[-1])
     shift[n] = float(timing.hi_values[0])
     scale = max(problem.energy(x0)[0], 1e-6)
-    last: dict[bytes, tuple[FloatArray, FloatArray]] = {}  # SLSQP asks for g and its Jacobian apart
+    last: dict[bytes, tuple[list[_Block], FloatArray]] = {}  # SLSQP asks for g and its Jacobian apart
 
-    def limits_at(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+    def blocks_at(x: FloatArray) -> tuple[list[_Block], FloatArray]:
         key = np.asarray(x, dtype=float).tobytes()
         if key not in last:
             last.clear()
-            last[key] = problem.constraints(x)
+            blocks = problem._limit_blocks(x)
+            last[key] = (blocks, _limit_values(blocks))
         return last[key]
+
+    def values_at(x: FloatArray) -> FloatArray:
+        return blocks_at(x)[1]
+
+    def jacobian_at(x: FloatArray, r: np.ndarray) -> FloatArray:
+        return problem.limit_jacobian(blocks_at(x)[0], r)
 
     # the limit rows enter lazily: those within SCREEN_BAND of their limit at the start, then
     # those the solve's result breaks or nears, re-solved from there (SLSQP's dense QP grows with
     # the rows: a fine grid holds thousands, of which few bind)
     x = np.asarray(x0, dtype=float)
-    rows = np.flatnonzero(limits_at(x)[0] < SCREEN_BAND)
+    rows = np.flatnonzero(values_at(x) < SCREEN_BAND)
     for _ in range(MAX_ROUNDS):
         chosen = rows
         result = minimize(
@@ -572,8 +611,8 @@ def _search(
                 [
                     {
                         "type": "ineq",
-                        "fun": lambda x, r=chosen: limits_at(x)[0][r],
-                        "jac": lambda x, r=chosen: limits_at(x)[1][r],
+                        "fun": lambda x, r=chosen: values_at(x)[r],
+                        "jac": lambda x, r=chosen: jacobian_at(x, r),
                     }
                 ]
                 if chosen.size
@@ -583,7 +622,7 @@ def _search(
             callback=None if deadline is None else lambda _: _stop_past(deadline),
         )
         x = np.asarray(result.x, dtype=float)
-        g = limits_at(x)[0]
+        g = values_at(x)
         if g.min() >= -1e-9 or (deadline is not None and time.perf_counter() > deadline):
             break
         grown = np.union1d(rows, np.flatnonzero(g < SCREEN_BAND))

@@ -186,6 +186,16 @@ class CycleSettings:
             raise InvalidInput(f"max_time_s must be a positive number of seconds, got {self.max_time_s}")
 
 
+FAST_CYCLE: dict[str, Any] = {"pass_search": 2, "table_points": 3, "retime_segments": False}
+""":class:`CycleSettings` for interactive use (``CycleSettings(**FAST_CYCLE)``; issue 36): at most 2 probes
+per inner target in the pass-time search, 3 durations per unit in the time table, and no re-timing of
+the segments with a ``MoveL`` along their paths. Measured on the bundled examples (one BLAS thread,
+CPU s and saving, default -> fast): pick_and_place 23.1 -> 8.0 s, 12.15 -> 10.80 %; palletizing
+26.7 -> 8.5 s, 22.30 -> 20.32 %; machine_tending 6.5 -> 2.4 s, 12.69 -> 11.18 %; inspection 8.6 ->
+8.8 s, 17.46 % both; approach_depart 9.1 -> 3.1 s, 13.60 -> 12.71 %; payload_tool 4.8 -> 2.6 s,
+12.67 -> 12.29 % (BENCHMARKS.md, benchmarks/cycle_examples.py with ``FAST=1``)."""
+
+
 class TimeBudgetSpent(Exception):
     """Internal: the wall-time bound was reached before a solve (never leaves this module)."""
 
@@ -263,6 +273,7 @@ class Solved:
     corridor_used_mm: float | None = None
     taught: bool = False  # the taught motion of the unit, as the controller runs it (not re-solved)
     passes: tuple[float, ...] | None = None  # s: when it passes the inner targets (None: waypoints())
+    coefficients: FloatArray | None = None  # the gradient search's (flat), a warm start for its neighbours
 
     @property
     def usable(self) -> bool:
@@ -458,6 +469,11 @@ pick_and_place: 0.1 s saved 11.6 %, 0.075 s 11.7 % in 7 s more, 0.05 s 11.5 % in
 PROBE_ROUNDS = 3
 """Rounds of new limit rows per continuation stage, at most, of a probe of that search (one whose
 pass times cannot be met spends them all; a probe's result is verified like any solve)."""
+PROBE_WARM_STAGES = 1
+"""Continuation stages of a pass-time probe on the taught motion started from the best probe so far
+(its path: the probes differ in one target's time by a few samples): the last. The first probe runs
+them all. Measured on pick_and_place (issue 36): the probes' CPU 20.0 -> 13.8 s, the same saving
+(12.15 %); the last two stages 15.3 s."""
 
 TIME_UNIT = FINE_DT
 """s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
@@ -482,13 +498,18 @@ class CycleOptimizer:
         *,
         progress: Callable[[str], None] | None = None,
         deadline: float | None = None,
+        plan: PlannedCycle | None = None,
     ) -> None:
         self.spec = spec
         self.settings = settings
         self.progress = progress or (lambda msg: None)
         self.deadline = deadline  # time.perf_counter() after which no new move is solved
         self.timed_out = False
-        self.plan: PlannedCycle = plan_cycle(spec, settings.controller, progress=self.progress)
+        # ``plan``: the taught cycle as planned for ``spec`` under ``settings.controller`` (one
+        # already planned, e.g. by the plan for samples before the plan for via points)
+        self.plan: PlannedCycle = (
+            plan_cycle(spec, settings.controller, progress=self.progress) if plan is None else plan
+        )
         self.gradient = replace(settings.gradient, energy_every=settings.energy_every)
         check_motion_time(self.plan, spec.source, optimized=True)
         if spec.module is None:
@@ -746,8 +767,10 @@ class CycleOptimizer:
         pass times it starts from are kept as shares of the duration (:meth:`waypoints`) for the
         chain's solves at every duration; the better solve at ``T`` is cached. A unit inside a
         ``MoveL`` segment probes on knots :data:`ON_TAUGHT_KNOTS` apart (its own solves:
-        :data:`WITHIN_KNOTS`), the probes compared among themselves, and the best pass times are then
-        solved as its own solves are, kept where that beats the untuned solve. Nothing for a single
+        :data:`WITHIN_KNOTS`), the probes compared among themselves (each after the first started from
+        the best probe's path, through the last :data:`PROBE_WARM_STAGES` continuation stages), and
+        the best pass times are then solved as its own solves are, kept where that beats the untuned
+        solve. Nothing for a single
         move or a MoveL."""
         members = self.chains[i]
         if len(members) < 2 or i in self.linear or i in self.tuned or not self.settings.pass_search:
@@ -767,6 +790,8 @@ class CycleOptimizer:
         elif all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
             seen[start] = first
 
+        warm = replace(probe, continuation=probe.continuation[-PROBE_WARM_STAGES:])
+
         def energy(edges: tuple[int, ...]) -> float:
             if not self._passes_reachable(i, edges, units):
                 return np.inf
@@ -774,7 +799,13 @@ class CycleOptimizer:
                 way = tuple(
                     (e * STEP, self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
                 )
-                seen[edges] = self._solve_once(m, units * STEP, units, corridor, way=way, gradient=probe)
+                near = seen.get(best) if coarse and PROBE_WARM_STAGES else None
+                if near is not None and near.usable and near.coefficients is not None:
+                    seen[edges] = self._solve_once(
+                        m, units * STEP, units, corridor, way=way, gradient=warm, initial=near.coefficients
+                    )
+                else:
+                    seen[edges] = self._solve_once(m, units * STEP, units, corridor, way=way, gradient=probe)
             s = seen[edges]
             return s.energy_J if s.usable else np.inf
 
@@ -1202,6 +1233,7 @@ class CycleOptimizer:
         warm: Solved | None = None,
         way: tuple[tuple[float, FloatArray], ...] | None = None,
         gradient: GradientSettings | None = None,
+        initial: FloatArray | None = None,
     ) -> Solved:
         robot = self._robot(m)
         amax = self._amax(robot)
@@ -1244,6 +1276,7 @@ class CycleOptimizer:
                 base=base,
                 energy_measure=self.settings.energy,
                 deadline=self.deadline,
+                initial=initial,
             )
         self.n_solves += 1
         x = res.coefficients.ravel()
@@ -1267,6 +1300,7 @@ class CycleOptimizer:
             None if self.settings.cell is None else self._clearance_mm(m, fine.q),
             corridor,
             passes=tuple(t for t, _ in way) if way else None,
+            coefficients=x,
         )
 
     def _retime_once(self, m: PlannedMove, T: float) -> Solved:
@@ -1910,10 +1944,22 @@ def optimize_cycle(
     Never refused at the taught cycle time: each unit's taught motion is a candidate, so
     in the worst case the taught cycle itself is returned, 0 % saved.
     """
+    return _optimize_cycle(spec, settings, progress=progress)
+
+
+def _optimize_cycle(
+    spec: CycleSpec,
+    settings: CycleSettings,
+    *,
+    progress: Callable[[str], None] | None = None,
+    plan: PlannedCycle | None = None,
+) -> tuple[CycleResult, CycleOptimizer]:
+    """:func:`optimize_cycle`, on ``plan`` when given (the taught cycle planned under
+    ``settings.controller``: the plan for via points takes the one for samples had)."""
     check_moves_arm(spec)
     t_start = time.perf_counter()
     deadline = None if settings.max_time_s is None else t_start + settings.max_time_s
-    opt = CycleOptimizer(spec, settings, progress=progress, deadline=deadline)
+    opt = CycleOptimizer(spec, settings, progress=progress, deadline=deadline, plan=plan)
     plan = opt.plan
     target = plan.cycle_time if settings.cycle_time is None else settings.cycle_time
     check_work(  # the time the moves may take at this cycle time, before any of them is solved
@@ -1959,7 +2005,7 @@ def optimize_cycle(
         )
         via = replace(settings, follow="via-points", rapid_plan=False, max_time_s=left)
         try:
-            rapid, _ = optimize_cycle(spec, via, progress=progress)
+            rapid, _ = _optimize_cycle(spec, via, progress=progress, plan=plan)
         except LimitViolation:  # no plan for via points at this cycle time: EGM only
             rapid = None
         if rapid is not None and rapid.paths:
