@@ -480,3 +480,14 @@ def test_fast_preset_plans_within_limits(spec):
     assert result.limits_ok
     assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
     assert result.optimized_energy_J <= result.default_energy_J + 1e-9
+
+
+def test_cli_fast_preset_skips_the_path_retiming_and_keeps_the_checks(tmp_path):
+    prog = tmp_path / "small.mod"
+    prog.write_text(SMALL)
+    base = ["cycle", str(prog), "--export", "egm", "--knot-spacing", "0.1"]
+    assert main([*base, "--out", str(tmp_path / "fast"), "--fast"]) == 0
+    fast = json.loads((tmp_path / "fast" / "cycle.json").read_text())
+    assert fast["breakdown"]["segments_retimed_along_their_path_J"] is None  # FAST_CYCLE: no re-timing
+    assert fast["limits_ok"] and fast["optimized_cycle_s"] <= fast["target_cycle_s"] + 1e-9
+    assert fast["saved_pct"] > 0.0

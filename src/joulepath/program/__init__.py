@@ -2,6 +2,7 @@
 controller does, optimize it."""
 
 from joulepath.program._cycle import (
+    FAST_CYCLE,
     Breakdown,
     CycleOptimizer,
     CycleResult,
@@ -22,6 +23,7 @@ from joulepath.program._write import format_move, write_module
 from joulepath.sim import plan_cycle
 
 __all__ = [
+    "FAST_CYCLE",
     "Breakdown",
     "CYCLE_FILES",
     "CycleOptimizer",
