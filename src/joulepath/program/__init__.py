@@ -23,15 +23,14 @@ from joulepath.program._write import format_move, write_module
 from joulepath.sim import plan_cycle
 
 __all__ = [
-    "FAST_CYCLE",
     "Breakdown",
     "CYCLE_FILES",
     "CycleOptimizer",
     "CycleResult",
     "CycleSettings",
     "CycleSpec",
+    "FAST_CYCLE",
     "LeverResult",
-    "ViaLevers",
     "Module",
     "MoveLever",
     "MoveOutcome",
@@ -39,9 +38,9 @@ __all__ = [
     "ProgramMotion",
     "ProgramRun",
     "RapidError",
+    "ViaLevers",
     "format_move",
     "levers_module",
-    "via_levers",
     "optimize_cycle",
     "optimized_module",
     "pareto",
@@ -53,6 +52,7 @@ __all__ = [
     "read_module",
     "resolve_module",
     "simulate_program",
+    "via_levers",
     "write_cycle_run",
     "write_module",
 ]
