@@ -32,6 +32,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
+from joulepath import __version__
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, JoulepathError, LimitViolation
@@ -372,7 +373,7 @@ def via_levers(
         body, where = _marked(text, lv.written_text, added) if only is None else (lv.written_text, None)
         saved = 100.0 * (1.0 - lv.energy_J / e_taught)
         header = [
-            f"{HEADERS[0]} {_version()} for energy: the plan's via points and the controller's levers "
+            f"{HEADERS[0]} {__version__} for energy: the plan's via points and the controller's levers "
             f"(AccSet, speed data or \\T, zones), as the controller emulation runs this module: "
             f"{lv.cycle_s:.3f} s per cycle (taught {t_taught:.3f} s), {lv.energy_J:.2f} J against the taught "
             f"{e_taught:.2f} J on {energy} energy ({saved:.1f} % saved). See cycle.json.",
@@ -430,9 +431,3 @@ def via_levers(
         clear,
         reverted,
     )
-
-
-def _version() -> str:
-    from joulepath import __version__
-
-    return __version__
