@@ -144,6 +144,14 @@ def cycle(
         "durations per move (over --table-points), no re-timing of MoveL segments along their paths. "
         "Measured on the bundled examples: at most 8.8 s of CPU each, 0-2 points less saving.",
     ),
+    levers_seconds: float = typer.Option(
+        LEVERS_SECONDS,
+        "--levers-seconds",
+        min=0.0,
+        max=3600.0,
+        help="s of wall time for each search of the controller's levers on the emulation (RAPID export; "
+        "what the search found by then is checked and written; 0: no lever search).",
+    ),
     corridor: float = typer.Option(
         100.0,
         "--corridor",
@@ -234,14 +242,14 @@ def cycle(
             say("energy against cycle time...")
             front = run_pareto(opt, points=points, use_waits=use_waits)
         levers = None
-        if rapid and export != "egm" and result.limits_ok:
+        if rapid and export != "egm" and result.limits_ok and levers_seconds > 0:
             from joulepath.program import levers_module
             from joulepath.program._task_levers import task_levers
 
             say("searching the controller's levers (AccSet, speed data, zones) on the controller emulation")
             if spec.module is not None:
                 levers = levers_module(
-                    spec, r, energy=energy, use_waits=use_waits, max_seconds=LEVERS_SECONDS
+                    spec, r, energy=energy, use_waits=use_waits, max_seconds=levers_seconds
                 )
             else:
                 levers = task_levers(
@@ -250,10 +258,18 @@ def cycle(
                     energy=energy,
                     io=scenario_values or None,
                     routine=routine,
-                    max_seconds=LEVERS_SECONDS,
+                    max_seconds=levers_seconds,
                 )
         via = None
-        if rapid and export != "egm" and result.limits_ok and spec.module is not None and result.paths:
+        searched = levers_seconds > 0
+        if (
+            rapid
+            and export != "egm"
+            and result.limits_ok
+            and spec.module is not None
+            and result.paths
+            and searched
+        ):
             from joulepath.program import via_levers
 
             say("searching the levers of the plan's via points on the controller emulation")
@@ -263,7 +279,7 @@ def cycle(
                 energy=energy,
                 corridor_mm=settings.corridor_mm,
                 cell=cell_data,
-                max_seconds=LEVERS_SECONDS,
+                max_seconds=levers_seconds,
             )
         say(f"writing {out} (the written program is checked on the controller emulation)")
         files = write_cycle_run(
