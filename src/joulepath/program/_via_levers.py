@@ -39,6 +39,7 @@ from joulepath.errors import InvalidInput, JoulepathError, LimitViolation
 from joulepath.program._levers import LeverResult, _Evaluator, cycle_motion, levers_module
 from joulepath.program._parse import parse_module
 from joulepath.program._resolve import CycleSpec, resolve_module
+from joulepath.program._via_timing import T_ARG, dense_vias, time_chains
 from joulepath.sim import ControllerConfig, PlannedCycle, tcp_pose
 from joulepath.trajectory import Trajectory
 
@@ -50,7 +51,6 @@ shortening every via point's ``\\T`` by the same factor."""
 MAX_PLANS = 4000
 """Cycle plans the lever search of the via points makes at most (each a few ms per move; ``max_seconds``
 bounds it too): a via-point module has many more statements than the program it was written from."""
-_T_ARG = re.compile(r"(\\T\s*:=\s*)(\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)")
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,7 +98,7 @@ def _scaled(text: str, lines: set[int], factor: float) -> str:
     out = text.splitlines(keepends=True)
     for k in lines:
         if 1 <= k <= len(out):
-            out[k - 1] = _T_ARG.sub(times, out[k - 1])
+            out[k - 1] = T_ARG.sub(times, out[k - 1])
     return "".join(out)
 
 
@@ -256,6 +256,7 @@ def via_levers(
     cell: Any = None,
     max_seconds: float | None = None,
     config: ControllerConfig | None = None,
+    timed_chains: bool = True,
 ) -> ViaLevers:
     """The via-point module of ``result``'s plan with the controller's levers of its via points,
     as the controller emulation runs it (module docstring).
@@ -277,6 +278,10 @@ def via_levers(
         Wall time of the lever search (what it found by then is written).
     config : ControllerConfig, optional
         The emulated controller.
+    timed_chains : bool, optional
+        Also the plan's via points at equal arc length with each chain's ``\\T`` timed for the
+        controller (:mod:`joulepath.program._via_timing`); the module that runs the taught cycle
+        time for less energy is the one the levers are searched on.
 
     Returns
     -------
@@ -303,29 +308,49 @@ def via_levers(
     plan_t, t_taught, _ = taught(())
     e_taught, lab_taught = taught.energies(plan_t)
     path = f"{spec.module.path} (via points)"
-    try:
-        via_spec = resolve_module(parse_module(text, path=path), robot)
-        _, t_via, e_via = _Evaluator(via_spec, [], energy, config)(())
 
-        def run(candidate: str) -> tuple[CycleSpec, float, float]:
-            spec_c = resolve_module(parse_module(candidate, path=path), robot)
-            _, t_c, e_c = _Evaluator(spec_c, [], energy, config)(())
-            return spec_c, t_c, e_c
+    def run(candidate: str) -> tuple[CycleSpec, float, float]:
+        spec_c = resolve_module(parse_module(candidate, path=path), robot)
+        _, t_c, e_c = _Evaluator(spec_c, [], energy, config)(())
+        return spec_c, t_c, e_c
 
-        via_spec, t_via, e_via = run(text)
-        text, via_spec, t_via, e_via = _fitted(text, via_spec, t_via, e_via, t_taught, run)
-        reverted = 0
-        while t_via > t_taught + _TOL_S:  # still longer: put a unit back as taught (the cheapest that
-            # fits, else the one that saves most time)
-            tries = [run(_reverted(text, u)) + (u,) for u in _units(text)]
+    def fit(candidate: str) -> tuple[str, CycleSpec, float, float, int]:
+        """The module within the taught cycle time: its ``\\T`` shortened, else units put back as taught
+        (the cheapest that fits, else the one that saves most time)."""
+        spec_v, t_v, e_v = run(candidate)
+        candidate, spec_v, t_v, e_v = _fitted(candidate, spec_v, t_v, e_v, t_taught, run)
+        back = 0
+        while t_v > t_taught + _TOL_S:
+            tries = [run(_reverted(candidate, u)) + (u,) for u in _units(candidate)]
             if not tries:
                 break
             fits = [x for x in tries if x[1] <= t_taught + _TOL_S]
             spec_r, t_r, e_r, u = min(fits, key=lambda x: x[2]) if fits else min(tries, key=lambda x: x[1])
-            if t_r >= t_via - _TOL_S:
+            if t_r >= t_v - _TOL_S:
                 break
-            text, via_spec, t_via, e_via = _fitted(_reverted(text, u), spec_r, t_r, e_r, t_taught, run)
-            reverted += 1
+            candidate, spec_v, t_v, e_v = _fitted(_reverted(candidate, u), spec_r, t_r, e_r, t_taught, run)
+            back += 1
+        return candidate, spec_v, t_v, e_v, back
+
+    try:
+        bases = [fit(text)]  # the via-point layout the plan was checked with
+        if timed_chains:  # the plan's points kept at equal arc length, their \T timed for the controller
+            dense = _plain(written_rapid(replace(plan, vias=dense_vias(plan))).text)
+            spec_d = run(dense)[0]
+            timed = time_chains(
+                dense,
+                spec_d,
+                _added_lines(spec_d),
+                measure=energy,
+                config=config,
+                cycle_s=t_taught,
+                run_cycle=lambda c: run(c)[1:],
+            )
+            bases.append(fit(timed.text))
+        within = [b for b in bases if b[2] <= t_taught + _TOL_S]
+        text, via_spec, t_via, e_via, reverted = (
+            min(within, key=lambda b: b[3]) if within else min(bases, key=lambda b: b[2])
+        )
         added = _added_lines(via_spec)
     except JoulepathError as err:
         return ViaLevers(None, f"the via-point module cannot be read: {err}")
