@@ -344,3 +344,29 @@ def test_writer_edits_arguments_in_place_across_lines_and_comments(robot):
     assert where == {k: k for k in range(1, len(text.splitlines()) + 1)}
     a, b, *_ = _moves(_spec(written, robot))
     assert (a.time_s, a.zone_mm, b.zone_mm, b.speed.v_tcp) == (2.5, 5.0, 30.0, 450.0)
+
+
+def test_a_module_over_its_baseline_time_is_first_brought_into_it(robot):
+    # the joint cycle's fly-by targets at z1: larger zones (a lever) cut the corners and buy time
+    text = JOINT_CYCLE.replace("z20", "z1")
+    spec = _spec(text, robot)
+    plan = plan_cycle(spec, ControllerConfig())
+    over = 0.004  # the module runs this much longer than the program it replaces (s)
+    baseline = (plan.cycle_time - over, 1e9, 1e9)  # any energy: only the time is asked here
+    lv = levers_module(spec, robot, energy="thesis", text=text, baseline=baseline, max_evaluations=400)
+    assert lv.cycle_s <= baseline[0] + 1e-6 < plan.cycle_time
+    # what it wrote, read back and run, is that cycle
+    again = plan_cycle(_spec(lv.written_text, robot), ControllerConfig())
+    assert again.cycle_time == pytest.approx(lv.cycle_s, abs=1e-9)
+    assert any(m.chosen.zone != m.taught.zone for m in lv.moves)
+    # where no lever buys the time, the result stays over it (for the caller to refuse), never faked
+    fine = _module(
+        "            MoveL pA, v300, fine, tool0;\n            MoveL pB, v300, fine, tool0;\n"
+    )  # stop points,
+    # and a MoveL's speed is the programmer's bound: nothing to gain
+    spec_f = _spec(fine, robot)
+    t_f = plan_cycle(spec_f, ControllerConfig()).cycle_time
+    lv_f = levers_module(
+        spec_f, robot, energy="thesis", text=fine, baseline=(t_f - over, 1e9, 1e9), max_evaluations=400
+    )
+    assert lv_f.cycle_s > t_f - over

@@ -53,7 +53,7 @@ def planned(robot):
     settings = CycleSettings(table_points=2, pass_search=0)
     settings = replace(settings, gradient=replace(settings.gradient, knot_spacing=0.1))
     result, _ = optimize_cycle(spec, settings)
-    return result, via_levers(result, robot, energy="thesis", max_seconds=60)
+    return result, via_levers(result, robot, energy="thesis", max_seconds=60, timed_chains=False)
 
 
 def _executed(text: str, robot) -> tuple[float, float]:
@@ -142,7 +142,7 @@ def test_marked_edits_restore_and_run_as_edited():
 def test_a_corridor_it_leaves_refuses_it(robot, planned):
     result, via = planned
     assert via.deviation_mm is not None and via.deviation_mm > 0.5
-    narrow = via_levers(result, robot, energy="thesis", corridor_mm=0.5, max_seconds=60)
+    narrow = via_levers(result, robot, energy="thesis", corridor_mm=0.5, max_seconds=60, timed_chains=False)
     assert narrow.levers is None
     assert "corridor" in narrow.note and f"{narrow.deviation_mm:.1f} mm" in narrow.note
 

@@ -21,7 +21,9 @@ written, where its statements stand.
   is taken. After a pass where none is, pairs of a change that gains time and one that
   spends it for less energy are ranked by their single effects and the best taken in turn
   where the two planned together keep the cycle time and lower the energy; the search
-  stops when neither helps or the plans are spent.
+  stops when neither helps or the plans are spent. A cycle that starts over its time (a module
+  written from a plan, :func:`joulepath.program.via_levers`) is first brought into it: each step
+  the change that gets it there for the least energy, else the one that buys time cheapest.
 * **Energy**: the cycle as the controller emulation runs it (:func:`joulepath.sim.evaluate_cycle`
   on the 2.5 ms grid), on the run's energy measure, with the model the written-program
   check uses (:func:`joulepath.program._output.check_written`): the whole cycle's motion,
@@ -511,6 +513,28 @@ def _search(
     """Coordinate descent with exchanges (module docstring), within ``max_evaluations`` plans."""
     state = tuple(s.taught for s in slots)
     plan, t, e = ev(state)
+    while t > target_s + _TOL_S and ev.n < max_evaluations:  # over the cycle time (a module written
+        # from a plan): first into it, each step the change that gets there for the least energy, else
+        # the one that buys time cheapest (energy per second)
+        into: tuple[float, tuple[Setting, ...]] | None = None
+        cheap: tuple[float, tuple[Setting, ...]] | None = None
+        for k, slot in enumerate(slots):
+            for kind in _kinds(slot):
+                duration = _durations(plan).get((slot.line, slot.instruction), 0.0)
+                for option in _options(state, k, kind, slot, ev.spec, duration):
+                    trial = _with(state, k, option)
+                    _, t_new, e_new = ev(trial)
+                    if t_new <= target_s + _TOL_S and (into is None or e_new < into[0]):
+                        into = (e_new, trial)
+                    elif t_new < t - 1e-6:
+                        rate = (e_new - e) / (t - t_new)
+                        if cheap is None or rate < cheap[0]:
+                            cheap = (rate, trial)
+        step = into or cheap
+        if step is None:
+            break
+        state = step[1]
+        plan, t, e = ev(state)
 
     def better(t_new: float, e_new: float, best: tuple[float, object] | None) -> bool:
         """Within the cycle time, less energy than now, and than ``best``."""
@@ -818,7 +842,9 @@ def levers_module(
     baseline : (cycle s, energy J, lab J), optional
         The program this module replaces, as the controller emulation runs it (the taught one, where
         ``spec`` is a rewrite of it): the cycle may run up to its cycle time (also where the module
-        itself runs shorter), and the result's ``taught_cycle_s`` and ``default_*`` are its.
+        itself runs shorter; where it runs longer, the search first brings it in, and where it cannot,
+        the result runs longer than ``taught_cycle_s``, for the caller to refuse), and the result's
+        ``taught_cycle_s`` and ``default_*`` are its.
     only_lines : collection of int, optional
         Only the move statements on these lines get levers; the others stay as written.
 
@@ -860,7 +886,7 @@ def levers_module(
     plan0, t0, _ = ev(taught_state)
     e0, lab0 = ev.energies(plan0)
     ev.deadline = None if max_seconds is None else start + max_seconds
-    own = t0 if baseline is None else max(t0, baseline[0])
+    own = t0 if baseline is None else baseline[0]  # a module over it is first brought into it
     target = own if cycle_time_s is None else min(cycle_time_s, own)
     if cycle_time_s is not None and not cycle_time_s > 0:
         raise InvalidInput(f"cycle_time_s must be positive, got {cycle_time_s}")
@@ -870,7 +896,7 @@ def levers_module(
     _, t_search, e_search = ev(chosen)
     spent = max(0.0, t_search - target)
     new_waits: dict[int, float] = {}
-    if spent > 0.0:
+    if spent > 0.0 and idle_s > 0.0:
         keep = 1.0 - spent / idle_s
         new_waits = {
             line: float(np.floor(sec * keep * 1000.0 + 1e-9) / 1000.0)
@@ -892,7 +918,7 @@ def levers_module(
     if differs is None and again is not None:
         plan_x, t_exec, _ = ev.run(again)
         e_exec, lab_exec = ev.energies(plan_x)
-        if t_exec > target + _TOL_S or e_exec > e0:
+        if t_exec > target + _TOL_S or e_exec > (e0 if t0 <= target + _TOL_S else np.inf):
             differs = f"run again it takes {t_exec:.3f} s and {e_exec:.3f} J"
     if differs is not None or again is None:  # not written with levers: the program as taught
         chosen, written, t_exec, e_exec, lab_exec, new_waits = taught_state, text, t0, e0, lab0, {}

@@ -332,8 +332,11 @@ def via_levers(
             back += 1
         return candidate, spec_v, t_v, e_v, back
 
+    timed_n = 0
     try:
-        bases = [fit(text)]  # the via-point layout the plan was checked with
+        old = fit(text)  # the via-point layout the plan was checked with (fitted into the taught time)
+        only_sets: tuple[set[int] | None, ...] = (None, _added_lines(old[1]))
+        bases = [(*old, only_sets)]
         if timed_chains:  # the plan's points kept at equal arc length, their \T timed for the controller
             dense = _plain(written_rapid(replace(plan, vias=dense_vias(plan))).text)
             spec_d = run(dense)[0]
@@ -345,16 +348,19 @@ def via_levers(
                 config=config,
                 cycle_s=t_taught,
                 run_cycle=lambda c: run(c)[1:],
+                max_seconds=max_seconds,
             )
-            bases.append(fit(timed.text))
-        within = [b for b in bases if b[2] <= t_taught + _TOL_S]
-        text, via_spec, t_via, e_via, reverted = (
-            min(within, key=lambda b: b[3]) if within else min(bases, key=lambda b: b[2])
-        )
-        added = _added_lines(via_spec)
+            # not fitted by shortening its \T (that breaks its chains): over the taught time, the lever
+            # search brings it in
+            spec_t, t_t, e_t = run(timed.text)
+            bases.append((timed.text, spec_t, t_t, e_t, 0, (None,)))  # every statement: it may be over
+            timed_n = timed.timed
     except JoulepathError as err:
         return ViaLevers(None, f"the via-point module cannot be read: {err}")
-    if t_via > t_taught + _TOL_S:
+    text, via_spec, t_via, e_via, reverted, _ = min(
+        bases, key=lambda b: (b[2] > t_taught + _TOL_S, b[3] if b[2] <= t_taught + _TOL_S else b[2])
+    )
+    if not any(b[2] <= t_taught + _TOL_S for b in bases) and not timed_chains:
         return ViaLevers(
             None,
             f"the via-point module takes {t_via:.3f} s per cycle, longer than the taught {t_taught:.3f} s",
@@ -373,7 +379,14 @@ def via_levers(
     found: LeverResult | None = None
     why = "no lever search ran"
     kept: tuple[float | None, float | None] = (None, None)
-    for only in (None, added):  # every move statement, and the via points' alone: the better as executed
+    found_base = bases[0]
+    searches = [(b, only) for b in bases for only in b[5] if b[2] <= t_taught + _TOL_S or b is not bases[0]]
+    for (
+        base,
+        only,
+    ) in searches:  # per base, every move statement and the via points' alone: the best as executed
+        text, via_spec, t_via, e_via, reverted, _ = base
+        added = _added_lines(via_spec)
         try:
             lv = levers_module(
                 via_spec,
@@ -441,14 +454,21 @@ def via_levers(
         if found is None or lv.energy_J < found.energy_J:
             found = replace(lv, written_text=written, moves=moves, base="via points")
             kept = (dev, clear)
+            found_base = base
     if found is not None:
         dev, clear = kept
+        _, _, t_via, e_via, reverted, _ = found_base
     if found is None:
         return ViaLevers(None, why, t_via, e_via, dev, clear, reverted)
     saved = 100.0 * (1.0 - found.energy_J / e_taught)
     return ViaLevers(
         found,
         f"via points with levers: {saved:.1f} % saved as executed"
+        + (
+            f" (the plan's via points with the \\T of their {timed_n} chain(s) timed for the controller)"
+            if found_base is not bases[0]
+            else ""
+        )
         + (f" ({reverted} optimized move(s) kept as taught to keep the cycle time)" if reverted else ""),
         t_via,
         e_via,
