@@ -470,10 +470,12 @@ PROBE_ROUNDS = 3
 """Rounds of new limit rows per continuation stage, at most, of a probe of that search (one whose
 pass times cannot be met spends them all; a probe's result is verified like any solve)."""
 PROBE_WARM_STAGES = 1
-"""Continuation stages of a pass-time probe on the taught motion started from the best probe so far
-(its path: the probes differ in one target's time by a few samples): the last. The first probe runs
-them all. Measured on pick_and_place (issue 36): the probes' CPU 20.0 -> 13.8 s, the same saving
-(12.15 %); the last two stages 15.3 s."""
+"""Continuation stages of a pass-time probe started from the best probe so far (its path: the probes
+differ in one target's time by a few samples; on one level of knots): the last. The first probe runs
+them all. Measured on pick_and_place (issue 36): the probes on the taught motion, CPU 20.0 -> 13.8 s,
+the same saving (12.15 %); the last two stages 15.3 s. The probes of a chain from rest to rest too:
+its 2-move chain's 4.2 -> 3.4 s, the same energies but the probe that breaks a limit (12.1889 %
+-> 12.1888 %)."""
 
 TIME_UNIT = FINE_DT
 """s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
@@ -768,9 +770,10 @@ class CycleOptimizer:
         chain's solves at every duration; the better solve at ``T`` is cached. A unit inside a
         ``MoveL`` segment probes on knots :data:`ON_TAUGHT_KNOTS` apart (its own solves:
         :data:`WITHIN_KNOTS`), the probes compared among themselves (each after the first started from
-        the best probe's path, through the last :data:`PROBE_WARM_STAGES` continuation stages); a
-        probe that beats the one at the untuned pass times is kept as the unit's solve at ``T``, else
-        the unit is solved at the untuned pass times as its own solves are. Measured on
+        the best probe's path, through the last :data:`PROBE_WARM_STAGES` continuation stages, as a
+        chain's probes are after the first); a probe that beats the one at the untuned pass times is
+        kept as the unit's solve at ``T``, else the unit is solved at the untuned pass times as its
+        own solves are. Measured on
         pick_and_place (issue 36, with the re-timing's scaled search): 19.9 s at 12.19 %; the best
         pass times solved again on :data:`WITHIN_KNOTS`, kept where that beat the untuned solve
         there (two solves of 144 variables, about 3 s each), as before: 25.0 s at 12.15 %; solved
@@ -794,7 +797,7 @@ class CycleOptimizer:
         elif first is not None and all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
             seen[start] = first
 
-        warm = replace(probe, continuation=probe.continuation[-PROBE_WARM_STAGES:])
+        warm = replace(probe, continuation=probe.continuation[-PROBE_WARM_STAGES:], coarse_factor=1)
 
         def energy(edges: tuple[int, ...]) -> float:
             if not self._passes_reachable(i, edges, units):
@@ -803,7 +806,7 @@ class CycleOptimizer:
                 way = tuple(
                     (e * STEP, self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
                 )
-                near = seen.get(best) if coarse and PROBE_WARM_STAGES else None
+                near = seen.get(best) if PROBE_WARM_STAGES else None
                 if near is not None and near.usable and near.coefficients is not None:
                     seen[edges] = self._solve_once(
                         m, units * STEP, units, corridor, way=way, gradient=warm, initial=near.coefficients
