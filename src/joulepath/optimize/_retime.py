@@ -70,11 +70,6 @@ COARSE_FACTOR = 4
 """With ``start="identity"``: the first search's grid is this many times coarser than the fine one."""
 COARSE_MARGIN = 0.01
 """... and keeps its limits this fraction below the checked ones (between its points they may rise)."""
-COARSE_ITERATIONS = 60
-"""... and runs this many SLSQP iterations at most per round of rows. Measured on the bundled
-examples' re-timed segments (issue 36, with :data:`FIRST_STEP`): palletizing's 13 at 200, 80, 60,
-40: 8.9, 6.3, 5.7, 4.7 s of CPU, 153.164, 153.177, 153.145, 153.147 J; pick_and_place's 2 at 200,
-60, 40: 37.282, 37.275, 37.284 J (the polish on the fine grid follows)."""
 POLISH_ITERATIONS = 30
 """SLSQP iterations, at most, of the polish of that search on the fine grid."""
 RESCUE_KNOT_S = 0.1
@@ -884,7 +879,6 @@ def _searched(
         _fit_start(timing, coarse, start(coarse)[0]),
         limits,
         margin=COARSE_MARGIN,
-        maxiter=COARSE_ITERATIONS,
         deadline=deadline,
     )
     yield timing, _search(robot, at, timing, t, x, limits, maxiter=POLISH_ITERATIONS, deadline=deadline)
