@@ -92,8 +92,8 @@ FTOL = 1e-9
 """SLSQP's tolerance on the relative change of the energy (from the start's) that ends a search."""
 FIRST_STEP = 0.01
 """The length of SLSQP's first step (its Hessian estimate starts as the identity) in the free control
-points, to which :func:`_search` scales its objective (at the energy's own scale it was about 1-10:
-SLSQP's first iterate had up to 5 times the start's energy, each round of new rows started so
+points, to which :func:`_search` scales its objective (at the energy's own scale the steps were far
+too long: SLSQP's first iterate had up to 5 times the start's energy, each round of new rows started so
 again, and 4 of palletizing's 13 polishes ended infeasible and took the rescue search). Measured on
 the bundled examples' re-timed segments (issue 36): palletizing's 13, CPU 17.5 -> 8.1 s, their
 energy 153.29 -> 153.16 J, no rescue; 0.003 and 0.02 within 0.05 J of it, 0.001 slower."""
@@ -597,8 +597,8 @@ def _search(
     e0, g0 = problem.energy(x0)
     scale = max(e0, 1e-6)
     # SLSQP's Hessian estimate starts as the identity: its first steps go the (scaled) gradient's
-    # length, which at the energy's own scale leaves [0, 1] at once and spends the iterations on
-    # the way back. The objective scaled to a first step of FIRST_STEP; the tolerance with it
+    # length, which at the energy's own scale is far too long, and the iterations go to the way
+    # back. The objective scaled to a first step of FIRST_STEP; the tolerance with it
     # (the same relative change of the energy ends the search)
     stretch = float(np.linalg.norm(g0)) / scale / FIRST_STEP
     if not stretch > 0:
