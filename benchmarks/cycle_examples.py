@@ -19,6 +19,10 @@ minutes on a shared 2-core machine, 16 of them the optimum's 13 segments of pall
 default search in place of the cycle's, ``joulepath.optimize._gradient.GRID_SEARCH``).
 Writes the table to stdout; BENCHMARKS.md holds a copy with the machine.
 
+``--chain``: also the long fly-by chain of issue 36 (``benchmarks/fly_by_chain.mod``: 8 ``MoveJ``
+back and forth, ``z10``, a stop once per cycle, about 5.4 s on the IRB 120; its target there is
+60 s of CPU), planned and timed as the examples are (``OPTIMUM=0`` for the plan alone).
+
 ``--before SRC``: the code before a change beside it, in the same run (issue 36): ``SRC`` a source
 folder of it (e.g. ``git archive <commit> src | tar -x -C /tmp/before``, then ``/tmp/before/src``).
 Each program's plan is also made by that code, in a child process (``PYTHONPATH=SRC``) started at
@@ -48,6 +52,8 @@ from joulepath.program import CycleSettings, optimize_cycle, read_cycle_program,
 from joulepath.program._cycle import CycleOptimizer  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+CHAIN = Path(__file__).resolve().with_name("fly_by_chain.mod")
+"""The long fly-by chain of issue 36 (``--chain``)."""
 INTERVALS = 8
 """Transcription intervals per piece of the cycle optimum (per line piece, per sub-leg of a joint
 piece; 8 agree with the single-move reference within 0.05 %, tests/optimize/test_cycle_reference.py)."""
@@ -168,10 +174,15 @@ def plan_settings() -> CycleSettings:
     return CycleSettings()
 
 
+def program_path(name: str) -> Path:
+    """The RAPID module of a program: one of examples/, or the chain (``fly_by_chain``)."""
+    return CHAIN if name == CHAIN.stem else EXAMPLES / f"{name}.mod"
+
+
 def plan_only(name: str) -> None:
     """The plan of one program, as the table times it; prints {cpu_s, wall_s, saved_pct} (JSON).
     The child process of ``--before``: it runs on whatever ``joulepath`` its PYTHONPATH gives."""
-    spec, _ = read_cycle_program(EXAMPLES / f"{name}.mod", load_robot("irb120"))
+    spec, _ = read_cycle_program(program_path(name), load_robot("irb120"))
     t0, w0 = time.process_time(), time.perf_counter()
     result, _ = optimize_cycle(spec, plan_settings())
     cpu, wall = time.process_time() - t0, time.perf_counter() - w0
@@ -190,17 +201,18 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     ap.add_argument("programs", nargs="*", help="programs of examples/ (default: all six)")
     ap.add_argument("--before", type=Path, help="source folder of the code before (see the docstring)")
+    ap.add_argument("--chain", action="store_true", help="also the long fly-by chain (fly_by_chain.mod)")
     ap.add_argument("--plan-only", metavar="PROGRAM", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.plan_only:
         plan_only(args.plan_only)
         return
-    names = tuple(args.programs) or PROGRAMS
+    names = (tuple(args.programs) or PROGRAMS) + ((CHAIN.stem,) if args.chain else ())
     robot = load_robot("irb120")
     rows = []
     before: dict[str, dict[str, float]] = {}
     for name in names:
-        spec, rapid = read_cycle_program(EXAMPLES / f"{name}.mod", robot)
+        spec, rapid = read_cycle_program(program_path(name), robot)
         child = None if args.before is None else start_before(name, args.before.resolve())
         t0 = time.process_time()
         w0 = time.perf_counter()

@@ -558,9 +558,10 @@ ENDMODULE
 
 def test_pass_times_of_a_run_between_moveL_are_searched_never_to_its_loss(robot):
     """A run of two joint moves between MoveL is one unit with an inner fly-by target. Its pass time
-    is searched by probes on wider knots; the result kept for the unit is a full solve, verified, as
-    good as the solve at the pass time it started from or better, and it passes the target within
-    its zone. Started 0.1 s off the taught pass time, the search finds a better one."""
+    is searched by probes on wider knots; the result kept for the unit (the best probe, or the unit's
+    own solve where no probe wins) is verified, as good as the unit's own solve at the pass time it
+    started from or better, and it passes the target within its zone. Started 0.1 s off the taught
+    pass time, the search finds a better one."""
     spec = resolve_module(parse_module(TRANSFER, path="transfer.mod"), robot)
     for shift in (0.0, 0.1):
         opt = CycleOptimizer(spec, CycleSettings(gradient=FAST, pass_search=4))

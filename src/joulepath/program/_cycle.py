@@ -79,7 +79,7 @@ from joulepath.sim import (
     via_layout,
 )
 from joulepath.sim import tcp_pose as _tcp
-from joulepath.trajectory import SplineBasis, Trajectory, quintic_hermite
+from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk, quintic_hermite
 from joulepath.units import SAMPLE_PERIOD
 
 STEP = SAMPLE_PERIOD
@@ -470,10 +470,12 @@ PROBE_ROUNDS = 3
 """Rounds of new limit rows per continuation stage, at most, of a probe of that search (one whose
 pass times cannot be met spends them all; a probe's result is verified like any solve)."""
 PROBE_WARM_STAGES = 1
-"""Continuation stages of a pass-time probe on the taught motion started from the best probe so far
-(its path: the probes differ in one target's time by a few samples): the last. The first probe runs
-them all. Measured on pick_and_place (issue 36): the probes' CPU 20.0 -> 13.8 s, the same saving
-(12.15 %); the last two stages 15.3 s."""
+"""Continuation stages of a pass-time probe started from the best probe so far (its path: the probes
+differ in one target's time by a few samples; on one level of knots): the last. The first probe runs
+them all. Measured on pick_and_place (issue 36): the probes on the taught motion, CPU 20.0 -> 13.8 s,
+the same saving (12.15 %); the last two stages 15.3 s. The probes of a chain from rest to rest too:
+its 2-move chain's 4.2 -> 3.4 s, the same energies but the probe that breaks a limit (12.1889 %
+-> 12.1888 %)."""
 
 TIME_UNIT = FINE_DT
 """s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
@@ -768,10 +770,14 @@ class CycleOptimizer:
         chain's solves at every duration; the better solve at ``T`` is cached. A unit inside a
         ``MoveL`` segment probes on knots :data:`ON_TAUGHT_KNOTS` apart (its own solves:
         :data:`WITHIN_KNOTS`), the probes compared among themselves (each after the first started from
-        the best probe's path, through the last :data:`PROBE_WARM_STAGES` continuation stages), and
-        the best pass times are then solved as its own solves are, kept where that beats the untuned
-        solve. Nothing for a single
-        move or a MoveL."""
+        the best probe's path, through the last :data:`PROBE_WARM_STAGES` continuation stages, as a
+        chain's probes are after the first); a probe that beats the one at the untuned pass times is
+        kept as the unit's solve at ``T``, else the unit is solved at the untuned pass times as its
+        own solves are. Measured on
+        pick_and_place (issue 36, with the re-timing's scaled search): 19.9 s at 12.19 %; the best
+        pass times solved again on :data:`WITHIN_KNOTS`, kept where that beat the untuned solve
+        there (two solves of 144 variables, about 3 s each), as before: 25.0 s at 12.15 %; solved
+        again without the untuned solve: 22.3 s at 12.15 %. Nothing for a single move or a MoveL."""
         members = self.chains[i]
         if len(members) < 2 or i in self.linear or i in self.tuned or not self.settings.pass_search:
             return
@@ -779,18 +785,19 @@ class CycleOptimizer:
         units = int(round(T / STEP))
         m = self.by_index[i]
         corridor = self.settings.corridor_mm
-        first = self._solve_once(m, units * STEP, units, corridor)  # where it passes them untuned
+        coarse = i in self.within  # probes on wider knots, compared among themselves
+        # where it passes them untuned (a unit inside a MoveL segment: only where no probe wins)
+        first: Solved | None = None if coarse else self._solve_once(m, units * STEP, units, corridor)
         untuned = [t for t, _ in self.waypoints(i, units * STEP)]
         start = tuple(int(round(t / STEP)) for t in untuned)
         seen: dict[tuple[int, ...], Solved] = {}
         probe = replace(self.gradient, give_up=True, max_rounds=min(self.gradient.max_rounds, PROBE_ROUNDS))
-        coarse = i in self.within  # probes on wider knots, compared among themselves; then one solve
         if coarse:
             probe = replace(probe, knot_spacing=max(probe.knot_spacing, ON_TAUGHT_KNOTS))
-        elif all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
+        elif first is not None and all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
             seen[start] = first
 
-        warm = replace(probe, continuation=probe.continuation[-PROBE_WARM_STAGES:])
+        warm = replace(probe, continuation=probe.continuation[-PROBE_WARM_STAGES:], coarse_factor=1)
 
         def energy(edges: tuple[int, ...]) -> float:
             if not self._passes_reachable(i, edges, units):
@@ -799,7 +806,7 @@ class CycleOptimizer:
                 way = tuple(
                     (e * STEP, self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
                 )
-                near = seen.get(best) if coarse and PROBE_WARM_STAGES else None
+                near = seen.get(best) if PROBE_WARM_STAGES else None
                 if near is not None and near.usable and near.coefficients is not None:
                     seen[edges] = self._solve_once(
                         m, units * STEP, units, corridor, way=way, gradient=warm, initial=near.coefficients
@@ -809,9 +816,12 @@ class CycleOptimizer:
             s = seen[edges]
             return s.energy_J if s.usable else np.inf
 
-        best, e_best = start, first.energy_J if first.usable else np.inf
+        best = start
         if coarse:
             e_best = energy(start)
+        else:
+            assert first is not None
+            e_best = first.energy_J if first.usable else np.inf
         won = False
         step = max(1, units // (4 * len(members)) if i not in self.within else 2)
         cap = self.settings.pass_search * len(start)
@@ -828,14 +838,13 @@ class CycleOptimizer:
                         break
             if not moved:
                 step //= 2
-        if won and coarse:  # the best pass times solved as the chain's own solves are
-            way = tuple((e * STEP, self.by_index[j].path.q1) for e, j in zip(best, members[:-1], strict=True))
-            seen[best] = self._solve_once(m, units * STEP, units, corridor, way=way)
-            won = seen[best].usable and (not first.usable or seen[best].energy_J < first.energy_J)
-        if won:
+        if won:  # the best probe (inside a MoveL segment: on its wider knots), verified as every solve is
             self.shares[i] = tuple(e / units for e in best)
             self.cache[(i, units)] = seen[best]
-        elif first.usable:
+            return
+        if first is None:  # no probe beat the untuned pass times: the unit's own solve there
+            first = self._solve_once(m, units * STEP, units, corridor)
+        if first.usable:
             self.cache[(i, units)] = first
 
     def _passes_reachable(self, i: int, edges: tuple[int, ...], units: int) -> bool:
@@ -1082,22 +1091,32 @@ class CycleOptimizer:
     def _chain_shortest(self, i: int, upper: float) -> float:
         """Shortest whole-sample chain duration: the first from half the sum of its moves' shortest
         rest-to-rest durations (``upper``) whose smoothest path through the targets keeps every limit,
-        else ``upper`` (the moves back to back, each from rest to rest, are feasible there)."""
+        else ``upper`` (the moves back to back, each from rest to rest, are feasible there). Found by
+        bisection (the smoothest path at a longer duration is the same path slower, its pass times
+        at the same shares up to whole samples): inspection's chain 72 checks -> 7 (issue 36)."""
         robot = self._robot(self.by_index[i])
         amax = self._amax(robot)
         n_legs = len(self.chains[i])
-        units = max(2 * n_legs + 2, int(np.floor(0.5 * upper / STEP)))
-        while units * STEP < upper - 1e-9:
-            T = units * STEP
-            problem = self._chain_problem(i, T)
+
+        def keeps_limits(units: int) -> bool:
+            if units * STEP >= upper - 1e-9:
+                return True
+            problem = self._chain_problem(i, units * STEP)
             fine = problem.path(problem.origin, fine=True)
-            report = check_limits(
+            return check_limits(
                 robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=self._jmax(robot)
-            )
-            if report.ok:
-                return round(T, 9)
-            units += 1
-        return round(upper, 9)
+            ).ok
+
+        lo = max(2 * n_legs + 2, int(np.floor(0.5 * upper / STEP)))
+        if lo * STEP >= upper - 1e-9:
+            return round(upper, 9)
+        if keeps_limits(lo):
+            return round(lo * STEP, 9)
+        hi = int(np.ceil(upper / STEP - 1e-9))  # lo breaks a limit, hi keeps them (or is upper)
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            lo, hi = (lo, mid) if keeps_limits(mid) else (mid, hi)
+        return round(hi * STEP, 9) if hi * STEP < upper - 1e-9 else round(upper, 9)
 
     def split(self, i: int, s: Solved) -> dict[int, Solved]:
         """A chain's solve cut at its targets into one piece per move (times from 0 in each piece;
@@ -1169,7 +1188,14 @@ class CycleOptimizer:
         return self._plants[key]
 
     def solve(self, i: int, duration: float) -> Solved:
-        """The optimized move ``i`` at ``duration`` (a whole number of 25 ms samples), verified; cached."""
+        """The optimized move ``i`` at ``duration`` (a whole number of 25 ms samples), verified; cached.
+
+        A fly-by chain (not inside a ``MoveL`` segment) with a usable solve at another duration starts
+        from it, stretched to ``duration`` (:meth:`_time_scaled`), on its fine knots through the last
+        continuation stages, and is solved as usual where that is not usable. Measured on
+        pick_and_place (issue 36): its 2-move chain at its shortest duration 5.6 -> 0.6 s of CPU, at
+        the next 0.3 -> 0.2 s, the same energies (to 1 mJ); the cold solve there ended SLSQP's rounds
+        with incompatible constraints."""
         units = int(round(duration / STEP))
         key = (i, units)
         if key in self.cache:
@@ -1183,12 +1209,38 @@ class CycleOptimizer:
             corridors += [first / 2, first / 4, first / 8]
         warm = self._neighbour(i, T) if self.settings.warm_start and len(self.chains[i]) == 1 else None
         out: Solved | None = None
+        chained = len(self.chains[i]) > 1 and i not in self.within
+        near = self._neighbour(i, T) if chained else None
+        if near is not None and near.coefficients is not None:  # a chain: from its nearest duration
+            g = self.gradient
+            refine = replace(g, n_starts=1, coarse_factor=1, continuation=g.continuation[-g.refine_stages :])
+            out = self._solve_once(
+                m, T, units, corridors[0], gradient=refine, initial=self._time_scaled(i, T, near)
+            )
+            if out.usable:
+                self.cache[key] = out
+                return out
         for corridor in corridors:
             out = self._solve_once(m, T, units, corridor, warm)
             if out.usable or not out.limits_ok:
                 break
         assert out is not None
         self.cache[key] = out
+        return out
+
+    def _time_scaled(self, i: int, T: float, near: Solved) -> FloatArray:
+        """The solve ``near`` of chain ``i`` stretched to ``T`` in the coefficients of a solve at ``T``
+        (fine knots, flat; least squares on the fine grid, offsets from the minimum-jerk move): it
+        passes each target at the same share of the duration, as :meth:`waypoints` asks at ``T``."""
+        g = self.gradient
+        basis = SplineBasis(T, knot_spacing=g.spacing_for(T), degree=g.degree, dt=STEP)
+        fine = basis.grid(STEP / g.check_factor)
+        q0, q1 = self.by_index[i].path.q0, self.by_index[self.chains[i][-1]].path.q1
+        default = minimum_jerk(q0, q1, T, dt=STEP / g.check_factor)
+        t_old = default.t * (near.duration / T)
+        q_old = np.column_stack([np.interp(t_old, near.fine.t, near.fine.q[:, j]) for j in range(q0.size)])
+        c = np.asarray(np.linalg.lstsq(fine.B, q_old - default.q, rcond=None)[0], dtype=float)
+        out: FloatArray = c.ravel()
         return out
 
     def _neighbour(self, i: int, T: float) -> Solved | None:
