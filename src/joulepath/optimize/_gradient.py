@@ -138,6 +138,7 @@ class GradientSettings:
     rate_rows: str = "hull"
     hull_refine: int = 3
     precondition: float = 1e-3
+    thin_rows: bool = False
 
     def __post_init__(self) -> None:
         if self.rate_rows not in RATE_ROWS:
@@ -541,6 +542,9 @@ class SplineProblem:
             cons.append({"type": kind, "fun": lambda y: A @ y + b, "jac": lambda y: A})
 
         def nonlinear(rows: Callable[[FloatArray], tuple[FloatArray, FloatArray]]) -> None:
+            # SLSQP asks for the rows' values and their gradient at the same point one after the
+            # other: both come from one evaluation (the same numbers, half the dynamics' derivatives)
+            rows = _last_point(rows)
             if change is None:
                 cons.append({"type": "ineq", "fun": lambda x: rows(x)[0], "jac": lambda x: rows(x)[1]})
                 return
@@ -644,6 +648,22 @@ class SplineProblem:
             worst = max(worst, float(self.deviation(x).max() - self.max_deviation_m) - 1e-9)
         worst = max(worst, self.waypoint_error(x) - WAYPOINT_TOLERANCE)
         return max(worst, 0.0)
+
+
+def _last_point(
+    rows: Callable[[FloatArray], tuple[FloatArray, FloatArray]],
+) -> Callable[[FloatArray], tuple[FloatArray, FloatArray]]:
+    """``rows`` that keeps its last point's result: a second call at an equal point returns it."""
+    last: list[tuple[FloatArray, tuple[FloatArray, FloatArray]]] = []
+
+    def cached(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        if last and np.array_equal(last[0][0], x):
+            return last[0][1]
+        out = rows(x)
+        last[:] = [(np.array(x, dtype=float, copy=True), out)]
+        return out
+
+    return cached
 
 
 def _derivative_controls(
@@ -997,7 +1017,7 @@ def solve_move(
             base=base,
             energy_measure=energy_measure,
             energy_every=settings.energy_every,
-            thin_rows=settings.is_long(duration),
+            thin_rows=settings.thin_rows or settings.is_long(duration),
             rate_rows=settings.rate_rows,
             hull_refine=settings.hull_refine,
         )
