@@ -138,7 +138,6 @@ class GradientSettings:
     rate_rows: str = "hull"
     hull_refine: int = 3
     precondition: float = 1e-3
-    thin_rows: bool = False
 
     def __post_init__(self) -> None:
         if self.rate_rows not in RATE_ROWS:
@@ -1017,7 +1016,7 @@ def solve_move(
             base=base,
             energy_measure=energy_measure,
             energy_every=settings.energy_every,
-            thin_rows=settings.thin_rows or settings.is_long(duration),
+            thin_rows=settings.is_long(duration),
             rate_rows=settings.rate_rows,
             hull_refine=settings.hull_refine,
         )
