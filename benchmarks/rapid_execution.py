@@ -67,9 +67,11 @@ def main() -> None:
 Machine: {machine()}.
 
 Per task: the plan for a sampled interface (EGM, URScript, ROS 2: the full acceleration and jerk limits)
-and the plan for RAPID (within 3/(2π) of the acceleration limit), both against the minimum-jerk move;
+and the plan for RAPID (within 3/(2π) of the acceleration limit; the search of
+`via_point_settings`: hull rows on 0.1 s knots), both against the minimum-jerk move;
 then the written path.mod run by the controller emulation: its optimized move against the controller's
-own `MoveAbsJ \\T` at the same duration, on physics and on the emulated lab robot. Written when the
+own `MoveAbsJ \\T` at the same duration, on physics and on the emulated lab robot (the motion
+its servo runs: the plant's tracking lag). Written when the
 module runs at most 2 % slower than planned, within 5 mm of the planned TCP path, with a saving.
 
 | task | duration | planned, sampled export | planned, RAPID | executed (path.mod), physics | executed, lab | executed duration | via points | TCP off plan | path.mod | RAPID plan wall |

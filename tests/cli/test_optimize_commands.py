@@ -144,3 +144,19 @@ def test_optimize_energy_electrical_without_drive_data_is_refused_in_one_line(tm
     assert not (tmp_path / "run").exists()
     assert main([*args[:-4], "--energy", "meter", "--out", str(tmp_path / "run")]) == 2
     assert "thesis, mechanical, electrical" in capsys.readouterr().err
+
+
+def test_optimize_command_imports_no_data_frames():
+    """`joulepath optimize` reads and writes no tables: its modules import without pandas (a quarter
+    of a second of every run's start)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, joulepath.cli._main, joulepath.cli._optimize, joulepath.optimize, joulepath.export, "
+        "joulepath.sim; print('pandas' in sys.modules)"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
+    )
+    assert out.stdout.strip() == "False"

@@ -99,3 +99,23 @@ def test_refusal_names_the_egm_export(rapid_run, irb120):
     reason = late.refusal()
     assert reason is not None and "--export egm" in reason and "+6.2 %" in reason
     assert execution.refusal() is None
+
+
+def test_tracked_motion_lags_a_ramp_by_the_servos_time_constant(irb120):
+    """The lab robot's servo (``w²/(s² + 2ws + w²)``, critically damped) runs a ramp ``v t`` a time
+    ``2/w`` behind, once its start has died out; a plant without a tracking lag runs the command."""
+    from joulepath.optimize._execute import tracked
+    from joulepath.sim import make_plant
+    from joulepath.trajectory import Trajectory
+
+    lab = make_plant("lab", irb120)
+    t = np.arange(0.0, 1.0 + 1e-9, 0.0025)
+    v = np.linspace(0.5, 1.0, irb120.n_joints)
+    ramp = Trajectory(t=t, q=t[:, None] * v, qd=np.tile(v, (t.size, 1)), qdd=np.zeros((t.size, v.size)))
+    run = tracked(lab, ramp)
+    late = t >= 0.5
+    lag = (ramp.q[late] - run.q[late]) / v
+    np.testing.assert_allclose(lag, 2.0 / (2 * np.pi * lab.tracking_hz), rtol=1e-2)
+    np.testing.assert_allclose(run.qd[late], ramp.qd[late], rtol=1e-6)
+    sim = make_plant("sim", irb120)
+    assert sim.tracking_hz is None and tracked(sim, ramp) is ramp

@@ -179,3 +179,52 @@ def test_default_search_reaches_the_search_before_within_every_limit(irb120):
         saved[label] = e0 - energy_on_samples(irb120, fine, friction=NOMINAL_FRICTION)
     assert saved["before"] > 0.0
     assert saved["default"] >= 0.97 * saved["before"]
+
+
+def test_effort_rows_are_evaluated_once_per_point(irb120, rng, monkeypatch):
+    """SLSQP asks for a nonlinear row's value and gradient at the same point one after the other: one
+    evaluation of the dynamics' derivatives serves both, the same numbers; a new point is evaluated."""
+    problem = _problem(irb120)
+    idx = np.arange(0, 60, 7)
+    plain = problem._effort_rows
+    calls: list[np.ndarray] = []
+
+    def counted(x, idx):
+        calls.append(np.array(x))
+        return plain(x, idx)
+
+    monkeypatch.setattr(problem, "_effort_rows", counted)
+    x = rng.standard_normal(problem.n_var) * 0.02
+    W = rng.standard_normal((problem.n_var, problem.n_var)) * 0.1
+    for change, at in ((None, x), ((x, W), np.zeros(problem.n_var))):
+        calls.clear()
+        (row,) = problem.constraints({"tau": idx}, change)
+        value, grad = row["fun"](at), row["jac"](at)
+        x_at = at if change is None else x + W @ at
+        assert len(calls) == 1
+        want_value, want_grad = plain(x_at, idx)
+        np.testing.assert_array_equal(value, want_value)
+        np.testing.assert_array_equal(grad, want_grad if change is None else want_grad @ W)
+        moved = at.copy()
+        moved[3] += 1e-3  # a point changed in place is a new point
+        row["jac"](moved)
+        row["fun"](moved)
+        assert len(calls) == 2
+        x_moved = moved if change is None else x + W @ moved
+        np.testing.assert_array_equal(row["fun"](moved), plain(x_moved, idx)[0])
+
+
+def test_via_point_plan_searches_the_wide_knots(via_points_run):
+    """The plan for RAPID via points (tests/conftest.py: the fixed task, ``follow="via-points"``) is
+    a spline on knots ``VIA_KNOT_FACTOR`` times ``knot_spacing`` apart (or, at the coarse level, twice
+    that), not on the 0.05 s knots of a streamed path."""
+    from joulepath.optimize import OptimizeConfig
+    from joulepath.optimize._search import VIA_KNOT_FACTOR, via_point_settings
+
+    result, _ = via_points_run
+    spacing = OptimizeConfig().knot_spacing
+    assert via_point_settings(OptimizeConfig())["knot_spacing"] == VIA_KNOT_FACTOR * spacing > spacing
+    T = result.summary.duration_s
+    wide = {SplineBasis(T, knot_spacing=f * VIA_KNOT_FACTOR * spacing).n_free for f in (1, 2)}
+    assert result.parameters.shape[0] in wide
+    assert result.parameters.shape[0] != SplineBasis(T, knot_spacing=spacing).n_free

@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 from scipy.signal import find_peaks
 
 from joulepath._typing import FloatArray
 from joulepath.data._logs import JointLog
 from joulepath.data._schema import FEATURE_SETS, TARGETS, table_columns
 from joulepath.energy import joint_energy
+
+if TYPE_CHECKING:  # pandas is imported where used: an optimization needs no data frames
+    import pandas as pd
 
 REST_SPEED = 1.0 * np.pi / 180.0
 """Joint speed (rad/s) below which every joint counts as at rest: 1 deg/s."""
@@ -236,6 +239,8 @@ def log_to_frame(
         cols[f"E{i + 1}"] = energy[:, i]
     cols["E"] = energy.sum(axis=1)
     cols["dt"] = dt
+    import pandas as pd
+
     frame = pd.DataFrame(cols)
     return frame[list(table_columns(feature_set, n))]
 

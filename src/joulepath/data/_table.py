@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -35,7 +34,9 @@ from joulepath.data._schema import (
 )
 from joulepath.errors import InvalidInput, InvalidLog
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # pandas is imported where used: an optimization needs no data frames
+    import pandas as pd
+
     from joulepath.dynamics import Robot
 
 TCP_TOLERANCE_M = 0.005
@@ -173,6 +174,8 @@ def load_table(path: str | os.PathLike[str]) -> EnergyTable:
 
 def _check_values(frame: pd.DataFrame, p: Path) -> None:
     """Every column numeric and finite (one InvalidLog naming the columns)."""
+    import pandas as pd
+
     text = [str(c) for c, dtype in frame.dtypes.items() if not pd.api.types.is_numeric_dtype(dtype)]
     if text:
         raise InvalidLog(f"{p}: column(s) {', '.join(text)} do not hold numbers; write the table again")
@@ -401,6 +404,8 @@ def ingest(
         )
         offset += n_moves
         frames.append(frame)
+    import pandas as pd
+
     frame = pd.concat(frames, ignore_index=True)
     return EnergyTable(
         frame=frame,

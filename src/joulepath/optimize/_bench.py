@@ -4,16 +4,18 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from joulepath.description import DEFAULT_ROBOT
 from joulepath.dynamics import Robot, load_robot
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize._run import OptimizeConfig, check_default_feasible, optimize_move
 from joulepath.sim import ACCEL_TIME, JERK_TIME
+
+if TYPE_CHECKING:  # imported where used: `joulepath optimize` needs no data frames
+    import pandas as pd
 
 MAX_DRAWS_PER_TASK = 1000
 """Draws :func:`random_tasks` may spend on one feasible task before it gives up."""
@@ -161,6 +163,8 @@ def bench_optimizers(
                 progress(i + 1, total)
     for (label, cfg, _), res in zip(jobs, results, strict=True):
         out.append({"configuration": label, "task": cfg.seed - seed, **res})
+    import pandas as pd
+
     frame = pd.DataFrame(out)
     return frame if per_run else summarize_bench(frame)
 

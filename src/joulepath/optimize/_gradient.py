@@ -541,6 +541,9 @@ class SplineProblem:
             cons.append({"type": kind, "fun": lambda y: A @ y + b, "jac": lambda y: A})
 
         def nonlinear(rows: Callable[[FloatArray], tuple[FloatArray, FloatArray]]) -> None:
+            # SLSQP asks for the rows' values and their gradient at the same point one after the
+            # other: both come from one evaluation (the same numbers, half the dynamics' derivatives)
+            rows = _last_point(rows)
             if change is None:
                 cons.append({"type": "ineq", "fun": lambda x: rows(x)[0], "jac": lambda x: rows(x)[1]})
                 return
@@ -644,6 +647,22 @@ class SplineProblem:
             worst = max(worst, float(self.deviation(x).max() - self.max_deviation_m) - 1e-9)
         worst = max(worst, self.waypoint_error(x) - WAYPOINT_TOLERANCE)
         return max(worst, 0.0)
+
+
+def _last_point(
+    rows: Callable[[FloatArray], tuple[FloatArray, FloatArray]],
+) -> Callable[[FloatArray], tuple[FloatArray, FloatArray]]:
+    """``rows`` that keeps its last point's result: a second call at an equal point returns it."""
+    last: list[tuple[FloatArray, tuple[FloatArray, FloatArray]]] = []
+
+    def cached(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        if last and np.array_equal(last[0][0], x):
+            return last[0][1]
+        out = rows(x)
+        last[:] = [(np.array(x, dtype=float, copy=True), out)]
+        return out
+
+    return cached
 
 
 def _derivative_controls(
