@@ -222,23 +222,28 @@ SHARED_FIXTURE_FILES: dict[str, tuple[str, ...]] = {
     ),
 }
 SLOW_FIRST: tuple[str, ...] = (
-    # units by their time in CI (--durations), the longest first; a unit not listed follows these
+    # units by their summed test durations (`pytest --durations=0`, 2 workers), the longest first;
+    # a unit not listed follows these
     "tiny_run",
     "tests/program/test_cycle.py",
+    "tests/identify/test_currents.py",
     "learn",
-    "tests/docs/test_site.py",
-    "tests/program/test_via_levers.py",
-    "tests/optimize/test_cycle_reference.py",
-    "tests/program/test_export_choice.py",
-    "via_points_run",
     "tests/identify/test_excitation.py",
+    "tests/program/test_cycle_units.py",
+    "tests/docs/test_site.py",
+    "tests/optimize/test_cycle_reference.py",
     "tests/identify/test_experiment_stage.py",
-    "tests/identify/test_identify_cli.py",
-    "tests/arms/test_named_arms.py",
-    "tests/program/test_cell.py",
-    "tests/optimize/test_reference.py",
     "synth",
+    "tests/program/test_via_levers.py",
+    "tests/identify/test_identify.py",
+    "tests/identify/test_identify_cli.py",
+    "tests/program/test_export_choice.py",
+    "tests/optimize/test_segment_reference.py",
+    "tests/optimize/test_retime.py",
+    "tests/cli/test_synth_commands.py",
+    "tests/optimize/test_reference.py",
     "plant",
+    "via_points_run",
     "egm_run",
 )
 
