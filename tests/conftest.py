@@ -193,3 +193,86 @@ class Background:
 @pytest.fixture
 def background() -> Iterator[type[Background]]:
     yield Background
+
+
+# ------------------------------------------------------------- pytest-xdist: test files to workers
+# `make test` runs `pytest -n 2 --dist loadfile`: each test file is one unit of work for one worker.
+# Two refinements of that, for `--dist loadfile` only (any other --dist runs as xdist does):
+# - files that share a session fixture go to one worker together, so that the fixture is built once
+#   per run and not once per worker (a session fixture lives in its worker's process);
+# - the slowest units are handed out first (longest first: the last unit handed out then ends near
+#   the others instead of running alone at the end); every other file follows in xdist's own order.
+# Both only choose where and when a test runs: every test runs, once, as it is written.
+SHARED_FIXTURE_FILES: dict[str, tuple[str, ...]] = {
+    # name of the unit: files (or folders, ending in "/") that use the fixture
+    "tiny_run": (
+        "tests/experiment/test_experiment.py",
+        "tests/experiment/test_run_folders.py",
+        "tests/report/test_report.py",
+    ),
+    "learn": ("tests/learn/",),  # lab_tables, trained (tests/learn/conftest.py)
+    "synth": ("tests/synth/",),  # energy_table, fitted (tests/synth/conftest.py)
+    "plant": ("tests/plant/",),  # mini_plant, reference_run (tests/plant/conftest.py)
+    "via_points_run": ("tests/optimize/test_execute.py", "tests/measure/test_measure.py"),
+    "egm_run": (
+        "tests/cli/test_stream.py",
+        "tests/egm/test_plan.py",
+        "tests/egm/test_server.py",
+        "tests/export/test_egm.py",
+    ),
+}
+SLOW_FIRST: tuple[str, ...] = (
+    # units by their summed test durations (`pytest --durations=0`, 2 workers), the longest first;
+    # a unit not listed follows these
+    "tiny_run",
+    "tests/program/test_cycle.py",
+    "tests/identify/test_currents.py",
+    "learn",
+    "tests/identify/test_excitation.py",
+    "tests/program/test_cycle_units.py",
+    "tests/docs/test_site.py",
+    "tests/optimize/test_cycle_reference.py",
+    "tests/identify/test_experiment_stage.py",
+    "synth",
+    "tests/program/test_via_levers.py",
+    "tests/identify/test_identify.py",
+    "tests/identify/test_identify_cli.py",
+    "tests/program/test_export_choice.py",
+    "tests/optimize/test_segment_reference.py",
+    "tests/optimize/test_retime.py",
+    "tests/cli/test_synth_commands.py",
+    "tests/optimize/test_reference.py",
+    "plant",
+    "via_points_run",
+    "egm_run",
+)
+
+
+def _unit(nodeid: str) -> str:
+    """The unit of work of a test: its file, or the name of the files sharing a session fixture."""
+    path = nodeid.split("::", 1)[0]
+    for name, members in SHARED_FIXTURE_FILES.items():
+        if any(path == m or (m.endswith("/") and path.startswith(m)) for m in members):
+            return name
+    return path
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
+    if config.getoption("dist") != "loadfile":
+        return None  # xdist's own scheduler
+    from xdist.scheduler import LoadFileScheduling
+
+    rank = {name: k for k, name in enumerate(SLOW_FIRST)}
+
+    class SharedFixtureFirstSlow(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return _unit(nodeid)
+
+        def _assign_work_unit(self, node: Any) -> None:
+            # the slowest unit left goes next (min keeps xdist's order among the others)
+            unit = min(self.workqueue, key=lambda u: rank.get(u, len(rank)))
+            self.workqueue.move_to_end(unit, last=False)
+            super()._assign_work_unit(node)
+
+    return SharedFixtureFirstSlow(config, log)
