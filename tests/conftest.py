@@ -99,8 +99,8 @@ def tiny_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
     base = tmp_path_factory.mktemp("tiny-demo")
     toml = _tiny_demo_toml(base, **{"train.targets": '["E", "E1"]'})
-    # the bundled example program's whole cycle, as the [cycle] stage runs it
-    shutil.copy(EXAMPLES / "pick_and_place.mod", base / "cell.mod")
+    # a bundled example program's whole cycle, as the [cycle] stage runs it (the cheapest of the six to plan)
+    shutil.copy(EXAMPLES / "payload_tool.mod", base / "cell.mod")
     toml.write_text(toml.read_text() + '\n[cycle]\nprogram = "cell.mod"\n')
     assert main(["run", str(toml), "--out", str(base / "run"), "--quiet"]) == 0
     return base / "run"
