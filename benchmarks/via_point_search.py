@@ -32,10 +32,10 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import machine, single_core, write_section  # noqa: E402
+from _tasks import NAMED_TASKS  # noqa: E402
 
 single_core()
 
-import numpy as np  # noqa: E402
 
 import joulepath  # noqa: E402
 from joulepath.optimize import OptimizeConfig, optimize_move, random_tasks, rapid_execution  # noqa: E402
@@ -48,15 +48,7 @@ from joulepath.optimize._search import (  # noqa: E402
 )
 
 RESULTS = Path(__file__).resolve().parent / "results"
-TASKS = [
-    (
-        "fixed task",
-        np.array([0.3, 0.2, -0.4, 0.5, -0.6, 1.0]),
-        np.array([-0.9, 0.6, 0.3, -1.2, 0.8, -1.5]),
-        1.6,
-    ),
-    ("README move", np.radians([-60, 10, -30, 40, 20, 0]), np.radians([70, 30, 10, -50, -40, 90]), 1.5),
-]
+TASKS = NAMED_TASKS
 CANDIDATES: dict[str, tuple[str, Any]] = {
     "grid": ("GRID_SEARCH on the 0.05 s knots (main's via-point search)", lambda c: dict(GRID_SEARCH)),
     "hull": ("hull rows, preconditioned (the single move's default), 0.05 s knots", lambda c: {}),
