@@ -370,3 +370,9 @@ def test_a_module_over_its_baseline_time_is_first_brought_into_it(robot):
         spec_f, robot, energy="thesis", text=fine, baseline=(t_f - over, 1e9, 1e9), max_evaluations=400
     )
     assert lv_f.cycle_s > t_f - over
+
+
+def test_a_search_stopped_by_its_time_budget_reports_the_plans_it_made(robot):
+    spec = _spec(JOINT_CYCLE, robot)
+    lv = levers_module(spec, robot, energy="thesis", text=JOINT_CYCLE, max_seconds=1e-9, max_evaluations=400)
+    assert 1 <= lv.n_evaluations <= 400  # the plans made, not the marker that stopped the search

@@ -942,7 +942,7 @@ def levers_module(
         written_text=written,
         encoding=encoding,
         reads_back=differs,
-        n_evaluations=ev.n,
+        n_evaluations=len(ev.memo),  # the plans made (ev.n is set past the budget when time runs out)
         wall_s=time.perf_counter() - start,
         waits=tuple((line, idle[line][0], sec) for line, sec in sorted(new_waits.items())),
     )

@@ -327,7 +327,7 @@ def task_levers(
         written_text="",
         encoding="utf-8",
         reads_back=differs,
-        n_evaluations=ev.n,
+        n_evaluations=len(ev.memo),  # the plans made (ev.n is set past the budget when time runs out)
         wall_s=time.perf_counter() - start,
         written_files=tuple(sorted(texts.items())),
     )
