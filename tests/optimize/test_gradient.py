@@ -502,3 +502,30 @@ def test_a_deadline_stops_the_search_where_it_is(irb120):
     assert free.n_iterations > 5
     assert late.n_iterations <= 1
     assert len(late.starts) == 1
+
+
+def test_an_initial_path_on_other_knots_is_not_used(irb120):
+    """A start whose size is not the search's (a search its deadline stopped on its coarse knots) is left
+    aside: the search runs as it would without one, to the same result."""
+    from joulepath.optimize import GradientSettings
+    from joulepath.optimize._gradient import solve_move
+
+    settings = GradientSettings(knot_spacing=0.1, coarse_factor=1, max_rounds=2)
+
+    def run(initial):
+        res, problem = solve_move(
+            irb120,
+            Q0,
+            QF,
+            1.6,
+            friction=irb120.friction,
+            settings=settings,
+            rng=np.random.default_rng(1),
+            initial=initial,
+        )
+        return res, problem
+
+    plain, problem = run(None)
+    other = np.zeros(problem.m * problem.n + 7)  # a path on other knots
+    again, _ = run(other)
+    np.testing.assert_array_equal(again.path.q, plain.path.q)

@@ -995,7 +995,8 @@ def solve_move(
     from :attr:`Robot.drivetrain`. ``deadline`` (``time.perf_counter()``): past it the search
     stops where it is (:func:`optimize_spline`). ``initial``: the start (coefficients on the fine
     knots, flat) in place of the smoothest path, for a search on one level of knots only
-    (``coarse_factor`` 1 or a move too short for two levels); refused otherwise.
+    (``coarse_factor`` 1 or a move too short for two levels); refused otherwise. A path on other
+    knots (a search its deadline stopped at its coarse level) is not used: the search starts as without.
     """
 
     def make(spacing: float) -> SplineProblem:
@@ -1023,6 +1024,8 @@ def solve_move(
 
     spacing = settings.spacing_for(duration)
     fine = make(spacing)
+    if initial is not None and np.asarray(initial).size != fine.m * fine.n:
+        initial = None  # a path on other knots (a search its deadline stopped on its coarse level)
     coarse_spacing = spacing * settings.coarse_factor
     if settings.coarse_factor <= 1 or round(duration / coarse_spacing) < 2:
         return optimize_spline(fine, settings, rng=rng, initial=initial, deadline=deadline), fine
