@@ -12,7 +12,6 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from joulepath import load_robot
 from joulepath.program import CycleSettings, optimize_cycle, parse_module, resolve_module
 from joulepath.program._levers import _Evaluator
 from joulepath.program._output import written_rapid
@@ -45,20 +44,15 @@ CONFIG = ControllerConfig()
 
 
 @pytest.fixture(scope="module")
-def robot():
-    return load_robot("irb120")
-
-
-@pytest.fixture(scope="module")
-def dense(robot):
+def dense(irb120):
     """The plan's via-point module with the points at equal arc length, read as written."""
-    spec = resolve_module(parse_module(PROGRAM, path="views.mod"), robot)
+    spec = resolve_module(parse_module(PROGRAM, path="views.mod"), irb120)
     settings = CycleSettings(table_points=2, pass_search=0)
     settings = replace(settings, gradient=replace(settings.gradient, knot_spacing=0.1))
     result, _ = optimize_cycle(spec, settings)
     plan = result.unretimed or result
     text = _plain(written_rapid(replace(plan, vias=dense_vias(plan, spacing=0.1))).text)
-    return spec, text, resolve_module(parse_module(text, path="views (via points)"), robot)
+    return spec, text, resolve_module(parse_module(text, path="views (via points)"), irb120)
 
 
 def _run(text: str, robot) -> tuple[float, float]:
@@ -91,7 +85,7 @@ def test_the_conditions_agree_with_the_emulation_on_whether_a_chain_holds(dense)
     assert agree[True] > 0 and agree[False] > 0, agree  # both sides seen
 
 
-def test_timed_module_keeps_its_chains_the_taught_cycle_and_changes_only_the_times(robot, dense):
+def test_timed_module_keeps_its_chains_the_taught_cycle_and_changes_only_the_times(irb120, dense):
     spec, text, spec_d = dense
     _, t_taught, e_taught = _Evaluator(spec, [], "thesis", CONFIG)(())
     timed = time_chains(
@@ -101,7 +95,7 @@ def test_timed_module_keeps_its_chains_the_taught_cycle_and_changes_only_the_tim
         measure="thesis",
         config=CONFIG,
         cycle_s=t_taught,
-        run_cycle=lambda c: _run(c, robot),
+        run_cycle=lambda c: _run(c, irb120),
     )
     assert timed.timed >= 1
     # only \T values differ, and only on the lines of the added procedures
@@ -112,14 +106,14 @@ def test_timed_module_keeps_its_chains_the_taught_cycle_and_changes_only_the_tim
     for k in changed:
         assert T_ARG.sub("", before[k - 1]) == T_ARG.sub("", after[k - 1])
     # read again by the interpreter (the other reader) and run: every timed chain holds, the taught time kept
-    plan = plan_cycle(as_sequence(read_written(timed.text, "views.mod", robot)), CONFIG)
+    plan = plan_cycle(as_sequence(read_written(timed.text, "views.mod", irb120)), CONFIG)
     assert plan.cycle_time <= t_taught + 1e-6
     written = {m.step.line for m in plan.moves if isinstance(m.profile, ChainProfile)}
-    again = resolve_module(parse_module(timed.text, path="views (via points)"), robot)
+    again = resolve_module(parse_module(timed.text, path="views (via points)"), irb120)
     for run in chain_runs(again, _added_lines(again)):
         assert {again.steps[i].line for i in run.steps} <= written
     # the plan's own times, which break the chain on the controller, cost more than the timed ones
-    t_dense, e_dense = _run(text, robot)
-    t_timed, e_timed = _run(timed.text, robot)
+    t_dense, e_dense = _run(text, irb120)
+    t_timed, e_timed = _run(timed.text, irb120)
     assert t_timed <= t_taught + 1e-6 and (t_dense > t_taught or e_timed < e_dense)
     assert re.search(r"\\T:=\d+\.\d{4},", timed.text)

@@ -39,7 +39,7 @@ from joulepath.errors import InvalidInput, JoulepathError, LimitViolation
 from joulepath.program._levers import LeverResult, _Evaluator, cycle_motion, levers_module
 from joulepath.program._parse import parse_module
 from joulepath.program._resolve import CycleSpec, resolve_module
-from joulepath.program._via_timing import T_ARG, dense_vias, time_chains
+from joulepath.program._via_timing import T_ARG, _written, dense_vias, time_chains
 from joulepath.sim import ControllerConfig, PlannedCycle, tcp_pose
 from joulepath.trajectory import Trajectory
 
@@ -93,7 +93,7 @@ def _scaled(text: str, lines: set[int], factor: float) -> str:
     """``text`` with every ``\\T`` on ``lines`` times ``factor`` (to 0.1 ms, at least 1 ms)."""
 
     def times(m: re.Match[str]) -> str:
-        return f"{m.group(1)}{max(0.001, round(float(m.group(2)) * factor, 4)):.4f}"
+        return _written(float(m.group(2)) * factor)(m)
 
     out = text.splitlines(keepends=True)
     for k in lines:
@@ -339,7 +339,7 @@ def via_levers(
         bases = [(*old, only_sets)]
         if timed_chains:  # the plan's points kept at equal arc length, their \T timed for the controller
             dense = _plain(written_rapid(replace(plan, vias=dense_vias(plan))).text)
-            spec_d = run(dense)[0]
+            spec_d = resolve_module(parse_module(dense, path=path), robot)
             timed = time_chains(
                 dense,
                 spec_d,
@@ -352,7 +352,8 @@ def via_levers(
             )
             # not fitted by shortening its \T (that breaks its chains): over the taught time, the lever
             # search brings it in
-            spec_t, t_t, e_t = run(timed.text)
+            spec_t = resolve_module(parse_module(timed.text, path=path), robot)
+            t_t, e_t = timed.cycle_s, timed.energy_J
             bases.append((timed.text, spec_t, t_t, e_t, 0, (None,)))  # every statement: it may be over
             timed_n = timed.timed
     except JoulepathError as err:
