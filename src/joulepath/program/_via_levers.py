@@ -36,7 +36,9 @@ from joulepath import __version__
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, JoulepathError, LimitViolation
+from joulepath.optimize._retime import tcp_velocity
 from joulepath.program._levers import LeverResult, _Evaluator, cycle_motion, levers_module
+from joulepath.program._line_speed import SPEED_TOL, LineSpeed, fastest_on_lines, line_speeds
 from joulepath.program._parse import parse_module
 from joulepath.program._resolve import CycleSpec, resolve_module
 from joulepath.program._via_timing import T_ARG, _written, dense_vias, time_chains
@@ -109,9 +111,11 @@ def _fitted(
     e: float,
     t_taught: float,
     run: Callable[[str], tuple[CycleSpec, float, float]],
+    keeps: Callable[[str], bool],
 ) -> tuple[str, CycleSpec, float, float]:
     """A module over the taught cycle time with every via point's ``\\T`` shortened by one factor,
-    until it fits (at most :data:`TIME_FITS` tries; as it was where shortening does not help)."""
+    until it fits (at most :data:`TIME_FITS` tries; as it was where shortening does not help, or
+    where it runs a ``MoveL``'s line faster than its speed data: ``keeps(module)`` false)."""
     as_planned, factor = text, 1.0
     added = _added_lines(spec)
     for _ in range(TIME_FITS):
@@ -120,7 +124,7 @@ def _fitted(
         factor *= t_taught / t * (1.0 - 1e-3)
         scaled = _scaled(as_planned, added, factor)
         spec_s, t_s, e_s = run(scaled)
-        if t_s >= t:
+        if t_s >= t or not keeps(scaled):
             break
         text, spec, t, e = scaled, spec_s, t_s, e_s
     return text, spec, t, e
@@ -238,6 +242,18 @@ def _with_header(text: str, header: list[str]) -> str:
     return "".join([*lines[: at + 1], *(indent + h + newline for h in header), *lines[at + 1 :]])
 
 
+def _fastest_on_lines(lines: tuple[LineSpeed, ...], plan: PlannedCycle) -> tuple[float, LineSpeed | None]:
+    """The largest ratio of the cycle's TCP speed to the speed data of the taught ``MoveL`` line it
+    runs on (:func:`joulepath.program._line_speed.fastest_on_lines`), and that line."""
+    if not lines:
+        return 1.0, None
+    traj = cycle_motion(plan)
+    first = plan.moves[0].step
+    assert first.robot is not None and first.tcp is not None
+    pos, _ = tcp_pose(first.robot, traj.q, first.tcp)
+    return fastest_on_lines(lines, pos, tcp_velocity(first.robot, traj.q, traj.qd, first.tcp))
+
+
 def _tcp_path(plan: PlannedCycle) -> tuple[FloatArray, Trajectory]:
     """The cycle's TCP positions (m) and motion on the 2.5 ms grid (the first move's robot and tool)."""
     traj = cycle_motion(plan)
@@ -308,18 +324,33 @@ def via_levers(
     plan_t, t_taught, _ = taught(())
     e_taught, lab_taught = taught.energies(plan_t)
     path = f"{spec.module.path} (via points)"
+    lines = line_speeds(plan_t)
+    on_lines: dict[str, tuple[float, LineSpeed | None]] = {}  # per module: its fastest on a MoveL line
 
     def run(candidate: str) -> tuple[CycleSpec, float, float]:
         spec_c = resolve_module(parse_module(candidate, path=path), robot)
-        _, t_c, e_c = _Evaluator(spec_c, [], energy, config)(())
+        plan_c, t_c, e_c = _Evaluator(spec_c, [], energy, config)(())
+        on_lines[candidate] = _fastest_on_lines(lines, plan_c)
         return spec_c, t_c, e_c
+
+    def keeps_lines(candidate: str) -> bool:
+        return on_lines[candidate][0] <= 1.0 + SPEED_TOL
 
     def fit(candidate: str) -> tuple[str, CycleSpec, float, float, int]:
         """The module within the taught cycle time: its ``\\T`` shortened, else units put back as taught
         (the cheapest that fits, else the one that saves most time)."""
         spec_v, t_v, e_v = run(candidate)
-        candidate, spec_v, t_v, e_v = _fitted(candidate, spec_v, t_v, e_v, t_taught, run)
         back = 0
+        while not keeps_lines(candidate):  # units that run a MoveL's line faster than its speed data go back
+            backs = [(_reverted(candidate, u), *run(_reverted(candidate, u))) for u in _units(candidate)]
+            if not backs:
+                break
+            keep = [x for x in backs if keeps_lines(x[0])]
+            candidate, spec_v, t_v, e_v = (
+                min(keep, key=lambda x: x[3]) if keep else min(backs, key=lambda x: on_lines[x[0]][0])
+            )
+            back += 1
+        candidate, spec_v, t_v, e_v = _fitted(candidate, spec_v, t_v, e_v, t_taught, run, keeps_lines)
         while t_v > t_taught + _TOL_S:
             tries = [run(_reverted(candidate, u)) + (u,) for u in _units(candidate)]
             if not tries:
@@ -328,7 +359,9 @@ def via_levers(
             spec_r, t_r, e_r, u = min(fits, key=lambda x: x[2]) if fits else min(tries, key=lambda x: x[1])
             if t_r >= t_v - _TOL_S:
                 break
-            candidate, spec_v, t_v, e_v = _fitted(_reverted(candidate, u), spec_r, t_r, e_r, t_taught, run)
+            candidate, spec_v, t_v, e_v = _fitted(
+                _reverted(candidate, u), spec_r, t_r, e_r, t_taught, run, keeps_lines
+            )
             back += 1
         return candidate, spec_v, t_v, e_v, back
 
@@ -349,13 +382,15 @@ def via_levers(
                 cycle_s=t_taught,
                 run_cycle=lambda c: run(c)[1:],
                 max_seconds=max_seconds,
+                speeds=lines,
             )
             # not fitted by shortening its \T (that breaks its chains): over the taught time, the lever
             # search brings it in
             spec_t = resolve_module(parse_module(timed.text, path=path), robot)
             t_t, e_t = timed.cycle_s, timed.energy_J
-            bases.append((timed.text, spec_t, t_t, e_t, 0, (None,)))  # every statement: it may be over
-            timed_n = timed.timed
+            if keeps_lines(timed.text):  # its chains on a MoveL's line are timed within its speed data
+                bases.append((timed.text, spec_t, t_t, e_t, 0, (None,)))  # every statement: it may be over
+                timed_n = timed.timed
     except JoulepathError as err:
         return ViaLevers(None, f"the via-point module cannot be read: {err}")
     text, via_spec, t_via, e_via, reverted, _ = min(

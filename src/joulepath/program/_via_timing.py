@@ -33,8 +33,9 @@ from scipy.optimize import minimize
 
 from joulepath._typing import FloatArray
 from joulepath.program._levers import _Evaluator
+from joulepath.program._line_speed import LineSpeed, chord_floor
 from joulepath.program._resolve import CycleSpec
-from joulepath.sim import ControllerConfig
+from joulepath.sim import ControllerConfig, tcp_pose
 from joulepath.sim._limits import acceleration_limit
 from joulepath.sim._timing import ChainProfile, acc_share, stops_after
 
@@ -113,7 +114,14 @@ def chain_runs(spec: CycleSpec, lines: set[int]) -> list[_Run]:
 class _Chain:
     """A run on its own, from rest to rest: its conditions on the times, its motion on the emulation."""
 
-    def __init__(self, spec: CycleSpec, run: _Run, measure: str, config: ControllerConfig) -> None:
+    def __init__(
+        self,
+        spec: CycleSpec,
+        run: _Run,
+        measure: str,
+        config: ControllerConfig,
+        lines: tuple[LineSpeed, ...] = (),
+    ) -> None:
         self.run = run
         self.base = [spec.steps[i] for i in run.steps]
         self.tail = None if run.tail is None else spec.steps[run.tail]
@@ -137,6 +145,13 @@ class _Chain:
             paths.path(s, np.asarray(qs[j]), spec.source).length_mm for j, s in enumerate(self.base)
         ]
         self.share = [acc_share(s) for s in self.base]
+        tcp = self.base[0].tcp
+        assert tcp is not None
+        pos, _ = tcp_pose(robot, np.asarray(qs, dtype=float), tcp)
+        # a segment on a taught MoveL's line: no shorter than its length at the line's speed data
+        self.floor = np.array(
+            [(1.0 + MARGIN) * chord_floor(lines, pos[j], pos[j + 1]) for j in range(len(self.base))]
+        )
 
     def spec_at(self, T: FloatArray) -> CycleSpec:
         timed = [replace(s, time_s=float(t)) for s, t in zip(self.base, T, strict=True)]
@@ -181,6 +196,8 @@ class _Chain:
             for w in sides[k]:
                 out.extend(amax * w - dv)
                 out.extend(amax * w + dv)
+        on_line = self.floor > 0.0
+        out.extend((T[on_line] - (1.0 + extra) * self.floor[on_line]).tolist())
         return np.asarray(out)
 
     def motion(self, T: FloatArray) -> tuple[bool, float, float]:
@@ -270,17 +287,19 @@ def time_chains(
     cycle_s: float,
     run_cycle: Callable[[str], tuple[float, float]],
     max_seconds: float | None = None,
+    speeds: tuple[LineSpeed, ...] = (),
 ) -> TimedChains:
     """``text`` (the via-point module read as ``spec``) with the ``\\T`` of each chain of the added
     procedures' ``lines`` timed for the controller (module docstring); ``cycle_s``: the taught
     cycle time the whole module must keep; ``run_cycle(text) -> (cycle s, energy J)``: the whole
     module on the emulation; ``max_seconds``: wall time of the searches (after it, each chain is
-    written at its shortest times, stretched over its budget where that holds)."""
+    written at its shortest times, stretched over its budget where that holds); ``lines``: the taught
+    ``MoveL`` lines, whose speed data bounds each chain segment on them."""
     deadline = None if max_seconds is None else time.perf_counter() + max_seconds
     chains: list[tuple[_Chain, FloatArray, float, float]] = []  # chain, fastest, its time, the plan's
     kept = 0
     for run in chain_runs(spec, lines):
-        chain = _Chain(spec, run, measure, config)
+        chain = _Chain(spec, run, measure, config, speeds)
         T0 = np.asarray([chain.spec.steps[i].time_s for i in run.steps], dtype=float)
         tail_s = 0.0 if chain.tail is None or chain.tail.time_s is None else float(chain.tail.time_s)
         fast = _fastest(chain, T0)
