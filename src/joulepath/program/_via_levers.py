@@ -32,6 +32,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
+import numpy as np
+
 from joulepath import __version__
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
@@ -242,16 +244,27 @@ def _with_header(text: str, header: list[str]) -> str:
     return "".join([*lines[: at + 1], *(indent + h + newline for h in header), *lines[at + 1 :]])
 
 
-def _fastest_on_lines(lines: tuple[LineSpeed, ...], plan: PlannedCycle) -> tuple[float, LineSpeed | None]:
+def _fastest_on_lines(
+    lines: tuple[LineSpeed, ...], plan: PlannedCycle, added: set[int]
+) -> tuple[float, LineSpeed | None]:
     """The largest ratio of the cycle's TCP speed to the speed data of the taught ``MoveL`` line it
-    runs on (:func:`joulepath.program._line_speed.fastest_on_lines`), and that line."""
+    runs on (:func:`joulepath.program._line_speed.fastest_on_lines`), and that line; outside the
+    blends the controller makes between a statement of the program and the next (superposed, as in
+    the taught cycle), inside those between two statements added on ``added`` lines (a via-point
+    chain's corners, whose times were chosen here)."""
     if not lines:
         return 1.0, None
     traj = cycle_motion(plan)
     first = plan.moves[0].step
     assert first.robot is not None and first.tcp is not None
-    pos, _ = tcp_pose(first.robot, traj.q, first.tcp)
-    return fastest_on_lines(lines, pos, tcp_velocity(first.robot, traj.q, traj.qd, first.tcp))
+    own = np.ones(traj.t.size, dtype=bool)
+    moving = [m for m in plan.moves if m.profile.duration > 0]
+    for a, b in zip(moving, moving[1:], strict=False):
+        if b.t0 < a.t_end and not (a.step.line in added and b.step.line in added):
+            own &= (traj.t < b.t0) | (traj.t > a.t_end)
+    pos, _ = tcp_pose(first.robot, traj.q[own], first.tcp)
+    vel = tcp_velocity(first.robot, traj.q[own], traj.qd[own], first.tcp)
+    return fastest_on_lines(lines, pos, vel)
 
 
 def _tcp_path(plan: PlannedCycle) -> tuple[FloatArray, Trajectory]:
@@ -330,7 +343,7 @@ def via_levers(
     def run(candidate: str) -> tuple[CycleSpec, float, float]:
         spec_c = resolve_module(parse_module(candidate, path=path), robot)
         plan_c, t_c, e_c = _Evaluator(spec_c, [], energy, config)(())
-        on_lines[candidate] = _fastest_on_lines(lines, plan_c)
+        on_lines[candidate] = _fastest_on_lines(lines, plan_c, _added_lines(spec_c))
         return spec_c, t_c, e_c
 
     def keeps_lines(candidate: str) -> bool:
@@ -371,7 +384,7 @@ def via_levers(
         only_sets: tuple[set[int] | None, ...] = (None, _added_lines(old[1]))
         bases = [(*old, only_sets)]
         if timed_chains:  # the plan's points kept at equal arc length, their \T timed for the controller
-            dense = _plain(written_rapid(replace(plan, vias=dense_vias(plan))).text)
+            dense = _plain(written_rapid(replace(plan, vias=dense_vias(plan, taught=plan_t))).text)
             spec_d = resolve_module(parse_module(dense, path=path), robot)
             timed = time_chains(
                 dense,

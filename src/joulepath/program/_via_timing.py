@@ -35,7 +35,7 @@ from joulepath._typing import FloatArray
 from joulepath.program._levers import _Evaluator
 from joulepath.program._line_speed import LineSpeed, chord_floor
 from joulepath.program._resolve import CycleSpec
-from joulepath.sim import ControllerConfig, tcp_pose
+from joulepath.sim import ControllerConfig, PlannedCycle, tcp_pose
 from joulepath.sim._limits import acceleration_limit
 from joulepath.sim._timing import ChainProfile, acc_share, stops_after
 
@@ -45,11 +45,20 @@ MARGIN = 0.03
 """Share of each corner's and ramp's condition kept in reserve, so that the chain holds on the
 controller with the times rounded as written (0.1 ms)."""
 FITS = 3
-"""Rounds, at most, of giving up the chains' spare time when the module runs over the taught cycle."""
+"""Rounds, at most, of fitting the chains' budgets to the taught cycle: giving up their spare time
+when the module runs over it, sharing the time left over when it runs under it."""
+GIVE_S = 0.01
+"""s: a module this much under the taught cycle shares the time left over among its chains."""
+GIVE_SHARE = 0.95
+"""Share of the time left over that is given to the chains (their time on their own is not quite
+what they add to the cycle)."""
 _MAX_ITER = 30
 FREEDOM = 0.02
 """A chain whose shortest time is within this share of its budget is written at its shortest (no
 time to spend on a search)."""
+BLEND_ROOM = 2.0
+"""The via point next to a kept move that blends into a unit (or out of it) is at least this many
+times the taught blend's time from the unit's end (the blend lasts at most half of either move)."""
 T_ARG = re.compile(r"(\\T\s*:=\s*)(\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)")
 """A move's ``\\T`` argument: the text before its value, and the value (s)."""
 
@@ -336,6 +345,10 @@ def time_chains(
         t_c, e_c = run_cycle(candidate)
         tried.append((t_c, e_c, candidate))
         excess = t_c - cycle_s
+        if excess < -GIVE_S and chains:  # under the taught cycle: the time left over shared by the chains
+            whole = sum(budgets)
+            budgets = [b - GIVE_SHARE * excess * b / whole for b in budgets]
+            continue
         spare = [b - tf for b, (_, _, tf, _) in zip(budgets, chains, strict=True)]
         total = sum(s for s in spare if s > 0)
         if excess <= 1e-6 or total <= 1e-9:
@@ -354,14 +367,52 @@ def _written(t: float) -> Callable[[re.Match[str]], str]:
     return lambda m: f"{m.group(1)}{max(0.001, round(t, 4)):.4f}"
 
 
-def dense_vias(plan: Any, spacing: float = VIA_SPACING_S) -> dict[int, tuple[int, ...]]:
+def dense_vias(
+    plan: Any, spacing: float = VIA_SPACING_S, taught: PlannedCycle | None = None
+) -> dict[int, tuple[int, ...]]:
     """Per optimized move of ``plan`` (a :class:`~joulepath.program.CycleResult`), via points at equal
-    TCP arc length about ``spacing`` s apart (:func:`joulepath.sim._via._leg_indices`), none dropped."""
+    TCP arc length about ``spacing`` s apart (:func:`joulepath.sim._via._leg_indices`), none dropped
+    but where a taught move blends into a joint move's unit or out of it (``taught``: the taught
+    cycle as the controller runs it). There the controller blends by superposition for at most half
+    of either move's time, so the via point next to the kept move is kept at least twice the taught
+    blend's time away (:func:`_clear_of_blends`); nearer, the blend shrinks and the kept move runs
+    almost to its target first, which costs the cycle the rest of the blend."""
     from joulepath.sim._via import _leg_indices
 
+    steps = plan.spec.steps
+    blends: dict[int, tuple[float, float]] = {}  # per move: the taught blends into it and out of it (s)
+    if taught is not None:
+        moving = [m for m in taught.moves if m.profile.duration > 0]
+        for k, m in enumerate(moving):
+            into = max(0.0, moving[k - 1].t_end - m.t0) if k > 0 else 0.0
+            out_of = max(0.0, m.t_end - moving[k + 1].t0) if k + 1 < len(moving) else 0.0
+            blends[m.index] = (into, out_of)
+    moves = [k for k, st in enumerate(steps) if st.kind == "move"]
+    where = {k: n for n, k in enumerate(moves)}
     out: dict[int, tuple[int, ...]] = {}
     for i in plan.vias:
-        step = plan.spec.steps[i]
+        step = steps[i]
         assert step.robot is not None and step.tcp is not None
-        out[i] = tuple(_leg_indices(step.robot, step.tcp, plan.paths[i].fine, spacing))
+        fine = plan.paths[i].fine
+        idx = _leg_indices(step.robot, step.tcp, fine, spacing)
+        n = where[i]
+        before = moves[n - 1] if n > 0 else None
+        after = moves[n + 1] if n + 1 < len(moves) else None
+        if step.linear or i not in blends:  # a MoveL's via points stay on its line, at its speed data
+            out[i] = tuple(idx)
+            continue
+        into, out_of = blends[i]
+        if before is None or before in plan.vias:
+            into = 0.0
+        if after is None or after in plan.vias:
+            out_of = 0.0
+        out[i] = _clear_of_blends(fine.t, idx, BLEND_ROOM * into, BLEND_ROOM * out_of)
     return out
+
+
+def _clear_of_blends(t: FloatArray, idx: list[int], head: float, tail: float) -> tuple[int, ...]:
+    """``idx`` (sample indices into times ``t``) without the via points in the move's first ``head``
+    and last ``tail`` seconds (its target, the last index, always kept)."""
+    end = float(t[-1])
+    kept = [k for k in idx[:-1] if t[k] >= head - 1e-9 and t[k] <= end - tail + 1e-9]
+    return (*kept, idx[-1])
