@@ -484,15 +484,15 @@ LONG_PROBE_KNOTS = 0.15
 themselves on these knots, through the continuation stages but the last, and only the best pass times
 are solved as the chain's own solves are. Measured on the long fly-by chain of issue 36 (8 legs, 5.3 s,
 one BLAS thread, CPU s per probe): on its own 0.083 s knots through every stage 13.5 s cold, 11-13 s
-from the best probe's path; on 0.15 s knots through the first two 2.6 s cold, 0.8-1.6 s from the best
-probe's path shifted in time (:meth:`CycleOptimizer._time_warped`), the same energies as cold to 0.3 mJ,
-and the same order of the probes as on the own knots (a step of 75 ms of the first pass time: +0.23 J
-on 0.15 s knots, +0.29 J on its own)."""
+from the best probe's path shifted in time (:meth:`CycleOptimizer._time_warped`); on 0.15 s knots
+through the first two stages 2.6 s cold, 0.8-2.6 s (1.5 s on average) from that shifted path, the
+same energies as cold to 0.3 mJ, and the probes in the same order as on its own knots (a step of 75 ms
+of the first pass time: +0.23 J on 0.15 s knots, +0.29 J on its own)."""
 LONG_PROBES = 2
 """Pass-time probes per inner target, at most, in a row without a gain, of a long chain's search (its
-first step 1/8 of a leg; ``pass_search`` per target in all, at most).
-Measured on the long fly-by chain of issue 36: the pattern search run on to 53 probes found pass times
-0.017 % better than the untuned ones (on the probes' knots), at 1.2 s a probe; 14 probes find none."""
+first step 1/8 of a leg; ``pass_search`` per target in all, at most). Measured on the long fly-by
+chain of issue 36: the pattern search run on to 53 probes (about 1.4 s each) found pass times 0.017 %
+better than the untuned ones on the probes' knots, within the scatter of the solves; 14 find none."""
 
 TIME_UNIT = FINE_DT
 """s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
@@ -796,7 +796,7 @@ class CycleOptimizer:
         at most :data:`LONG_PROBES` per target in a row without a gain, its first step 1/8 of a leg;
         the chain is then solved at the untuned pass times and, where a probe won, at the best
         probe's, and the better is kept (the long fly-by chain of issue 36: 56 probes of 7-9 s each,
-        every one ending at the smoothest path, -> 14 of about 1.3 s). Measured on
+        every one ending at the smoothest path, -> 14 of about 1.5 s). Measured on
         pick_and_place (issue 36, with the re-timing's scaled search): 19.9 s at 12.19 %; the best
         pass times solved again on :data:`WITHIN_KNOTS`, kept where that beat the untuned solve
         there (two solves of 144 variables, about 3 s each), as before: 25.0 s at 12.15 %; solved
