@@ -130,7 +130,9 @@ class CycleSettings:
     planned). A shape added to the taught motion keeps the ``gradient``'s own (measured: on the
     bundled examples the finer grid there saved less, e.g. payload_tool 3.8 % against 4.2 %). ``pass_search``:
     solves per inner target, at most, of the search for when a chain passes its targets
-    (:meth:`CycleOptimizer.tune_passes`; 0: in proportion to each move's shortest duration).
+    (:meth:`CycleOptimizer.tune_passes`; a long chain's probes, on wider knots, stop after
+    :data:`LONG_PROBES` per target in a row without a gain; 0: no search, the targets passed in
+    proportion to each move's shortest duration).
     ``retime_segments``: with ``"samples"``, every segment with a ``MoveL`` is at last re-timed
     along its own joint path in the chosen cycle (:meth:`CycleOptimizer.retime_segments`: the
     lines, blends and zones as they are, the speeddata a bound, the segment's duration kept).
@@ -476,6 +478,21 @@ them all. Measured on pick_and_place (issue 36): the probes on the taught motion
 the same saving (12.15 %); the last two stages 15.3 s. The probes of a chain from rest to rest too:
 its 2-move chain's 4.2 -> 3.4 s, the same energies but the probe that breaks a limit (12.1889 %
 -> 12.1888 %)."""
+LONG_PROBE_KNOTS = 0.15
+"""s between knots, at least, of a pass-time probe of a long chain (one past the gradient's
+``max_knots`` at its knot spacing, :meth:`GradientSettings.is_long`): its probes are compared among
+themselves on these knots, through the continuation stages but the last, and only the best pass times
+are solved as the chain's own solves are. Measured on the long fly-by chain of issue 36 (8 legs, 5.3 s,
+one BLAS thread, CPU s per probe): on its own 0.083 s knots through every stage 13.5 s cold, 11-13 s
+from the best probe's path shifted in time (:meth:`CycleOptimizer._time_warped`); on 0.15 s knots
+through the first two stages 2.6 s cold, 0.8-2.6 s (1.5 s on average) from that shifted path, the
+same energies as cold to 0.3 mJ, and the probes in the same order as on its own knots (a step of 75 ms
+of the first pass time: +0.23 J on 0.15 s knots, +0.29 J on its own)."""
+LONG_PROBES = 2
+"""Pass-time probes per inner target, at most, in a row without a gain, of a long chain's search (its
+first step 1/8 of a leg; ``pass_search`` per target in all, at most). Measured on the long fly-by
+chain of issue 36: the pattern search run on to 53 probes (about 1.4 s each) found pass times 0.017 %
+better than the untuned ones on the probes' knots, within the scatter of the solves; 14 find none."""
 
 TIME_UNIT = FINE_DT
 """s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
@@ -773,7 +790,13 @@ class CycleOptimizer:
         the best probe's path, through the last :data:`PROBE_WARM_STAGES` continuation stages, as a
         chain's probes are after the first); a probe that beats the one at the untuned pass times is
         kept as the unit's solve at ``T``, else the unit is solved at the untuned pass times as its
-        own solves are. Measured on
+        own solves are. A long chain (:meth:`GradientSettings.is_long`) probes on knots
+        :data:`LONG_PROBE_KNOTS` apart through the continuation stages but the last, each probe after
+        the first from the best probe's path shifted in time to its pass times (:meth:`_time_warped`),
+        at most :data:`LONG_PROBES` per target in a row without a gain, its first step 1/8 of a leg;
+        the chain is then solved at the untuned pass times and, where a probe won, at the best
+        probe's, and the better is kept (the long fly-by chain of issue 36: 42 probes of 7-9 s each,
+        every one ending at the smoothest path, -> 14 of about 1.5 s). Measured on
         pick_and_place (issue 36, with the re-timing's scaled search): 19.9 s at 12.19 %; the best
         pass times solved again on :data:`WITHIN_KNOTS`, kept where that beat the untuned solve
         there (two solves of 144 variables, about 3 s each), as before: 25.0 s at 12.15 %; solved
@@ -786,30 +809,42 @@ class CycleOptimizer:
         m = self.by_index[i]
         corridor = self.settings.corridor_mm
         coarse = i in self.within  # probes on wider knots, compared among themselves
+        long = not coarse and self.gradient.is_long(units * STEP)  # so too, then solved on its own knots
         # where it passes them untuned (a unit inside a MoveL segment: only where no probe wins)
-        first: Solved | None = None if coarse else self._solve_once(m, units * STEP, units, corridor)
+        first: Solved | None = None if coarse or long else self._solve_once(m, units * STEP, units, corridor)
         untuned = [t for t, _ in self.waypoints(i, units * STEP)]
         start = tuple(int(round(t / STEP)) for t in untuned)
         seen: dict[tuple[int, ...], Solved] = {}
         probe = replace(self.gradient, give_up=True, max_rounds=min(self.gradient.max_rounds, PROBE_ROUNDS))
         if coarse:
             probe = replace(probe, knot_spacing=max(probe.knot_spacing, ON_TAUGHT_KNOTS))
+        elif long:
+            probe = replace(
+                probe,
+                knot_spacing=max(probe.knot_spacing, LONG_PROBE_KNOTS),
+                coarse_factor=1,
+                continuation=probe.continuation[:-1] or probe.continuation,
+            )
         elif first is not None and all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
             seen[start] = first
 
         warm = replace(probe, continuation=probe.continuation[-PROBE_WARM_STAGES:], coarse_factor=1)
 
+        def way_at(edges: tuple[int, ...]) -> tuple[tuple[float, FloatArray], ...]:
+            return tuple(
+                (e * STEP, self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
+            )
+
         def energy(edges: tuple[int, ...]) -> float:
             if not self._passes_reachable(i, edges, units):
                 return np.inf
             if edges not in seen:
-                way = tuple(
-                    (e * STEP, self.by_index[j].path.q1) for e, j in zip(edges, members[:-1], strict=True)
-                )
+                way = way_at(edges)
                 near = seen.get(best) if PROBE_WARM_STAGES else None
                 if near is not None and near.usable and near.coefficients is not None:
+                    initial = self._time_warped(i, near, edges, probe) if long else near.coefficients
                     seen[edges] = self._solve_once(
-                        m, units * STEP, units, corridor, way=way, gradient=warm, initial=near.coefficients
+                        m, units * STEP, units, corridor, way=way, gradient=warm, initial=initial
                     )
                 else:
                     seen[edges] = self._solve_once(m, units * STEP, units, corridor, way=way, gradient=probe)
@@ -817,27 +852,44 @@ class CycleOptimizer:
             return s.energy_J if s.usable else np.inf
 
         best = start
-        if coarse:
+        if coarse or long:
             e_best = energy(start)
         else:
             assert first is not None
             e_best = first.energy_J if first.usable else np.inf
         won = False
-        step = max(1, units // (4 * len(members)) if i not in self.within else 2)
         cap = self.settings.pass_search * len(start)
-        while step >= 1 and len(seen) < cap:
+        # a long chain: at most LONG_PROBES per target in a row without a gain
+        idle_cap = min(self.settings.pass_search, LONG_PROBES) * len(start) if long else cap
+        if long:
+            step = max(1, units // (8 * len(members)))
+        else:
+            step = max(1, units // (4 * len(members)) if i not in self.within else 2)
+        since = 0  # probes since the last gain
+        while step >= 1 and len(seen) < cap and since < idle_cap:
             moved = False
             for k in range(len(best)):
                 for d in (-step, step):
                     cand = tuple(e + d if n == k else e for n, e in enumerate(best))
-                    if len(seen) >= cap:
+                    if len(seen) >= cap or since >= idle_cap:
                         break
+                    n_seen = len(seen)
                     e = energy(cand)
+                    since += len(seen) - n_seen
                     if e < e_best - 1e-9:
-                        best, e_best, moved, won = cand, e, True, True
+                        best, e_best, moved, won, since = cand, e, True, True, 0
                         break
             if not moved:
                 step //= 2
+        if long:  # on its own knots: at the untuned pass times, and at the best probe's where it won
+            first = self._solve_once(m, units * STEP, units, corridor, way=way_at(start))
+            tuned = self._solve_once(m, units * STEP, units, corridor, way=way_at(best)) if won else None
+            if tuned is not None and tuned.usable and (not first.usable or tuned.energy_J < first.energy_J):
+                self.shares[i] = tuple(e / units for e in best)
+                self.cache[(i, units)] = tuned
+            elif first.usable:
+                self.cache[(i, units)] = first
+            return
         if won:  # the best probe (inside a MoveL segment: on its wider knots), verified as every solve is
             self.shares[i] = tuple(e / units for e in best)
             self.cache[(i, units)] = seen[best]
@@ -846,6 +898,27 @@ class CycleOptimizer:
             first = self._solve_once(m, units * STEP, units, corridor)
         if first.usable:
             self.cache[(i, units)] = first
+
+    def _time_warped(
+        self, i: int, near: Solved, edges: tuple[int, ...], gradient: GradientSettings
+    ) -> FloatArray:
+        """The solve ``near`` of chain ``i`` shifted in time to pass its inner targets at samples
+        ``edges`` of its duration (each leg stretched or squeezed on its own, linearly in time), in the
+        coefficients of a solve on ``gradient``'s knots at that duration (flat; least squares on the
+        fine grid, offsets from the minimum-jerk move): a start for a probe at those pass times, near
+        the best probe's path and near its targets at their new times (a probe started from the best
+        path itself, its targets missed, ends outside a limit or at the smoothest path)."""
+        assert near.passes is not None
+        T = near.duration
+        basis = SplineBasis(T, knot_spacing=gradient.spacing_for(T), degree=gradient.degree, dt=STEP)
+        fine = basis.grid(STEP / gradient.check_factor)
+        q0, q1 = self.by_index[i].path.q0, self.by_index[self.chains[i][-1]].path.q1
+        default = minimum_jerk(q0, q1, T, dt=STEP / gradient.check_factor)
+        t_old = np.interp(default.t, [0.0, *(e * STEP for e in edges), T], [0.0, *near.passes, T])
+        q_old = np.column_stack([np.interp(t_old, near.fine.t, near.fine.q[:, j]) for j in range(q0.size)])
+        c = np.asarray(np.linalg.lstsq(fine.B, q_old - default.q, rcond=None)[0], dtype=float)
+        out: FloatArray = c.ravel()
+        return out
 
     def _passes_reachable(self, i: int, edges: tuple[int, ...], units: int) -> bool:
         """Whether chain ``i`` can pass its inner targets at samples ``edges`` of ``units``, by a bound
