@@ -22,6 +22,15 @@ run again by the emulation, and must give the searched cycle time and energy; it
 within ``corridor_mm`` of the taught cycle's path (the corridor the plan itself keeps), and, with a
 cell, clear the cell's margin. The figures are those of the module as executed, against the taught
 program run by the same emulation, on the run's energy measure.
+
+A ``MoveL``'s speed data is the programmer's bound on its line (an approach to a part at ``v200``),
+and the plan keeps it; via points that replace a line run at whatever speed their ``\\T`` give. So
+each via-point module searched on runs every taught ``MoveL`` line no faster than its speed data
+(:mod:`joulepath.program._line_speed`; outside the blends the controller makes between a taught
+statement and the next, as in the taught cycle): a layout's ``\\T`` are not shortened past it, a
+unit that breaks it goes back as taught, and a timed chain's segments on a line are timed within
+it. The levers never make a line faster (they stretch ``\\T``, lower ``AccSet``, and never raise a
+``MoveL``'s speed data); a zone they enlarge lets the controller blend further into the line.
 """
 
 from __future__ import annotations
@@ -43,7 +52,7 @@ from joulepath.program._levers import LeverResult, _Evaluator, cycle_motion, lev
 from joulepath.program._line_speed import SPEED_TOL, LineSpeed, fastest_on_lines, line_speeds
 from joulepath.program._parse import parse_module
 from joulepath.program._resolve import CycleSpec, resolve_module
-from joulepath.program._via_timing import T_ARG, _written, dense_vias, time_chains
+from joulepath.program._via_timing import BLEND_ROOM, T_ARG, _written, dense_vias, time_chains
 from joulepath.sim import ControllerConfig, PlannedCycle, tcp_pose
 from joulepath.trajectory import Trajectory
 
@@ -384,25 +393,39 @@ def via_levers(
         only_sets: tuple[set[int] | None, ...] = (None, _added_lines(old[1]))
         bases = [(*old, only_sets)]
         if timed_chains:  # the plan's points kept at equal arc length, their \T timed for the controller
-            dense = _plain(written_rapid(replace(plan, vias=dense_vias(plan, taught=plan_t))).text)
-            spec_d = resolve_module(parse_module(dense, path=path), robot)
-            timed = time_chains(
-                dense,
-                spec_d,
-                _added_lines(spec_d),
-                measure=energy,
-                config=config,
-                cycle_s=t_taught,
-                run_cycle=lambda c: run(c)[1:],
-                max_seconds=max_seconds,
-                speeds=lines,
-            )
-            # not fitted by shortening its \T (that breaks its chains): over the taught time, the lever
-            # search brings it in
-            spec_t = resolve_module(parse_module(timed.text, path=path), robot)
-            t_t, e_t = timed.cycle_s, timed.energy_J
-            if keeps_lines(timed.text):  # its chains on a MoveL's line are timed within its speed data
-                bases.append((timed.text, spec_t, t_t, e_t, 0, (None,)))  # every statement: it may be over
+            timings = []
+            for room in (BLEND_ROOM, 0.0):  # clear of the taught blends, or every point kept
+                dense = _plain(
+                    written_rapid(replace(plan, vias=dense_vias(plan, taught=plan_t, room=room))).text
+                )
+                spec_d = resolve_module(parse_module(dense, path=path), robot)
+                timed = time_chains(
+                    dense,
+                    spec_d,
+                    _added_lines(spec_d),
+                    measure=energy,
+                    config=config,
+                    cycle_s=t_taught,
+                    run_cycle=lambda c: run(c)[1:],
+                    max_seconds=max_seconds,
+                    speeds=lines,
+                )
+                if keeps_lines(timed.text):  # its chains on a MoveL's line are timed within its speed data
+                    timings.append(timed)
+            if timings:  # within the taught cycle for the least energy, else the least over it
+                timed = min(
+                    timings,
+                    key=lambda x: (
+                        x.cycle_s > t_taught + _TOL_S,
+                        x.energy_J if x.cycle_s <= t_taught + _TOL_S else x.cycle_s,
+                    ),
+                )
+                # not fitted by shortening its \T (that breaks its chains): over the taught time, the lever
+                # search brings it in
+                spec_t = resolve_module(parse_module(timed.text, path=path), robot)
+                bases.append(
+                    (timed.text, spec_t, timed.cycle_s, timed.energy_J, 0, (None,))
+                )  # every statement
                 timed_n = timed.timed
     except JoulepathError as err:
         return ViaLevers(None, f"the via-point module cannot be read: {err}")

@@ -11,13 +11,18 @@ via-point layout (:func:`joulepath.sim._via.layout`) drops points until the chai
 leaves long straight segments that carry little of the plan's shape.
 
 Here the points stay where the plan puts them, at equal TCP arc length about
-:data:`VIA_SPACING_S` apart, and the ``\\T`` of each chain is chosen instead, for the least energy
-as the emulation runs the chain, such that every corner and ramp holds with a margin
-(:data:`MARGIN`, the conditions of :func:`joulepath.sim._timing._chain_profiles` written as
-constraints on the times) and the chain, run on its own from rest to rest with the move that
-ends it, takes no longer than the plan gave its unit (or, where no timing holds in that time,
-the least it can). When the whole module then runs longer than the taught cycle, the chains
-with time to spare give it up, in proportion, and are timed again.
+:data:`VIA_SPACING_S` apart (but next to a taught move that blends into the unit or out of it:
+the controller's blend there lasts at most half of either move, so the via point next to it is
+kept :data:`BLEND_ROOM` times the taught blend's time away), and the ``\\T`` of each chain is
+chosen instead, for the least energy as the emulation runs the chain, such that every corner and
+ramp holds with a margin (:data:`MARGIN`, the conditions of
+:func:`joulepath.sim._timing._chain_profiles` written as constraints on the times), every segment
+on a taught ``MoveL``'s line runs within the line's speed data, and the chain, run on its own from
+rest to rest with the move that ends it, takes no longer than the plan gave its unit (or, where no
+timing holds in that time, the least it can). When the whole module then runs longer than the
+taught cycle, the chains with time to spare give it up, in proportion, and are timed again; when
+it runs shorter, the time left over is shared among the chains (at most :data:`FITS` rounds, the
+least energy within the taught cycle kept).
 """
 
 from __future__ import annotations
@@ -44,7 +49,7 @@ VIA_SPACING_S = 0.05
 MARGIN = 0.03
 """Share of each corner's and ramp's condition kept in reserve, so that the chain holds on the
 controller with the times rounded as written (0.1 ms)."""
-FITS = 3
+FITS = 6
 """Rounds, at most, of fitting the chains' budgets to the taught cycle: giving up their spare time
 when the module runs over it, sharing the time left over when it runs under it."""
 GIVE_S = 0.01
@@ -368,7 +373,7 @@ def _written(t: float) -> Callable[[re.Match[str]], str]:
 
 
 def dense_vias(
-    plan: Any, spacing: float = VIA_SPACING_S, taught: PlannedCycle | None = None
+    plan: Any, spacing: float = VIA_SPACING_S, taught: PlannedCycle | None = None, room: float = BLEND_ROOM
 ) -> dict[int, tuple[int, ...]]:
     """Per optimized move of ``plan`` (a :class:`~joulepath.program.CycleResult`), via points at equal
     TCP arc length about ``spacing`` s apart (:func:`joulepath.sim._via._leg_indices`), none dropped
@@ -376,7 +381,8 @@ def dense_vias(
     cycle as the controller runs it). There the controller blends by superposition for at most half
     of either move's time, so the via point next to the kept move is kept at least twice the taught
     blend's time away (:func:`_clear_of_blends`); nearer, the blend shrinks and the kept move runs
-    almost to its target first, which costs the cycle the rest of the blend."""
+    almost to its target first, which costs the cycle the rest of the blend. ``room``: that many
+    times the taught blend's time (0: none dropped)."""
     from joulepath.sim._via import _leg_indices
 
     steps = plan.spec.steps
@@ -406,7 +412,7 @@ def dense_vias(
             into = 0.0
         if after is None or after in plan.vias:
             out_of = 0.0
-        out[i] = _clear_of_blends(fine.t, idx, BLEND_ROOM * into, BLEND_ROOM * out_of)
+        out[i] = _clear_of_blends(fine.t, idx, room * into, room * out_of)
     return out
 
 
