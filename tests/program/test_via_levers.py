@@ -232,3 +232,26 @@ def test_a_bundled_program_keeps_its_structure_and_saves_as_executed(robot):
         assert word in text
     assert "WHILE TRUE DO" in text
     assert restore_program(text) == original
+    # every taught MoveL line run no faster than its speed data, but in the controller's own blends
+    # between two statements (a timed chain's corners, whose \T were chosen, are counted)
+    from joulepath.optimize._retime import tcp_velocity
+    from joulepath.program._line_speed import SPEED_TOL, fastest_on_lines, line_speeds
+    from joulepath.sim import tcp_pose
+    from joulepath.sim._timing import ChainProfile
+
+    lines = line_speeds(plan_cycle(spec, ControllerConfig()))
+    assert lines, "approach_depart approaches and leaves its parts on MoveL lines"
+    plan = plan_cycle(as_sequence(read_written(text, "written.mod", robot)), ControllerConfig())
+    t = np.linspace(0.0, plan.cycle_time, int(np.ceil(plan.cycle_time / FINE_DT)) + 1)
+    traj = evaluate_cycle(plan, t)
+    own = np.ones(t.size, dtype=bool)
+    moving = [m for m in plan.moves if m.profile.duration > 0]
+    for a, b in zip(moving, moving[1:], strict=False):
+        if b.t0 < a.t_end and not (
+            isinstance(a.profile, ChainProfile) and isinstance(b.profile, ChainProfile)
+        ):
+            own &= (t < b.t0) | (t > a.t_end)
+    tcp = plan.moves[0].step.tcp
+    pos, _ = tcp_pose(robot, traj.q[own], tcp)
+    ratio, line = fastest_on_lines(lines, pos, tcp_velocity(robot, traj.q[own], traj.qd[own], tcp))
+    assert ratio <= 1.0 + SPEED_TOL, line
