@@ -146,6 +146,8 @@ def test_settings_refuse_an_unknown_row_kind_and_a_bad_preconditioner():
         GradientSettings(precondition=1.5)
     with pytest.raises(InvalidInput, match="hull_refine must be 1..8"):
         GradientSettings(hull_refine=0)
+    with pytest.raises(InvalidInput, match=r"screen_band must be in \(0, 1\]"):
+        GradientSettings(screen_band=0.0)
 
 
 def test_default_search_reaches_the_search_before_within_every_limit(irb120):
