@@ -182,26 +182,28 @@ class GradientSettings:
         return duration > self.knot_spacing * self.max_knots + 1e-9
 
 
-GRID_SEARCH: dict[str, Any] = {
-    "rate_rows": "grid",
-    "precondition": 0.0,
-    "ftol": 1e-7,
-    "max_iter": 200,
-    "screen_band": 0.1,
-    "prune_stages": True,
-}
-""":class:`GradientSettings` of the search before the hull rows (issue 36): a row per point of the fine
-grid for the accelerations and jerks, SLSQP in the plain coefficients. The single move's
-``gradient-grid``, and the cycle's default (:class:`joulepath.program.CycleSettings`: measured on the
-bundled examples, the single move's new settings saved less there, payload_tool 12.0 % against 12.7 %,
-and took as long). Its stages prune their rows (``prune_stages``, :func:`_solve_from`), and its
-rows enter a solve within 0.1 of their limits (``screen_band``; the single move's default 0.25):
-measured on the cycle (issue 36, one BLAS thread, CPU s, 0.25 -> 0.1), pick_and_place 9.5-10.8 ->
-7.7-8.1 s at 12.189 -> 12.181 %, palletizing 12.0-12.5 -> 11.6-12.3 s at 22.373 -> 22.357 %. On the
-single move 0.1 is no faster (the 21 tasks of ``benchmarks/optimizer_speed.py``: median 0.84 ->
-0.88 s, share 97.24 -> 97.25 %; the Panda's 2 s move, its many hull rows near their limits: the
-search 4.5 -> 3.8 s at 37.82 -> 37.83 %), and on the short move of
-``tests/optimize/test_gradient_hull.py`` it ends in a poorer local optimum."""
+SEARCH_BEFORE_HULL: dict[str, Any] = {"rate_rows": "grid", "precondition": 0.0, "ftol": 1e-7, "max_iter": 200}
+""":class:`GradientSettings` of the single move's search before the hull rows (issue 36): a row per point
+of the fine grid for the accelerations and jerks, SLSQP in the plain coefficients. The single move's
+``gradient-grid``, the yardstick of its speed-up."""
+
+GRID_SEARCH: dict[str, Any] = {**SEARCH_BEFORE_HULL, "ftol": 3e-7, "screen_band": 0.1, "prune_stages": True}
+""":class:`GradientSettings` of the cycle (:class:`joulepath.program.CycleSettings`' default): the rows on
+the fine grid and the plain coefficients of :data:`SEARCH_BEFORE_HULL` (measured on the bundled
+examples, the single move's new settings saved less there, payload_tool 12.0 % against 12.7 %, and took
+as long), with three changes for speed (issue 36; one BLAS thread, CPU s of the plan, measured on the
+bundled examples one after the other, BENCHMARKS.md):
+
+* ``screen_band`` 0.1 (the single move's default 0.25): pick_and_place 9.5-10.8 -> 7.7-8.1 s at
+  12.189 -> 12.181 %, palletizing 12.0-12.5 -> 11.6-12.3 s at 22.373 -> 22.357 %. On the single move
+  it is no faster (the 21 tasks of ``benchmarks/optimizer_speed.py``: median 0.84 -> 0.88 s, share
+  97.24 -> 97.25 %; the Panda's 2 s move, its many hull rows near their limits: its search 4.5 -> 3.8 s
+  at 37.82 -> 37.83 %), and on the short move of ``tests/optimize/test_gradient_hull.py`` it ends in
+  a poorer local optimum;
+* ``prune_stages`` (:func:`_solve_from`): palletizing 11.5-11.6 -> 10.3-10.7 s at 22.357 -> 22.349 %;
+* ``ftol`` 3e-7 (from 1e-7): palletizing 10.8-11.7 -> 9.8-10.2 s at 22.349 -> 22.372 %, the five
+  others as fast or faster at the same or a higher saving (1e-6: palletizing 9.8-9.9 s, 22.351 %, but
+  payload_tool 12.663 -> 12.649 %)."""
 
 
 @dataclass(frozen=True, slots=True)
