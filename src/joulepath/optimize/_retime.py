@@ -589,7 +589,32 @@ def _search(
     deadline: float | None = None,
 ) -> FloatArray:
     """SLSQP from ``x0`` (past ``deadline``, a ``time.perf_counter()``, it stops at its iterate), the
-    limit rows taken lazily (:data:`SCREEN_BAND`, at most :data:`MAX_ROUNDS` solves)."""
+    limit rows taken lazily (:data:`SCREEN_BAND`, at most :data:`MAX_ROUNDS` solves).
+
+    On one BLAS thread, as :func:`joulepath.optimize.optimize_spline`: its small dense linear algebra
+    runs slower on a pool that competes for the same cores (measured on palletizing's 13 re-timed
+    segments without ``OMP_NUM_THREADS`` set, as ``joulepath cycle`` runs them on 2 logical CPUs:
+    8.5 -> 3.6 s of CPU, the whole plan 15.7 -> 10.3 s; issue 36)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _search_on_one_thread(
+            robot, at, timing, t, x0, limits, margin=margin, maxiter=maxiter, deadline=deadline
+        )
+
+
+def _search_on_one_thread(
+    robot: Robot,
+    at: Callable[..., Any],
+    timing: _Timing,
+    t: FloatArray,
+    x0: FloatArray,
+    limits: _Limits,
+    *,
+    margin: float,
+    maxiter: int,
+    deadline: float | None,
+) -> FloatArray:
     problem = _problem(robot, at, timing, t, limits, margin)
     n = x0.size
     order = np.zeros((n + 1, n))  # x_0 >= lo, x_{i+1} - x_i >= 0, hi - x_{n-1} >= 0 (the fixed neighbours)
