@@ -104,3 +104,21 @@ def test_jacobian_matches_pinocchio(irb120, rng):
     for k in range(3):
         ref = pin.computeFrameJacobian(model, data, q[k], fid, pin.LOCAL_WORLD_ALIGNED)
         np.testing.assert_allclose(ours[k], ref, atol=1e-12)
+
+
+def test_position_and_jacobian_match_the_pose_and_pinocchio(irb120, rng):
+    """One pass over the chain gives the tool position of the forward kinematics and Pinocchio's
+    Jacobian, for a batch (the corridor rows of the gradient search take both at once)."""
+    import pinocchio as pin
+
+    from joulepath.kinematics import forward_kinematics, position_and_jacobian
+
+    q = rng.uniform(-2, 2, size=(4, 6))
+    position, jac = position_and_jacobian(irb120.chain, q)
+    np.testing.assert_allclose(position, forward_kinematics(irb120.chain, q).position_m, atol=1e-15)
+    model = irb120.pinocchio_model
+    data = model.createData()
+    fid = model.getFrameId("tool0")
+    for k in range(4):
+        ref = pin.computeFrameJacobian(model, data, q[k], fid, pin.LOCAL_WORLD_ALIGNED)
+        np.testing.assert_allclose(jac[k], ref, atol=1e-12)

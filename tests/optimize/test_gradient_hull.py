@@ -146,6 +146,8 @@ def test_settings_refuse_an_unknown_row_kind_and_a_bad_preconditioner():
         GradientSettings(precondition=1.5)
     with pytest.raises(InvalidInput, match="hull_refine must be 1..8"):
         GradientSettings(hull_refine=0)
+    with pytest.raises(InvalidInput, match=r"screen_band must be in \(0, 1\]"):
+        GradientSettings(screen_band=0.0)
 
 
 def test_default_search_reaches_the_search_before_within_every_limit(irb120):
@@ -228,3 +230,40 @@ def test_via_point_plan_searches_the_wide_knots(via_points_run):
     wide = {SplineBasis(T, knot_spacing=f * VIA_KNOT_FACTOR * spacing).n_free for f in (1, 2)}
     assert result.parameters.shape[0] in wide
     assert result.parameters.shape[0] != SplineBasis(T, knot_spacing=spacing).n_free
+
+
+def test_pruned_stages_carry_fewer_rows_and_end_within_every_limit(irb120, monkeypatch):
+    """``prune_stages``: a continuation stage that starts within every limit starts from the rows near
+    its limits there, not from every row the earlier rounds gathered: its solves carry fewer rows in
+    all (the first the same), and the search still ends within every limit on the 10x grid."""
+    amax = acceleration_limit(irb120, ACCEL_TIME)
+    rows_per_solve: dict[bool, list[int]] = {}
+    seen: list[int] = []
+    original = SplineProblem.constraints
+
+    def counting(self, active, change=None):
+        seen.append(sum(int(v.size) for v in active.values()))
+        return original(self, active, change)
+
+    monkeypatch.setattr(SplineProblem, "constraints", counting)
+    for prune in (True, False):
+        seen.clear()
+        settings = GradientSettings(
+            rate_rows="grid", precondition=0.0, coarse_factor=1, screen_band=0.1, prune_stages=prune
+        )
+        res, problem = solve_move(
+            irb120,
+            Q0,
+            Q0 + 0.5 * (QF - Q0),
+            1.2,
+            friction=irb120.friction,
+            settings=settings,
+            rng=np.random.default_rng(0),
+            acceleration_limit=amax,
+        )
+        fine = problem.path(res.coefficients.ravel(), fine=True)
+        report = check_limits(irb120, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax)
+        assert res.feasible and report.ok, prune
+        rows_per_solve[prune] = list(seen)
+    assert rows_per_solve[True][0] == rows_per_solve[False][0]
+    assert sum(rows_per_solve[True]) < sum(rows_per_solve[False])

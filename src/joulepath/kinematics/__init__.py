@@ -6,6 +6,7 @@ from joulepath.kinematics._fk import (
     forward_kinematics,
     geometric_jacobian,
     link_frames,
+    position_and_jacobian,
 )
 from joulepath.kinematics._ik import check_layout, confdata, ik_branches, solve_ik
 from joulepath.kinematics._rotations import (
@@ -27,6 +28,7 @@ __all__ = [
     "geometric_jacobian",
     "ik_branches",
     "link_frames",
+    "position_and_jacobian",
     "quaternion_to_rotation",
     "rotation_to_euler_zyx",
     "rotation_to_quaternion",

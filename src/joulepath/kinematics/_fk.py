@@ -116,10 +116,18 @@ def geometric_jacobian(chain: Chain, q: ArrayLike) -> FloatArray:
     -------
     ndarray of shape (..., 6, n)
     """
+    return position_and_jacobian(chain, q)[1]
+
+
+def position_and_jacobian(chain: Chain, q: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Tool frame origin (m, shape (..., 3)) and its :func:`geometric_jacobian` (shape (..., 6, n))
+    from one pass over the chain (a caller that needs both computes the link frames once)."""
     qa = check_q(q, chain.n_joints)
     frames = link_frames(chain, qa)
     tool = frames[..., -1, :, :] @ chain.tool
     z = np.einsum("...iab,ib->...ia", frames[..., :3, :3], chain.axes)
     origins = frames[..., :3, 3]
-    lin = np.cross(z, tool[..., None, :3, 3] - origins)
-    return np.concatenate([np.swapaxes(lin, -1, -2), np.swapaxes(z, -1, -2)], axis=-2)
+    position = tool[..., :3, 3]
+    lin = np.cross(z, position[..., None, :] - origins)
+    jac = np.concatenate([np.swapaxes(lin, -1, -2), np.swapaxes(z, -1, -2)], axis=-2)
+    return position.copy(), jac

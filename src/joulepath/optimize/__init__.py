@@ -12,6 +12,7 @@ from joulepath.optimize._execute import EXECUTION_TOLERANCES, Execution, rapid_e
 from joulepath.optimize._features import path_features
 from joulepath.optimize._gradient import (
     GRID_SEARCH,
+    SEARCH_BEFORE_HULL,
     GradientResult,
     GradientSettings,
     SplineProblem,
@@ -103,6 +104,7 @@ __all__ = [
     "PENALTY",
     "PlanSegment",
     "RUN_FILES",
+    "SEARCH_BEFORE_HULL",
     "Retimed",
     "SearchOutcome",
     "SegmentMove",

@@ -59,12 +59,15 @@ from joulepath._typing import FloatArray
 from joulepath.dynamics import Friction, Robot, inverse_dynamics_derivatives
 from joulepath.energy import DEFAULT_MEASURE, check_measure
 from joulepath.errors import InvalidInput
+from joulepath.kinematics import position_and_jacobian
 from joulepath.optimize._verify import energy_on_samples
 from joulepath.trajectory import DEFAULT_KNOT_SPACING, GridBasis, SplineBasis, Trajectory, minimum_jerk
 from joulepath.units import SAMPLE_PERIOD
 
 SCREEN_BAND = 0.25
-"""A fine-grid constraint enters the solve when its value is within this share of its limit."""
+"""A constraint enters the solve when its value is within this share of its limit (the rest are
+checked after each solve, and those it breaks or nears enter the next): the default of
+:attr:`GradientSettings.screen_band`."""
 THIN_ROWS = 2
 """Rows of one rate kind, per variable, above which only each bump's deepest samples enter a solve."""
 RANGE_MARGIN = 1e-6
@@ -112,6 +115,12 @@ class GradientSettings:
     (about ten times the rows). A move added to a given ``base`` motion (not a spline) always
     takes the grid rows.
 
+    ``screen_band``: a row enters a solve when its value is within this share of its limit
+    (:data:`SCREEN_BAND`); after each solve every row is checked and those broken or within the band
+    enter the next round. ``prune_stages``: a continuation stage after the first that starts within
+    every limit starts again from the rows within the band there (and the known ones), not with every
+    row the earlier rounds gathered (:func:`_solve_from`).
+
     ``precondition``: each continuation stage's round solves in coordinates ``y`` with ``x = x_at + W y``,
     ``Wᵀ H W`` near the identity for the smoothed energy's Hessian ``H`` at the round's start (its
     eigenvalues' magnitudes held at least this share of the largest; 0: the plain coefficients).
@@ -138,12 +147,16 @@ class GradientSettings:
     rate_rows: str = "hull"
     hull_refine: int = 3
     precondition: float = 1e-3
+    screen_band: float = SCREEN_BAND
+    prune_stages: bool = False
 
     def __post_init__(self) -> None:
         if self.rate_rows not in RATE_ROWS:
             raise InvalidInput(f"rate_rows must be one of {', '.join(RATE_ROWS)}, got {self.rate_rows!r}")
         if not 0.0 <= self.precondition < 1.0:
             raise InvalidInput(f"precondition must be in [0, 1) (0: none), got {self.precondition}")
+        if not 0.0 < self.screen_band <= 1.0:
+            raise InvalidInput(f"screen_band must be in (0, 1] (a share of a limit), got {self.screen_band}")
         if not 1 <= self.hull_refine <= 8:
             raise InvalidInput(f"hull_refine must be 1..8, got {self.hull_refine}")
         if self.refine_stages < 1 or self.coarse_stages < 0:
@@ -169,12 +182,28 @@ class GradientSettings:
         return duration > self.knot_spacing * self.max_knots + 1e-9
 
 
-GRID_SEARCH: dict[str, Any] = {"rate_rows": "grid", "precondition": 0.0, "ftol": 1e-7, "max_iter": 200}
-""":class:`GradientSettings` of the search before the hull rows (issue 36): a row per point of the fine
-grid for the accelerations and jerks, SLSQP in the plain coefficients. The single move's
-``gradient-grid``, and the cycle's default (:class:`joulepath.program.CycleSettings`: measured on the
-bundled examples, the single move's new settings saved less there, payload_tool 12.0 % against 12.7 %,
-and took as long)."""
+SEARCH_BEFORE_HULL: dict[str, Any] = {"rate_rows": "grid", "precondition": 0.0, "ftol": 1e-7, "max_iter": 200}
+""":class:`GradientSettings` of the single move's search before the hull rows (issue 36): a row per point
+of the fine grid for the accelerations and jerks, SLSQP in the plain coefficients. The single move's
+``gradient-grid``, the yardstick of its speed-up."""
+
+GRID_SEARCH: dict[str, Any] = {**SEARCH_BEFORE_HULL, "ftol": 3e-7, "screen_band": 0.1, "prune_stages": True}
+""":class:`GradientSettings` of the cycle (:class:`joulepath.program.CycleSettings`' default): the rows on
+the fine grid and the plain coefficients of :data:`SEARCH_BEFORE_HULL` (measured on the bundled
+examples, the single move's new settings saved less there, payload_tool 12.0 % against 12.7 %, and took
+as long), with three changes for speed (issue 36; one BLAS thread, CPU s of the plan, measured on the
+bundled examples one after the other, BENCHMARKS.md):
+
+* ``screen_band`` 0.1 (the single move's default 0.25): pick_and_place 9.5-10.8 -> 7.7-8.1 s at
+  12.189 -> 12.181 %, palletizing 12.0-12.5 -> 11.6-12.3 s at 22.373 -> 22.357 %. On the single move
+  it is no faster (the 21 tasks of ``benchmarks/optimizer_speed.py``: median 0.84 -> 0.88 s, share
+  97.24 -> 97.25 %; the Panda's 2 s move, its many hull rows near their limits: its search 4.5 -> 3.8 s
+  at 37.82 -> 37.83 %), and on the short move of ``tests/optimize/test_gradient_hull.py`` it ends in
+  a poorer local optimum;
+* ``prune_stages`` (:func:`_solve_from`): palletizing 11.5-11.6 -> 10.3-10.7 s at 22.357 -> 22.349 %;
+* ``ftol`` 3e-7 (from 1e-7): palletizing 10.8-11.7 -> 9.8-10.2 s at 22.349 -> 22.372 %, the five
+  others as fast or faster at the same or a higher saving (1e-6: palletizing 9.8-9.9 s, 22.351 %, but
+  payload_tool 12.663 -> 12.649 %)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -613,9 +642,9 @@ class SplineProblem:
         assert self.max_deviation_m is not None
         c = self.coefficients(x)
         q = self.default.q[idx] + self.samples.B[idx] @ c
-        tcp = self.robot.fk(q).position_m
+        tcp, jac6 = position_and_jacobian(self.robot.chain, q)  # one pass over the chain for both
         delta = tcp - self.tcp_default[idx]
-        jac = self.robot.jacobian(q)[:, :3, :]  # (k, 3, n)
+        jac = jac6[:, :3, :]  # (k, 3, n)
         dd = 2.0 * np.einsum("ka,kal->kl", delta, jac)  # d|delta|²/dq (k, n)
         grad = -(self.samples.B[idx][:, :, None] * dd[:, None, :]).reshape(idx.size, self.m * self.n)
         bound = self.max_deviation_m * (1.0 - RATE_MARGIN)  # solver tolerance, as for the rates
@@ -814,6 +843,15 @@ def _solve_from(
 ) -> tuple[FloatArray, int, dict[str, np.ndarray]]:
     """Continuation stages from ``x0``; each stage regenerates constraints until none is violated.
 
+    With :attr:`GradientSettings.prune_stages`, a stage after the first that starts within every
+    limit starts with the rows near their limits there and ``known``, the rows an earlier stage
+    gathered dropped (on the way, a round's iterate can run far past limits whose rows it did not
+    have yet, and every row it came near stayed in every later solve). Measured (issue 36, one BLAS
+    thread): the cycle's palletizing 11.5-11.6 -> 10.3-10.7 s of CPU, 22.357 -> 22.349 %,
+    pick_and_place the same (7.6-8.2 s, 12.181 -> 12.184 %); the single move's 21 tasks of
+    ``benchmarks/optimizer_speed.py`` no faster (the median of the per-task CPU ratios 1.00), share
+    97.23 -> 97.20 %: on for the cycle (:data:`GRID_SEARCH`) only.
+
     ``known`` adds constraints found active by an earlier search on the same fine grid.
     ``deadline`` (``time.perf_counter()``): past it the solver stops at its current iterate.
     """
@@ -825,11 +863,18 @@ def _solve_from(
 
     x = x0.copy()
     n_iter = 0
-    active = problem.screen(x, SCREEN_BAND)
+    active = problem.screen(x, settings.screen_band)
     if known:
         active = _merge(active, known)
-    for share in settings.continuation:
+    for stage, share in enumerate(settings.continuation):
         eps = share * eps_unit
+        if stage and settings.prune_stages and problem.violation(x) == 0.0:
+            # a later stage starts from a point within every limit: only the rows near their limits
+            # there (and the known ones), not every row an earlier round's iterate came near on its
+            # way (the dense QP's work grows with its rows; those it breaks enter again after the solve)
+            active = problem.screen(x, settings.screen_band)
+            if known:
+                active = _merge(active, known)
 
         def fun(z: FloatArray, eps: float = eps) -> float:
             return problem.smooth_energy_value(z, eps) / scale
@@ -874,7 +919,7 @@ def _solve_from(
             if np.all(np.isfinite(cand)):
                 x = cand
             history.append(problem.true_energy(x))
-            active = _merge(active, problem.screen(x, SCREEN_BAND))
+            active = _merge(active, problem.screen(x, settings.screen_band))
             if problem.violation(x) == 0.0 or _past(deadline):
                 break
         if (settings.give_up and problem.violation(x) > 0.0) or _past(deadline):

@@ -70,6 +70,12 @@ COARSE_FACTOR = 4
 """With ``start="identity"``: the first search's grid is this many times coarser than the fine one."""
 COARSE_MARGIN = 0.01
 """... and keeps its limits this fraction below the checked ones (between its points they may rise)."""
+COARSE_ITERATIONS = 40
+"""SLSQP iterations, at most, of that first search (each round of new rows). Past them it mostly
+crawled to its tolerance: measured on the bundled examples' re-timed segments (issue 36), 200 ->
+40 took palletizing's 13 from 6.5 to 3.6 s of CPU and pick_and_place's 2 from 2.6 to 0.9 s, their
+energy after the polish 153.164 -> 153.147 J and 37.0046 J both (20: 153.88 J; 30: 153.23 J; 60:
+153.145 J in 4.3 s; preconditioning it as :mod:`joulepath.optimize._gradient` does took twice as long)."""
 POLISH_ITERATIONS = 30
 """SLSQP iterations, at most, of the polish of that search on the fine grid."""
 RESCUE_KNOT_S = 0.1
@@ -583,7 +589,32 @@ def _search(
     deadline: float | None = None,
 ) -> FloatArray:
     """SLSQP from ``x0`` (past ``deadline``, a ``time.perf_counter()``, it stops at its iterate), the
-    limit rows taken lazily (:data:`SCREEN_BAND`, at most :data:`MAX_ROUNDS` solves)."""
+    limit rows taken lazily (:data:`SCREEN_BAND`, at most :data:`MAX_ROUNDS` solves).
+
+    On one BLAS thread, as :func:`joulepath.optimize.optimize_spline`: its small dense linear algebra
+    runs slower on a pool that competes for the same cores (measured on palletizing's 13 re-timed
+    segments without ``OMP_NUM_THREADS`` set, as ``joulepath cycle`` runs them on 2 logical CPUs:
+    8.5 -> 3.6 s of CPU, the whole plan 15.7 -> 10.3 s; issue 36)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _search_on_one_thread(
+            robot, at, timing, t, x0, limits, margin=margin, maxiter=maxiter, deadline=deadline
+        )
+
+
+def _search_on_one_thread(
+    robot: Robot,
+    at: Callable[..., Any],
+    timing: _Timing,
+    t: FloatArray,
+    x0: FloatArray,
+    limits: _Limits,
+    *,
+    margin: float,
+    maxiter: int,
+    deadline: float | None,
+) -> FloatArray:
     problem = _problem(robot, at, timing, t, limits, margin)
     n = x0.size
     order = np.zeros((n + 1, n))  # x_0 >= lo, x_{i+1} - x_i >= 0, hi - x_{n-1} >= 0 (the fixed neighbours)
@@ -856,7 +887,8 @@ def _searched(
 
     From the controller's profile: one search on the fine grid. From a motion's own timing
     (``"identity"``): a control point per :data:`IDENTITY_KNOT_S`, searched on a grid
-    :data:`COARSE_FACTOR` times coarser within :data:`COARSE_MARGIN` of the limits, then polished
+    :data:`COARSE_FACTOR` times coarser within :data:`COARSE_MARGIN` of the limits
+    (:data:`COARSE_ITERATIONS`), then polished
     on the fine grid (:data:`POLISH_ITERATIONS`); where that is not feasible, a control point per
     :data:`RESCUE_KNOT_S` searched on the fine grid (SLSQP's dense QP grows with the rows times
     the variables squared, so the fine grid takes the coarser spline)."""
@@ -879,6 +911,7 @@ def _searched(
         _fit_start(timing, coarse, start(coarse)[0]),
         limits,
         margin=COARSE_MARGIN,
+        maxiter=COARSE_ITERATIONS,
         deadline=deadline,
     )
     yield timing, _search(robot, at, timing, t, x, limits, maxiter=POLISH_ITERATIONS, deadline=deadline)

@@ -28,7 +28,7 @@ from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.evolve import DE, GA, MA, Termination, minimize
-from joulepath.optimize._gradient import GRID_SEARCH, GradientSettings, solve_move
+from joulepath.optimize._gradient import SEARCH_BEFORE_HULL, GradientSettings, solve_move
 from joulepath.optimize._problem import FINE_FACTOR, FITNESS, PENALTY, TrajectoryProblem, limit_violation
 from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk, rest_to_rest, thesis_quintic
 
@@ -133,7 +133,7 @@ def via_point_settings(config: SearchSettings) -> dict[str, Any]:
     The controller plans its own motion through the written via points, so what counts is the
     saving of the module as the controller emulation runs it, not the plan's. The default search
     (hull rows, preconditioned) on knots ``VIA_KNOT_FACTOR`` times wider apart: measured on 14 tasks
-    against the search before (``GRID_SEARCH``, fine-grid rows, on the 0.05 s knots), the executed
+    against the search before (``SEARCH_BEFORE_HULL``, fine-grid rows, on the 0.05 s knots), the executed
     saving on the planning model +0.36 ± 0.45 points (mean ± s.e.; the plans' own saving 0.55 points
     lower), on the lab robot as its servo tracks it -0.32 ± 0.20 points (lower on 11 of 14), for a
     twenty-fifth of the CPU (median 0.35 s against 8.3 s). The default search on the 0.05 s knots:
@@ -157,7 +157,7 @@ def _gradient_fast(task: SearchTask, config: SearchSettings, rng: np.random.Gene
 
 
 def _gradient_grid(task: SearchTask, config: SearchSettings, rng: np.random.Generator) -> SearchOutcome:
-    return _gradient_with(task, config, rng, GRID_SEARCH)
+    return _gradient_with(task, config, rng, SEARCH_BEFORE_HULL)
 
 
 def _gradient_with(
