@@ -8,12 +8,12 @@ before it writes ``path.mod``) against the controller's own ``MoveAbsJ \\T`` at 
 For each task (the fixed task, the README's move, random tasks of the IRB 120) every candidate
 search plans the move in this process, one after the other, and its plan is run on the emulation:
 
-* ``grid`` — ``GRID_SEARCH`` (fine-grid rate rows, plain SLSQP), the via-point search of main
+* ``grid`` — ``SEARCH_BEFORE_HULL`` (fine-grid rate rows, plain SLSQP), the via-point search of main
   before this benchmark (``--algo gradient-grid`` with ``follow="via-points"``);
 * ``hull`` — the single move's default (hull rows, preconditioned SLSQP) on the 0.05 s knots;
 * ``hull-wide`` — the same on knots twice as wide (0.1 s; 0.2 s for the coarse level): the via-point
   search since this benchmark (:func:`joulepath.optimize._search.via_point_settings`);
-* ``grid-wide`` — ``GRID_SEARCH`` on knots twice as wide.
+* ``grid-wide`` — ``SEARCH_BEFORE_HULL`` on knots twice as wide.
 
 CPU: ``time.process_time`` of ``optimize_move`` (the search and its verification), one BLAS thread.
 Rows: ``benchmarks/results/via_point_search_<stamp>.csv``; the table: BENCHMARKS.md.
@@ -39,7 +39,7 @@ single_core()
 
 import joulepath  # noqa: E402
 from joulepath.optimize import OptimizeConfig, optimize_move, random_tasks, rapid_execution  # noqa: E402
-from joulepath.optimize._gradient import GRID_SEARCH  # noqa: E402
+from joulepath.optimize._gradient import SEARCH_BEFORE_HULL  # noqa: E402
 from joulepath.optimize._search import (  # noqa: E402
     ALGORITHMS,
     AlgorithmSpec,
@@ -50,12 +50,15 @@ from joulepath.optimize._search import (  # noqa: E402
 RESULTS = Path(__file__).resolve().parent / "results"
 TASKS = NAMED_TASKS
 CANDIDATES: dict[str, tuple[str, Any]] = {
-    "grid": ("GRID_SEARCH on the 0.05 s knots (main's via-point search)", lambda c: dict(GRID_SEARCH)),
+    "grid": (
+        "SEARCH_BEFORE_HULL on the 0.05 s knots (main's via-point search)",
+        lambda c: dict(SEARCH_BEFORE_HULL),
+    ),
     "hull": ("hull rows, preconditioned (the single move's default), 0.05 s knots", lambda c: {}),
     "hull-wide": ("hull rows, preconditioned, 0.1 s knots (`via_point_settings`)", via_point_settings),
     "grid-wide": (
-        "GRID_SEARCH on 0.1 s knots",
-        lambda c: {**GRID_SEARCH, "knot_spacing": 2 * c.knot_spacing},
+        "SEARCH_BEFORE_HULL on 0.1 s knots",
+        lambda c: {**SEARCH_BEFORE_HULL, "knot_spacing": 2 * c.knot_spacing},
     ),
 }
 
