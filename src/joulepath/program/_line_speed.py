@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from joulepath._typing import FloatArray
-from joulepath.sim import PlannedCycle, evaluate_cycle, tcp_pose
+from joulepath.sim import PlannedCycle, PlannedMove, evaluate_cycle, tcp_pose
 
 ON_LINE_M = 0.001
 """A TCP position this close (m) to a line's interior is on the line."""
@@ -38,18 +38,28 @@ class LineSpeed:
     speed_mm_s: float  # the speed data's TCP speed as written (mm/s)
 
 
+def blends(plan: PlannedCycle) -> list[tuple[PlannedMove, float, float]]:
+    """Each moving move of ``plan`` with the time (s) the controller blends the move before into it
+    and it into the next (superposed; 0 where one stops first)."""
+    moving = [m for m in plan.moves if m.profile.duration > 0]
+    out: list[tuple[PlannedMove, float, float]] = []
+    for k, m in enumerate(moving):
+        into = max(0.0, moving[k - 1].t_end - m.t0) if k > 0 else 0.0
+        out_of = max(0.0, m.t_end - moving[k + 1].t0) if k + 1 < len(moving) else 0.0
+        out.append((m, into, out_of))
+    return out
+
+
 def line_speeds(plan: PlannedCycle) -> tuple[LineSpeed, ...]:
     """The interior of each ``MoveL`` line of the taught cycle ``plan`` with its speed bound: the
     speed data's ``v_tcp``, and ``v_ori`` over the line's turn as a TCP speed along it (the
     lesser), as the plan bounds it."""
-    moving = [m for m in plan.moves if m.profile.duration > 0]
     out: list[LineSpeed] = []
-    for k, m in enumerate(moving):
+    for m, into, out_of in blends(plan):
         step = m.step
         if not step.linear or step.speed is None or step.robot is None or step.tcp is None:
             continue
-        a = max(m.t0, moving[k - 1].t_end) if k > 0 else m.t0  # after the blend into it
-        b = min(m.t_end, moving[k + 1].t0) if k + 1 < len(moving) else m.t_end  # before the next
+        a, b = m.t0 + into, m.t_end - out_of  # after the blend into it, before the blend out of it
         if b - a <= 1e-6 or m.path.length_mm <= 1e-6:
             continue
         v = step.speed.v_tcp

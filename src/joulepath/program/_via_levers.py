@@ -347,16 +347,26 @@ def via_levers(
     e_taught, lab_taught = taught.energies(plan_t)
     path = f"{spec.module.path} (via points)"
     lines = line_speeds(plan_t)
-    on_lines: dict[str, tuple[float, LineSpeed | None]] = {}  # per module: its fastest on a MoveL line
+    runs: dict[str, tuple[CycleSpec, PlannedCycle]] = {}  # per module run: what it was read as and its plan
+    on_lines: dict[str, float] = {}  # per module asked: its fastest on a MoveL line, to its speed data
 
     def run(candidate: str) -> tuple[CycleSpec, float, float]:
         spec_c = resolve_module(parse_module(candidate, path=path), robot)
         plan_c, t_c, e_c = _Evaluator(spec_c, [], energy, config)(())
-        on_lines[candidate] = _fastest_on_lines(lines, plan_c, _added_lines(spec_c))
+        runs[candidate] = (spec_c, plan_c)
         return spec_c, t_c, e_c
 
+    def line_ratio(candidate: str) -> float:
+        if candidate not in on_lines:  # the motion's TCP, only for the modules whose lines are asked about
+            spec_c, plan_c = runs[candidate]
+            on_lines[candidate] = _fastest_on_lines(lines, plan_c, _added_lines(spec_c))[0]
+        return on_lines[candidate]
+
     def keeps_lines(candidate: str) -> bool:
-        return on_lines[candidate][0] <= 1.0 + SPEED_TOL
+        return line_ratio(candidate) <= 1.0 + SPEED_TOL
+
+    def in_time_first(t: float, e: float) -> tuple[bool, float]:  # within the taught time, least energy
+        return (t > t_taught + _TOL_S, e if t <= t_taught + _TOL_S else t)  # else the least over it
 
     def fit(candidate: str) -> tuple[str, CycleSpec, float, float, int]:
         """The module within the taught cycle time: its ``\\T`` shortened, else units put back as taught
@@ -369,7 +379,7 @@ def via_levers(
                 break
             keep = [x for x in backs if keeps_lines(x[0])]
             candidate, spec_v, t_v, e_v = (
-                min(keep, key=lambda x: x[3]) if keep else min(backs, key=lambda x: on_lines[x[0]][0])
+                min(keep, key=lambda x: x[3]) if keep else min(backs, key=lambda x: line_ratio(x[0]))
             )
             back += 1
         candidate, spec_v, t_v, e_v = _fitted(candidate, spec_v, t_v, e_v, t_taught, run, keeps_lines)
@@ -413,13 +423,7 @@ def via_levers(
                 if keeps_lines(timed.text):  # its chains on a MoveL's line are timed within its speed data
                     timings.append(timed)
             if timings:  # within the taught cycle for the least energy, else the least over it
-                timed = min(
-                    timings,
-                    key=lambda x: (
-                        x.cycle_s > t_taught + _TOL_S,
-                        x.energy_J if x.cycle_s <= t_taught + _TOL_S else x.cycle_s,
-                    ),
-                )
+                timed = min(timings, key=lambda x: in_time_first(x.cycle_s, x.energy_J))
                 # not fitted by shortening its \T (that breaks its chains): over the taught time, the lever
                 # search brings it in
                 spec_t = resolve_module(parse_module(timed.text, path=path), robot)
@@ -429,9 +433,7 @@ def via_levers(
                 timed_n = timed.timed
     except JoulepathError as err:
         return ViaLevers(None, f"the via-point module cannot be read: {err}")
-    text, via_spec, t_via, e_via, reverted, _ = min(
-        bases, key=lambda b: (b[2] > t_taught + _TOL_S, b[3] if b[2] <= t_taught + _TOL_S else b[2])
-    )
+    text, via_spec, t_via, e_via, reverted, _ = min(bases, key=lambda b: in_time_first(b[2], b[3]))
     if not any(b[2] <= t_taught + _TOL_S for b in bases) and not timed_chains:
         return ViaLevers(
             None,

@@ -38,7 +38,7 @@ from scipy.optimize import minimize
 
 from joulepath._typing import FloatArray
 from joulepath.program._levers import _Evaluator
-from joulepath.program._line_speed import LineSpeed, chord_floor
+from joulepath.program._line_speed import LineSpeed, blends, chord_floor
 from joulepath.program._resolve import CycleSpec
 from joulepath.sim import ControllerConfig, PlannedCycle, tcp_pose
 from joulepath.sim._limits import acceleration_limit
@@ -307,8 +307,8 @@ def time_chains(
     procedures' ``lines`` timed for the controller (module docstring); ``cycle_s``: the taught
     cycle time the whole module must keep; ``run_cycle(text) -> (cycle s, energy J)``: the whole
     module on the emulation; ``max_seconds``: wall time of the searches (after it, each chain is
-    written at its shortest times, stretched over its budget where that holds); ``lines``: the taught
-    ``MoveL`` lines, whose speed data bounds each chain segment on them."""
+    written at its shortest times, stretched over its budget where that holds); ``speeds``: the
+    taught ``MoveL`` lines, whose speed data bounds each chain segment on them."""
     deadline = None if max_seconds is None else time.perf_counter() + max_seconds
     chains: list[tuple[_Chain, FloatArray, float, float]] = []  # chain, fastest, its time, the plan's
     kept = 0
@@ -328,22 +328,17 @@ def time_chains(
     for _ in range(FITS):
         out = text.splitlines(keepends=True)
         for n, ((chain, fast, t_fast, _), budget) in enumerate(zip(chains, budgets, strict=True)):
-            if n in timed and timed[n][0] == budget:  # its budget unchanged: the same times
-                T = timed[n][1]
-                for i, t in zip(chain.run.steps, T, strict=True):
-                    k = chain.spec.steps[i].line - 1
-                    out[k] = T_ARG.sub(_written(float(t)), out[k])
-                continue
-            start = fast
-            if t_fast < budget:  # the spare time spread over the chain, where that still holds
-                slow = fast * (1.0 + (budget - t_fast) / max(float(fast.sum()), 1e-9))
-                held, t_slow, _ = chain.motion(slow)
-                if held and chain.conditions(slow).min() >= 0.0 and t_slow <= budget + 1e-9:
-                    start = slow
-            late = deadline is not None and time.perf_counter() > deadline
-            T = start if late or t_fast >= budget * (1.0 - FREEDOM) else _cheapest(chain, start, budget)[0]
-            timed[n] = (budget, T)
-            for i, t in zip(chain.run.steps, T, strict=True):
+            if n not in timed or timed[n][0] != budget:  # else its budget unchanged: the same times
+                start = fast
+                if t_fast < budget:  # the spare time spread over the chain, where that still holds
+                    slow = fast * (1.0 + (budget - t_fast) / max(float(fast.sum()), 1e-9))
+                    held, t_slow, _ = chain.motion(slow)
+                    if held and chain.conditions(slow).min() >= 0.0 and t_slow <= budget + 1e-9:
+                        start = slow
+                late = deadline is not None and time.perf_counter() > deadline
+                free = not late and t_fast < budget * (1.0 - FREEDOM)
+                timed[n] = (budget, _cheapest(chain, start, budget)[0] if free else start)
+            for i, t in zip(chain.run.steps, timed[n][1], strict=True):
                 k = chain.spec.steps[i].line - 1
                 out[k] = T_ARG.sub(_written(float(t)), out[k])
         candidate = "".join(out)
@@ -386,13 +381,8 @@ def dense_vias(
     from joulepath.sim._via import _leg_indices
 
     steps = plan.spec.steps
-    blends: dict[int, tuple[float, float]] = {}  # per move: the taught blends into it and out of it (s)
-    if taught is not None:
-        moving = [m for m in taught.moves if m.profile.duration > 0]
-        for k, m in enumerate(moving):
-            into = max(0.0, moving[k - 1].t_end - m.t0) if k > 0 else 0.0
-            out_of = max(0.0, m.t_end - moving[k + 1].t0) if k + 1 < len(moving) else 0.0
-            blends[m.index] = (into, out_of)
+    # per move: the taught blends into it and out of it (s)
+    taught_blends = {} if taught is None else {m.index: (a, b) for m, a, b in blends(taught)}
     moves = [k for k, st in enumerate(steps) if st.kind == "move"]
     where = {k: n for n, k in enumerate(moves)}
     out: dict[int, tuple[int, ...]] = {}
@@ -404,10 +394,10 @@ def dense_vias(
         n = where[i]
         before = moves[n - 1] if n > 0 else None
         after = moves[n + 1] if n + 1 < len(moves) else None
-        if step.linear or i not in blends:  # a MoveL's via points stay on its line, at its speed data
+        if step.linear or i not in taught_blends:  # a MoveL's via points stay on its line, at its speed data
             out[i] = tuple(idx)
             continue
-        into, out_of = blends[i]
+        into, out_of = taught_blends[i]
         if before is None or before in plan.vias:
             into = 0.0
         if after is None or after in plan.vias:
