@@ -17,7 +17,7 @@ from joulepath.errors import InvalidInput
 from joulepath.program import parse_module, read_cycle_program, resolve_module
 from joulepath.program._cycle import _energy
 from joulepath.program._levers import _slots, levers_module, write_levers
-from joulepath.sim import ControllerConfig, make_plant
+from joulepath.sim import ControllerConfig, make_plant, tcp_pose
 from joulepath.sim import _timing as timing
 from joulepath.sim._limits import jerk_limit
 from joulepath.sim._profile import Profile, plan_profile
@@ -376,3 +376,71 @@ def test_a_search_stopped_by_its_time_budget_reports_the_plans_it_made(robot):
     spec = _spec(JOINT_CYCLE, robot)
     lv = levers_module(spec, robot, energy="thesis", text=JOINT_CYCLE, max_seconds=1e-9, max_evaluations=400)
     assert 1 <= lv.n_evaluations <= 400  # the plans made, not the marker that stopped the search
+
+
+def _farthest_mm(plan, taught_pos) -> float:
+    """The farthest the cycle's TCP comes from ``taught_pos`` (mm), by brute force."""
+    n = int(np.ceil(plan.cycle_time / FINE_DT)) + 1
+    traj = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
+    first = plan.moves[0].step
+    pos = tcp_pose(first.robot, traj.q, first.tcp)[0]
+    d = np.linalg.norm(pos[:, None, :] - taught_pos[None, :, :], axis=2).min(axis=1)
+    return 1000.0 * float(d.max())
+
+
+def test_a_bound_on_the_motion_holds_at_every_step_the_search_takes(robot):
+    spec = _spec(JOINT_CYCLE, robot)
+    plan0 = plan_cycle(spec, ControllerConfig())
+    n = int(np.ceil(plan0.cycle_time / FINE_DT)) + 1
+    traj0 = evaluate_cycle(plan0, np.linspace(0.0, plan0.cycle_time, n))
+    first = plan0.moves[0].step
+    taught_pos = tcp_pose(first.robot, traj0.q, first.tcp)[0]
+    free = levers_module(spec, robot, energy="thesis", text=JOINT_CYCLE, max_evaluations=300)
+    free_dev = _farthest_mm(plan_cycle(_spec(free.written_text, robot), ControllerConfig()), taught_pos)
+    assert free.energy_J < free.default_energy_J and free_dev > 0.5  # its levers move the path
+    bound = free_dev / 2.0
+    asked = []
+
+    def past(plan) -> float:
+        asked.append(plan)
+        return _farthest_mm(plan, taught_pos) - bound
+
+    held = levers_module(spec, robot, energy="thesis", text=JOINT_CYCLE, max_evaluations=300, excess=past)
+    assert asked  # it was asked, and what the search took keeps it
+    assert _farthest_mm(plan_cycle(_spec(held.written_text, robot), ControllerConfig()), taught_pos) <= bound
+    assert held.cycle_s <= held.taught_cycle_s + 1e-9 and held.energy_J <= held.default_energy_J
+    # a bound nothing passes: nothing taken, the program as given
+    none = levers_module(
+        spec, robot, energy="thesis", text=JOINT_CYCLE, max_evaluations=300, excess=lambda p: 1.0
+    )
+    assert none.n_changed == 0 and none.written_text == JOINT_CYCLE
+
+
+def test_a_module_past_the_bound_is_first_brought_within_it(robot):
+    # the bound: the path of the cycle with small zones; the module cuts its corners at z20 and has time
+    # to spare (its baseline), so smaller zones bring it within the bound
+    near = JOINT_CYCLE.replace("z20", "z1").replace("z10", "z1")
+    plan_n = plan_cycle(_spec(near, robot), ControllerConfig())
+    n = int(np.ceil(plan_n.cycle_time / FINE_DT)) + 1
+    traj_n = evaluate_cycle(plan_n, np.linspace(0.0, plan_n.cycle_time, n))
+    first = plan_n.moves[0].step
+    ref = tcp_pose(first.robot, traj_n.q, first.tcp)[0]
+    spec = _spec(JOINT_CYCLE, robot)
+    plan0 = plan_cycle(spec, ControllerConfig())
+    dev0 = _farthest_mm(plan0, ref)
+    assert dev0 > 2.0
+    bound = dev0 / 2.0
+    baseline = (plan_n.cycle_time + 0.05, 1e9, 1e9)
+    lv = levers_module(
+        spec,
+        robot,
+        energy="thesis",
+        text=JOINT_CYCLE,
+        baseline=baseline,
+        max_evaluations=300,
+        excess=lambda p: _farthest_mm(p, ref) - bound,
+    )
+    again = plan_cycle(_spec(lv.written_text, robot), ControllerConfig())
+    assert _farthest_mm(again, ref) <= bound
+    assert lv.cycle_s <= baseline[0] + 1e-6
+    assert any(m.chosen.zone != m.taught.zone for m in lv.moves)

@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import re
 import time
-from collections.abc import Collection
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -508,11 +508,54 @@ Tried = tuple[tuple[int, str], Setting, float, float]
 
 
 def _search(
-    ev: _Evaluator, slots: list[_Slot], target_s: float, max_evaluations: int, pairs: int
+    ev: _Evaluator,
+    slots: list[_Slot],
+    target_s: float,
+    max_evaluations: int,
+    pairs: int,
+    excess: Callable[[PlannedCycle], float] | None = None,
 ) -> tuple[Setting, ...]:
-    """Coordinate descent with exchanges (module docstring), within ``max_evaluations`` plans."""
+    """Coordinate descent with exchanges (module docstring), within ``max_evaluations`` plans.
+
+    With ``excess`` (how far a plan is past a bound of the caller's; within it at 0 or less), a change
+    is taken only where its plan is within the bound (asked only of changes that would be taken, once
+    per setting); a start past it is first brought within (each step the change that gets there within
+    the time for the least energy, else in the least time, else the one that comes nearest), then
+    into the time."""
     state = tuple(s.taught for s in slots)
     plan, t, e = ev(state)
+    past: dict[tuple[Setting, ...], float] = {}
+
+    def over(trial: tuple[Setting, ...]) -> float:
+        if excess is None:
+            return 0.0
+        if trial not in past:
+            past[trial] = excess(ev(trial)[0])
+        return past[trial]
+
+    def ok(trial: tuple[Setting, ...]) -> bool:
+        return over(trial) <= 0.0
+
+    while over(state) > 0.0 and ev.n < max_evaluations:  # past the caller's bound: first within it,
+        # each step the change that gets there within the time for the least energy, else in the least
+        # time (the next phase brings it into the time), else the one that comes nearest
+        steps: list[tuple[tuple[int, float], tuple[Setting, ...]]] = []
+        for k, slot in enumerate(slots):
+            for kind in _kinds(slot):
+                duration = _durations(plan).get((slot.line, slot.instruction), 0.0)
+                for option in _options(state, k, kind, slot, ev.spec, duration):
+                    trial = _with(state, k, option)
+                    _, t_new, e_new = ev(trial)
+                    x = over(trial)
+                    if x <= 0.0:
+                        steps.append(((0, e_new) if t_new <= target_s + _TOL_S else (1, t_new), trial))
+                    elif x < over(state) and t_new <= max(t, target_s) + _TOL_S:
+                        steps.append(((2, x), trial))
+        if not steps:
+            break
+        state = min(steps, key=lambda r: r[0])[1]
+        plan, t, e = ev(state)
+
     while t > target_s + _TOL_S and ev.n < max_evaluations:  # over the cycle time (a module written
         # from a plan): first into it, each step the change that gets there for the least energy, else
         # the one that buys time cheapest (energy per second)
@@ -525,10 +568,11 @@ def _search(
                     trial = _with(state, k, option)
                     _, t_new, e_new = ev(trial)
                     if t_new <= target_s + _TOL_S and (into is None or e_new < into[0]):
-                        into = (e_new, trial)
+                        if ok(trial):
+                            into = (e_new, trial)
                     elif t_new < t - 1e-6:
                         rate = (e_new - e) / (t - t_new)
-                        if cheap is None or rate < cheap[0]:
+                        if (cheap is None or rate < cheap[0]) and ok(trial):
                             cheap = (rate, trial)
         step = into or cheap
         if step is None:
@@ -552,7 +596,7 @@ def _search(
                         break
                     _, t_new, e_new = ev(_with(state, k, option))
                     tried.append(((k, kind), option, t_new - t, e_new - e))
-                    if better(t_new, e_new, best):
+                    if better(t_new, e_new, best) and ok(_with(state, k, option)):
                         best = (e_new, option)
                 if best is not None:
                     state = _with(state, k, best[1])
@@ -586,7 +630,7 @@ def _search(
             both = _with(state, kg, _combine(state[kg], g[1], kind_g))
             both = _with(both, ks, _combine(both[ks], s[1], kind_s))
             _, t_new, e_new = ev(both)
-            if better(t_new, e_new, None):
+            if better(t_new, e_new, None) and ok(both):
                 state = both
                 plan, t, e = ev(state)
                 used |= {g[0], s[0]}
@@ -811,6 +855,7 @@ def levers_module(
     max_seconds: float | None = None,
     baseline: tuple[float, float, float] | None = None,
     only_lines: Collection[int] | None = None,
+    excess: Callable[[PlannedCycle], float] | None = None,
 ) -> LeverResult:
     """Search the controller's levers of a RAPID program's cycle and write them into its text.
 
@@ -847,6 +892,11 @@ def levers_module(
         ``taught_cycle_s`` and ``default_*`` are its.
     only_lines : collection of int, optional
         Only the move statements on these lines get levers; the others stay as written.
+    excess : callable, optional
+        A bound of the caller's on the motion (for example, a corridor around the taught path): how far
+        a cycle's plan is past it (0 or less: within). The search takes a change only where the plan
+        with it is within; a module that starts past it is first brought within where its levers can
+        (else it is returned as given, for the caller to refuse).
 
     Returns
     -------
@@ -892,7 +942,7 @@ def levers_module(
         raise InvalidInput(f"cycle_time_s must be positive, got {cycle_time_s}")
     idle = _idle_waits(spec, lines) if use_waits else {}
     idle_s = sum(sec * n for sec, n, _, _ in idle.values())
-    chosen = _search(ev, slots, target + idle_s, max_evaluations, pairs)
+    chosen = _search(ev, slots, target + idle_s, max_evaluations, pairs, excess)
     _, t_search, e_search = ev(chosen)
     spent = max(0.0, t_search - target)
     new_waits: dict[int, float] = {}

@@ -54,7 +54,6 @@ from joulepath.program._parse import parse_module
 from joulepath.program._resolve import CycleSpec, resolve_module
 from joulepath.program._via_timing import BLEND_ROOM, T_ARG, _written, dense_vias, time_chains
 from joulepath.sim import ControllerConfig, PlannedCycle, tcp_pose
-from joulepath.trajectory import Trajectory
 
 _TOL_S = 1e-6
 _TOL_REL = 1e-6
@@ -276,13 +275,13 @@ def _fastest_on_lines(
     return fastest_on_lines(lines, pos, vel)
 
 
-def _tcp_path(plan: PlannedCycle) -> tuple[FloatArray, Trajectory]:
-    """The cycle's TCP positions (m) and motion on the 2.5 ms grid (the first move's robot and tool)."""
+def _tcp_path(plan: PlannedCycle) -> FloatArray:
+    """The cycle's TCP positions (m) on the 2.5 ms grid (the first move's robot and tool)."""
     traj = cycle_motion(plan)
     first = plan.moves[0].step
     assert first.robot is not None and first.tcp is not None
     pos, _ = tcp_pose(first.robot, traj.q, first.tcp)
-    return pos, traj
+    return pos
 
 
 def via_levers(
@@ -446,7 +445,13 @@ def via_levers(
     from joulepath.program._cell import clearance
 
     original = list(spec.module.source)
-    taught_pos, _ = _tcp_path(plan_t)
+    taught_tree = cKDTree(_tcp_path(plan_t))
+
+    def deviation_mm(plan_c: PlannedCycle) -> float:
+        """The farthest the cycle's TCP comes from the taught cycle's TCP path (mm)."""
+        return 1000.0 * float(taught_tree.query(_tcp_path(plan_c))[0].max())
+
+    past_corridor = None if corridor_mm is None else (lambda p: deviation_mm(p) - corridor_mm)
     dev: float | None = None
     clear: float | None = None
     header: list[str] = []
@@ -472,6 +477,7 @@ def via_levers(
                 max_evaluations=MAX_PLANS,
                 baseline=(t_taught, e_taught, lab_taught),
                 only_lines=only,
+                excess=past_corridor,  # every step the search takes keeps the corridor
             )
         except InvalidInput as err:
             why = f"the levers of the via points: {err}"
@@ -507,13 +513,13 @@ def via_levers(
                 f"searched {lv.cycle_s:.3f} s and {lv.energy_J:.3f} J; not written"
             )
             continue
-        pos, traj = _tcp_path(plan_a)
-        dev = 1000.0 * float(cKDTree(taught_pos).query(pos)[0].max())
+        dev = deviation_mm(plan_a)
         clear = None
         if cell is not None:
             first = plan_a.moves[0].step
             assert first.robot is not None and first.tcp is not None
-            clear = 1000.0 * (clearance(cell, first.robot, traj.q, first.tcp).distance - cell.margin)
+            q = cycle_motion(plan_a).q
+            clear = 1000.0 * (clearance(cell, first.robot, q, first.tcp).distance - cell.margin)
         if corridor_mm is not None and dev > corridor_mm:
             why = f"its TCP leaves the taught path by {dev:.1f} mm (the corridor is {corridor_mm:g} mm)"
             continue
