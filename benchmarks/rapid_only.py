@@ -52,7 +52,7 @@ def run(program: Path, export: str) -> dict[str, object]:
         "via_levers_pct": via.get("executed_saved_pct"),
         "via_levers_note": via.get("note"),
         "via_levers_kept": via.get("optimized_moves_kept_as_taught"),
-        "via_levers_dev_mm": via.get("tcp_from_taught_path_mm"),
+        "via_levers_dev_mm": via.get("tool0_from_taught_path_mm"),
         "written": c.get("rapid_written_from"),
         "executed_pct": c.get("executed_saved_pct"),
         "executed_cycle_s": c.get("executed_cycle_s"),
@@ -126,8 +126,8 @@ the thesis energy (the CLI's default), at the program's own cycle time:
 - *levers*: the controller's levers (AccSet, speed data or \\T, zones) of the taught program;
 - *via points + levers*: the plan's via-point module run as the controller runs it (fitted into the
   taught cycle time where needed), with the levers of its via points searched on the emulation
-  (`joulepath.program.via_levers`); "from taught path": the largest distance of its TCP from the
-  taught cycle's TCP path (the corridor is 100 mm).
+  (`joulepath.program.via_levers`); "from taught path": the largest distance of its tool0 from the
+  taught cycle's tool0 path (the corridor is 100 mm, as the plan keeps it for tool0).
 
 The written module is the best of them; "RAPID / EGM": its executed saving over the EGM plan's
 planned saving. `--export auto` writes EGM too where RAPID saves less than half of the plan.

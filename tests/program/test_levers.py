@@ -378,14 +378,18 @@ def test_a_search_stopped_by_its_time_budget_reports_the_plans_it_made(robot):
     assert 1 <= lv.n_evaluations <= 400  # the plans made, not the marker that stopped the search
 
 
-def _farthest_mm(plan, taught_pos) -> float:
-    """The farthest the cycle's TCP comes from ``taught_pos`` (mm), by brute force."""
+def _farthest(plan, taught_pos) -> tuple[float, float]:
+    """The farthest the cycle's TCP comes from ``taught_pos`` (mm), by brute force, and when (s)."""
     n = int(np.ceil(plan.cycle_time / FINE_DT)) + 1
     traj = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
     first = plan.moves[0].step
     pos = tcp_pose(first.robot, traj.q, first.tcp)[0]
     d = np.linalg.norm(pos[:, None, :] - taught_pos[None, :, :], axis=2).min(axis=1)
-    return 1000.0 * float(d.max())
+    return 1000.0 * float(d.max()), float(traj.t[np.argmax(d)])
+
+
+def _farthest_mm(plan, taught_pos) -> float:
+    return _farthest(plan, taught_pos)[0]
 
 
 def test_a_bound_on_the_motion_holds_at_every_step_the_search_takes(robot):
@@ -398,20 +402,22 @@ def test_a_bound_on_the_motion_holds_at_every_step_the_search_takes(robot):
     free = levers_module(spec, robot, energy="thesis", text=JOINT_CYCLE, max_evaluations=300)
     free_dev = _farthest_mm(plan_cycle(_spec(free.written_text, robot), ControllerConfig()), taught_pos)
     assert free.energy_J < free.default_energy_J and free_dev > 0.5  # its levers move the path
-    bound = free_dev / 2.0
+    limit_mm = free_dev / 2.0
     asked = []
 
-    def past(plan) -> float:
+    def past(plan):
         asked.append(plan)
-        return _farthest_mm(plan, taught_pos) - bound
+        mm, at_s = _farthest(plan, taught_pos)
+        return mm - limit_mm, at_s
 
-    held = levers_module(spec, robot, energy="thesis", text=JOINT_CYCLE, max_evaluations=300, excess=past)
+    held = levers_module(spec, robot, energy="thesis", text=JOINT_CYCLE, max_evaluations=300, bound=past)
     assert asked  # it was asked, and what the search took keeps it
-    assert _farthest_mm(plan_cycle(_spec(held.written_text, robot), ControllerConfig()), taught_pos) <= bound
+    again = plan_cycle(_spec(held.written_text, robot), ControllerConfig())
+    assert _farthest_mm(again, taught_pos) <= limit_mm
     assert held.cycle_s <= held.taught_cycle_s + 1e-9 and held.energy_J <= held.default_energy_J
     # a bound nothing passes: nothing taken, the program as given
     none = levers_module(
-        spec, robot, energy="thesis", text=JOINT_CYCLE, max_evaluations=300, excess=lambda p: 1.0
+        spec, robot, energy="thesis", text=JOINT_CYCLE, max_evaluations=300, bound=lambda p: (1.0, 0.0)
     )
     assert none.n_changed == 0 and none.written_text == JOINT_CYCLE
 
@@ -429,7 +435,7 @@ def test_a_module_past_the_bound_is_first_brought_within_it(robot):
     plan0 = plan_cycle(spec, ControllerConfig())
     dev0 = _farthest_mm(plan0, ref)
     assert dev0 > 2.0
-    bound = dev0 / 2.0
+    limit_mm = dev0 / 2.0
     baseline = (plan_n.cycle_time + 0.05, 1e9, 1e9)
     lv = levers_module(
         spec,
@@ -438,9 +444,9 @@ def test_a_module_past_the_bound_is_first_brought_within_it(robot):
         text=JOINT_CYCLE,
         baseline=baseline,
         max_evaluations=300,
-        excess=lambda p: _farthest_mm(p, ref) - bound,
+        bound=lambda p: (_farthest(p, ref)[0] - limit_mm, _farthest(p, ref)[1]),
     )
     again = plan_cycle(_spec(lv.written_text, robot), ControllerConfig())
-    assert _farthest_mm(again, ref) <= bound
+    assert _farthest_mm(again, ref) <= limit_mm
     assert lv.cycle_s <= baseline[0] + 1e-6
     assert any(m.chosen.zone != m.taught.zone for m in lv.moves)

@@ -507,49 +507,65 @@ Tried = tuple[tuple[int, str], Setting, float, float]
 """A single change tried: (slot, lever), the slot's new setting, its change of cycle time and energy."""
 
 
+Bound = Callable[[PlannedCycle], tuple[float, float]]
+"""A bound of the caller's on a cycle's motion: how far its plan is past it (0 or less: within) and when
+in the cycle (s) it is farthest past (or nearest to it)."""
+
+
+def _near(plan: PlannedCycle, at_s: float) -> set[int]:
+    """The steps of the moves that run at ``at_s`` in ``plan``, and of the move before and after each."""
+    runs = [i for i, m in enumerate(plan.moves) if m.t0 - _TOL_S <= at_s <= m.t_end + _TOL_S]
+    ends = {j for i in runs for j in (i - 1, i, i + 1) if 0 <= j < len(plan.moves)}
+    return {plan.moves[j].index for j in ends}
+
+
 def _search(
     ev: _Evaluator,
     slots: list[_Slot],
     target_s: float,
     max_evaluations: int,
     pairs: int,
-    excess: Callable[[PlannedCycle], float] | None = None,
+    bound: Bound | None = None,
 ) -> tuple[Setting, ...]:
     """Coordinate descent with exchanges (module docstring), within ``max_evaluations`` plans.
 
-    With ``excess`` (how far a plan is past a bound of the caller's; within it at 0 or less), a change
-    is taken only where its plan is within the bound (asked only of changes that would be taken, once
-    per setting); a start past it is first brought within (each step the change that gets there within
-    the time for the least energy, else in the least time, else the one that comes nearest), then
-    into the time."""
+    With ``bound``, a change is taken only where its plan is within the bound (asked only of changes
+    that would be taken, once per setting); a start past it is first brought within, by the levers of
+    the statements that run where it is farthest past (each step the change that gets it within the
+    time for the least energy, else in the least time, else the one that comes nearest), then into
+    the time."""
     state = tuple(s.taught for s in slots)
     plan, t, e = ev(state)
-    past: dict[tuple[Setting, ...], float] = {}
+    past: dict[tuple[Setting, ...], tuple[float, float]] = {}
 
-    def over(trial: tuple[Setting, ...]) -> float:
-        if excess is None:
-            return 0.0
+    def over(trial: tuple[Setting, ...]) -> tuple[float, float]:
+        if bound is None:
+            return (0.0, 0.0)
         if trial not in past:
-            past[trial] = excess(ev(trial)[0])
+            past[trial] = bound(ev(trial)[0])
         return past[trial]
 
     def ok(trial: tuple[Setting, ...]) -> bool:
-        return over(trial) <= 0.0
+        return over(trial)[0] <= 0.0
 
-    while over(state) > 0.0 and ev.n < max_evaluations:  # past the caller's bound: first within it,
-        # each step the change that gets there within the time for the least energy, else in the least
-        # time (the next phase brings it into the time), else the one that comes nearest
+    while not ok(state) and ev.n < max_evaluations:  # past the caller's bound: first within it
+        x_now, at_s = over(state)
+        near = _near(plan, at_s)
         steps: list[tuple[tuple[int, float], tuple[Setting, ...]]] = []
         for k, slot in enumerate(slots):
+            if near.isdisjoint(slot.steps):
+                continue
             for kind in _kinds(slot):
                 duration = _durations(plan).get((slot.line, slot.instruction), 0.0)
                 for option in _options(state, k, kind, slot, ev.spec, duration):
                     trial = _with(state, k, option)
+                    if ev.n >= max_evaluations and trial not in ev.memo:
+                        break
                     _, t_new, e_new = ev(trial)
-                    x = over(trial)
+                    x = over(trial)[0]
                     if x <= 0.0:
                         steps.append(((0, e_new) if t_new <= target_s + _TOL_S else (1, t_new), trial))
-                    elif x < over(state) and t_new <= max(t, target_s) + _TOL_S:
+                    elif x < x_now and t_new <= max(t, target_s) + _TOL_S:
                         steps.append(((2, x), trial))
         if not steps:
             break
@@ -855,7 +871,7 @@ def levers_module(
     max_seconds: float | None = None,
     baseline: tuple[float, float, float] | None = None,
     only_lines: Collection[int] | None = None,
-    excess: Callable[[PlannedCycle], float] | None = None,
+    bound: Bound | None = None,
 ) -> LeverResult:
     """Search the controller's levers of a RAPID program's cycle and write them into its text.
 
@@ -892,11 +908,11 @@ def levers_module(
         ``taught_cycle_s`` and ``default_*`` are its.
     only_lines : collection of int, optional
         Only the move statements on these lines get levers; the others stay as written.
-    excess : callable, optional
-        A bound of the caller's on the motion (for example, a corridor around the taught path): how far
-        a cycle's plan is past it (0 or less: within). The search takes a change only where the plan
-        with it is within; a module that starts past it is first brought within where its levers can
-        (else it is returned as given, for the caller to refuse).
+    bound : callable, optional
+        A bound of the caller's on the motion (for example, a corridor around the taught path):
+        :data:`Bound`. The search takes a change only where the plan with it is within; a module that
+        starts past it is first brought within where its levers can (else it is returned as given,
+        for the caller to refuse).
 
     Returns
     -------
@@ -942,7 +958,7 @@ def levers_module(
         raise InvalidInput(f"cycle_time_s must be positive, got {cycle_time_s}")
     idle = _idle_waits(spec, lines) if use_waits else {}
     idle_s = sum(sec * n for sec, n, _, _ in idle.values())
-    chosen = _search(ev, slots, target + idle_s, max_evaluations, pairs, excess)
+    chosen = _search(ev, slots, target + idle_s, max_evaluations, pairs, bound)
     _, t_search, e_search = ev(chosen)
     spent = max(0.0, t_search - target)
     new_waits: dict[int, float] = {}

@@ -533,7 +533,7 @@ def _via_levers_json(via: Any) -> dict[str, Any]:
         "note": via.note,
         "via_points_executed_cycle_s": via.via_cycle_s,
         "via_points_executed_energy_J": via.via_energy_J,
-        "tcp_from_taught_path_mm": via.deviation_mm,
+        "tool0_from_taught_path_mm": via.deviation_mm,
         "cell_clearance_mm": via.clearance_mm,
         "optimized_moves_kept_as_taught": via.taught_units,
     }

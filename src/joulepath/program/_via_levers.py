@@ -18,9 +18,11 @@ written on one line under ``! joulepath: was:`` lines of what stood there, so th
 reads back as the program it was written from (:func:`joulepath.program._rapid_write.restore_program`).
 
 Before it is offered, the written text (with its header) is read again by the RAPID interpreter and
-run again by the emulation, and must give the searched cycle time and energy; its TCP path must stay
-within ``corridor_mm`` of the taught cycle's path (the corridor the plan itself keeps), and, with a
-cell, clear the cell's margin. The figures are those of the module as executed, against the taught
+run again by the emulation, and must give the searched cycle time and energy; its tool0 (the flange,
+the point whose corridor the cycle's plan keeps) must stay within ``corridor_mm`` of the taught
+cycle's tool0 path, at every step of the lever search too (a module past it is first brought within
+by the levers of the statements that run where it is farthest), and, with a cell, clear the cell's
+margin. The figures are those of the module as executed, against the taught
 program run by the same emulation, on the run's energy measure.
 
 A ``MoveL``'s speed data is the programmer's bound on its line (an approach to a part at ``v200``),
@@ -70,7 +72,7 @@ class ViaLevers:
     """The via-point module with levers (``levers``, ``base`` ``"via points"``), or None and why not.
 
     ``via_cycle_s``/``via_energy_J``: the via-point module before the levers, as executed;
-    ``deviation_mm``: the largest distance of the written module's TCP from the taught cycle's
+    ``deviation_mm``: the largest distance of the written module's tool0 from the taught cycle's
     path; ``clearance_mm``: from the cell's margin (None without a cell); ``taught_units``: optimized
     moves put back as taught (their statement instead of the via points) to keep the cycle time."""
 
@@ -275,13 +277,16 @@ def _fastest_on_lines(
     return fastest_on_lines(lines, pos, vel)
 
 
-def _tcp_path(plan: PlannedCycle) -> FloatArray:
-    """The cycle's TCP positions (m) on the 2.5 ms grid (the first move's robot and tool)."""
-    traj = cycle_motion(plan)
+def _left(dev_mm: float, corridor_mm: float) -> str:
+    return f"its tool0 leaves the taught path by {dev_mm:.1f} mm (the corridor is {corridor_mm:g} mm)"
+
+
+def _tool0_path(plan: PlannedCycle) -> FloatArray:
+    """The cycle's tool0 (flange) positions (m) on the 2.5 ms grid (the first move's robot): the point
+    whose corridor the cycle's plan keeps (:class:`joulepath.program.CycleSettings` ``corridor_mm``)."""
     first = plan.moves[0].step
-    assert first.robot is not None and first.tcp is not None
-    pos, _ = tcp_pose(first.robot, traj.q, first.tcp)
-    return pos
+    assert first.robot is not None
+    return first.robot.fk(cycle_motion(plan).q).position_m
 
 
 def via_levers(
@@ -307,8 +312,8 @@ def via_levers(
     energy : str
         The energy measure minimised (the run's).
     corridor_mm : float, optional
-        The written module's TCP stays within this distance (mm) of the taught cycle's TCP path
-        (None: not checked).
+        The written module's tool0 stays within this distance (mm) of the taught cycle's tool0 path
+        (None: not checked), and the lever search keeps it at every step.
     cell : Cell, optional
         Obstacles: the written module's motion must keep the cell's margin.
     max_seconds : float, optional
@@ -445,13 +450,18 @@ def via_levers(
     from joulepath.program._cell import clearance
 
     original = list(spec.module.source)
-    taught_tree = cKDTree(_tcp_path(plan_t))
+    taught_tree = cKDTree(_tool0_path(plan_t))
 
-    def deviation_mm(plan_c: PlannedCycle) -> float:
-        """The farthest the cycle's TCP comes from the taught cycle's TCP path (mm)."""
-        return 1000.0 * float(taught_tree.query(_tcp_path(plan_c))[0].max())
+    def farthest(plan_c: PlannedCycle) -> tuple[float, float]:
+        """The farthest the cycle's tool0 comes from the taught cycle's (mm), and when (s)."""
+        d = taught_tree.query(_tool0_path(plan_c))[0]
+        k = int(np.argmax(d))
+        return 1000.0 * float(d[k]), plan_c.cycle_time * k / max(1, d.size - 1)  # its 2.5 ms grid
 
-    past_corridor = None if corridor_mm is None else (lambda p: deviation_mm(p) - corridor_mm)
+    def past_corridor(plan_c: PlannedCycle) -> tuple[float, float]:
+        dev_c, at_s = farthest(plan_c)
+        return dev_c - (np.inf if corridor_mm is None else corridor_mm), at_s
+
     dev: float | None = None
     clear: float | None = None
     header: list[str] = []
@@ -477,11 +487,17 @@ def via_levers(
                 max_evaluations=MAX_PLANS,
                 baseline=(t_taught, e_taught, lab_taught),
                 only_lines=only,
-                excess=past_corridor,  # every step the search takes keeps the corridor
+                bound=None if corridor_mm is None else past_corridor,  # each step keeps the corridor
             )
         except InvalidInput as err:
             why = f"the levers of the via points: {err}"
             continue
+        if corridor_mm is not None:  # where the search could not bring it within the corridor
+            run(lv.written_text)
+            dev = farthest(runs[lv.written_text][1])[0]
+            if dev > corridor_mm:
+                why = _left(dev, corridor_mm)
+                continue
         if not (lv.cycle_s <= t_taught + _TOL_S and lv.energy_J < e_taught):
             why = (
                 f"the via-point module runs {lv.cycle_s:.3f} s for {lv.energy_J:.2f} J against the taught "
@@ -513,7 +529,7 @@ def via_levers(
                 f"searched {lv.cycle_s:.3f} s and {lv.energy_J:.3f} J; not written"
             )
             continue
-        dev = deviation_mm(plan_a)
+        dev = farthest(plan_a)[0]
         clear = None
         if cell is not None:
             first = plan_a.moves[0].step
@@ -521,7 +537,7 @@ def via_levers(
             q = cycle_motion(plan_a).q
             clear = 1000.0 * (clearance(cell, first.robot, q, first.tcp).distance - cell.margin)
         if corridor_mm is not None and dev > corridor_mm:
-            why = f"its TCP leaves the taught path by {dev:.1f} mm (the corridor is {corridor_mm:g} mm)"
+            why = _left(dev, corridor_mm)
             continue
         if clear is not None and clear < 0.0:
             why = f"it comes {-clear:.1f} mm inside the cell's margin"
