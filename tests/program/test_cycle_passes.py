@@ -119,3 +119,54 @@ def test_a_probe_starts_from_the_best_path_shifted_to_its_pass_times(spec):
             k_new = int(np.argmin(np.abs(t - e_new * STEP)))
             was = near.fine.q[int(np.argmin(np.abs(near.fine.t - e_old * STEP)))]
             assert np.abs(q[k_new] - was).max() < 0.25 * np.abs(q_kept[k_new] - was).max()
+
+
+LOOP = """MODULE Loop
+    CONST jointtarget j1 := [[-40, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST jointtarget j2 := [[-15, 30, -10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST jointtarget j3 := [[40, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    PROC main()
+        WHILE TRUE DO
+            MoveAbsJ j2, v500, z50, tool0;
+            MoveAbsJ j3, v500, z50, tool0;
+            MoveAbsJ j1, v500, fine, tool0;
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+
+
+def test_a_long_chain_alone_in_its_cycle_skips_only_durations_that_cannot_win():
+    """A long chain alone in its cycle (no other unit takes the time its shorter durations leave;
+    taught slower than it can run, so its table spans 1.6-2.6 s): its time table solves a shorter
+    duration only where the coarse probe there could win (:meth:`CycleOptimizer._screened`), by the
+    rule its docstring states. Every duration it skips, solved as the table solves the others, takes
+    more energy than the longest, so the best allocation of the whole table is the one of the
+    screened table."""
+    spec = resolve_module(parse_module(LOOP, path="loop.mod"), joulepath.load_robot("irb120"))
+    opt = CycleOptimizer(spec, CycleSettings(gradient=LONG, pass_search=1))
+    (i,) = opt.optimizable
+    assert len(opt.chains[i]) == 3
+    budget = opt.budget(opt.plan.cycle_time, False)
+    table = opt.table(budget)
+    probed = sorted({u for (j, u, _) in opt.probes if j == i})
+    longest = probed[-1]
+    assert opt.gradient.is_long(longest * STEP) and opt._screens_durations(i, longest)
+    solved = {int(round(s.duration / STEP)) for s in table[i] if not s.taught and s.coefficients is not None}
+    assert longest in solved
+    skipped = [u for u in probed[:-1] if u not in solved]
+    assert skipped  # the test exercises the screen
+    best_longest = opt.cache[(i, longest)]
+    assert best_longest.usable
+    probes = {u: s for (j, u, _), s in opt.probes.items() if j == i}
+    ref = probes[longest]
+    bar = ref.energy_J + max(ref.energy_J - best_longest.energy_J, 0.0)
+    for u in probed[:-1]:  # solved where its probe is below the bar, or not usable
+        assert (u in solved) == (not probes[u].usable or probes[u].energy_J < bar)
+    full = {i: [*table[i]]}
+    for u in skipped:
+        s = opt.solve(i, u * STEP)
+        assert not s.usable or s.energy_J > best_longest.energy_J
+        full[i].append(s)
+    screened = opt.best(table, budget, opt.wait_total)
+    assert screened.energy_J == pytest.approx(opt.best(full, budget, opt.wait_total).energy_J, rel=1e-12)

@@ -551,6 +551,8 @@ class CycleOptimizer:
         self.linear: set[int] = set()  # MoveL units: re-timed along their line (retime_on_path)
         self.shares: dict[int, tuple[float, ...]] = {}  # by chain: when it passes its targets (tune_passes)
         self.tuned: set[int] = set()  # chains whose pass times were searched
+        # a long chain's coarse probes by (chain, duration in samples, pass times in samples)
+        self.probes: dict[tuple[int, int, tuple[int, ...]], Solved] = {}
         for seg in self.segments:
             for members, window, inner in self._units_of(seg):
                 self.chains[members[0]] = members
@@ -819,12 +821,7 @@ class CycleOptimizer:
         if coarse:
             probe = replace(probe, knot_spacing=max(probe.knot_spacing, ON_TAUGHT_KNOTS))
         elif long:
-            probe = replace(
-                probe,
-                knot_spacing=max(probe.knot_spacing, LONG_PROBE_KNOTS),
-                coarse_factor=1,
-                continuation=probe.continuation[:-1] or probe.continuation,
-            )
+            probe = self._long_probe_settings()
         elif first is not None and all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
             seen[start] = first
 
@@ -882,13 +879,16 @@ class CycleOptimizer:
             if not moved:
                 step //= 2
         if long:  # on its own knots: at the untuned pass times, and at the best probe's where it won
-            first = self._solve_once(m, units * STEP, units, corridor, way=way_at(start))
-            tuned = self._solve_once(m, units * STEP, units, corridor, way=way_at(best)) if won else None
+            first = self._from_probe(i, units, way_at(start), seen.get(start))
+            tuned = self._from_probe(i, units, way_at(best), seen[best]) if won else None
             if tuned is not None and tuned.usable and (not first.usable or tuned.energy_J < first.energy_J):
                 self.shares[i] = tuple(e / units for e in best)
                 self.cache[(i, units)] = tuned
             elif first.usable:
                 self.cache[(i, units)] = first
+            kept = best if i in self.shares else start  # the pass times of the chain's solves
+            if kept in seen:  # the probe there, for the screen of the time table (:meth:`_screened`)
+                self.probes[(i, units, kept)] = seen[kept]
             return
         if won:  # the best probe (inside a MoveL segment: on its wider knots), verified as every solve is
             self.shares[i] = tuple(e / units for e in best)
@@ -898,6 +898,110 @@ class CycleOptimizer:
             first = self._solve_once(m, units * STEP, units, corridor)
         if first.usable:
             self.cache[(i, units)] = first
+
+    def _long_probe_settings(self) -> GradientSettings:
+        """The search of a long chain's coarse probes (:meth:`tune_passes`, :meth:`_screened`): knots
+        :data:`LONG_PROBE_KNOTS` apart, the continuation stages but the last, ``give_up`` and at most
+        :data:`PROBE_ROUNDS` rounds per stage."""
+        g = self.gradient
+        return replace(
+            g,
+            give_up=True,
+            max_rounds=min(g.max_rounds, PROBE_ROUNDS),
+            knot_spacing=max(g.knot_spacing, LONG_PROBE_KNOTS),
+            coarse_factor=1,
+            continuation=g.continuation[:-1] or g.continuation,
+        )
+
+    def _from_probe(
+        self, i: int, units: int, way: tuple[tuple[float, FloatArray], ...], probe: Solved | None
+    ) -> Solved:
+        """Long chain ``i`` solved at ``units`` samples through its targets at ``way`` on its own knots,
+        from its coarse ``probe`` there (:meth:`_long_probe_settings`: the stages but the last, on
+        wider knots; its path fitted to the chain's knots, :meth:`_time_scaled`) through the last
+        ``refine_stages`` continuation stages, as the wide knots of a cold solve hand over to the fine
+        ones; a cold solve where the probe or that solve is not usable. Measured on the long fly-by
+        chain of issue 36 (one BLAS thread): 7.5 s at 42.277 J, cold 8.9 s at 42.286 J (its own wide
+        knots, 0.166 s apart, take the first stages again)."""
+        m = self.by_index[i]
+        T = units * STEP
+        corridor = self.settings.corridor_mm
+        if probe is not None and probe.usable and probe.coefficients is not None:
+            g = self.gradient
+            refine = replace(g, n_starts=1, coarse_factor=1, continuation=g.continuation[-g.refine_stages :])
+            start = self._time_scaled(i, T, probe)
+            out = self._solve_once(m, T, units, corridor, way=way, gradient=refine, initial=start)
+            if out.usable:
+                return out
+        return self._solve_once(m, T, units, corridor, way=way)
+
+    def _long_probe(self, i: int, units: int) -> Solved:
+        """Chain ``i``'s coarse probe at ``units`` samples, through its targets where its solves pass
+        them (:meth:`waypoints`), as :meth:`tune_passes` probes a long chain; cached. It starts from
+        its nearest probe (at another duration) stretched in time (:meth:`_time_scaled`), through the
+        last :data:`PROBE_WARM_STAGES` stages, and cold where that one is not usable."""
+        T = units * STEP
+        way = self.waypoints(i, T)
+        edges = tuple(int(round(t / STEP)) for t, _ in way)
+        key = (i, units, edges)
+        if key in self.probes:
+            return self.probes[key]
+        self._before_solve()
+        m = self.by_index[i]
+        probe = self._long_probe_settings()
+        corridor = self.settings.corridor_mm
+        near = [
+            s for (j, _, _), s in self.probes.items() if j == i and s.usable and s.coefficients is not None
+        ]
+        out: Solved | None = None
+        if near and PROBE_WARM_STAGES:
+            nearest = min(near, key=lambda s: abs(s.duration - T))
+            warm = replace(probe, continuation=probe.continuation[-PROBE_WARM_STAGES:])
+            start = self._time_scaled(i, T, nearest, probe)
+            out = self._solve_once(m, T, units, corridor, way=way, gradient=warm, initial=start)
+        if out is None or not out.usable:
+            out = self._solve_once(m, T, units, corridor, way=way, gradient=probe)
+        self.probes[key] = out
+        return out
+
+    def _screens_durations(self, i: int, longest: int) -> bool:
+        """Whether unit ``i``'s shorter durations in the time table are screened by coarse probes
+        (:meth:`_screened`): a long fly-by chain (past the gradient's ``max_knots`` at ``longest``
+        samples, :meth:`GradientSettings.is_long`) from rest to rest, alone in its cycle (no other
+        unit takes the time its shorter durations leave: they count only where one of them takes
+        less energy than its longest duration)."""
+        return (
+            len(self.optimizable) == 1
+            and len(self.chains[i]) > 1
+            and i not in self.within
+            and i not in self.linear
+            and self.gradient.is_long(longest * STEP)
+        )
+
+    def _screened(self, i: int, units: list[int]) -> list[Solved]:
+        """Unit ``i`` solved at its durations ``units`` (samples, ascending), alone in its cycle
+        (:meth:`_screens_durations`): at the longest as every duration is (:meth:`solve`), at a shorter
+        one only where its coarse probe (:meth:`_long_probe`) could win, i.e. is below the coarse
+        probe at the longest by less than the longest's own gain from its probe to its solve (a
+        shorter duration whose probe is above that needs more than twice that gain to win), or where
+        either probe is not usable. Measured on the long fly-by chain of issue 36 (5.0, 5.025, 5.075
+        and 5.325 s): probes 48.25, 47.77, 47.12 and 44.27 J (about 1 s each), solves 45.20, 44.95,
+        44.45 and 42.29 J (14-16 s each under load): the gains 3.05, 2.82, 2.67 and 1.98 J, the
+        shorter durations' at most 1.6 times the longest's; the three are screened out."""
+        longest = self.solve(i, units[-1] * STEP)
+        out = [longest]
+        bar = np.inf
+        if longest.usable:
+            ref = self._long_probe(i, units[-1])
+            if ref.usable:
+                bar = ref.energy_J + max(ref.energy_J - longest.energy_J, 0.0)
+        for u in reversed(units[:-1]):  # the nearest first: each solve starts from its nearest
+            if np.isfinite(bar):
+                p = self._long_probe(i, u)
+                if p.usable and p.energy_J >= bar:
+                    continue
+            out.append(self.solve(i, u * STEP))
+        return sorted(out, key=lambda s: s.duration)
 
     def _time_warped(
         self, i: int, near: Solved, edges: tuple[int, ...], gradient: GradientSettings
@@ -1301,11 +1405,14 @@ class CycleOptimizer:
         self.cache[key] = out
         return out
 
-    def _time_scaled(self, i: int, T: float, near: Solved) -> FloatArray:
+    def _time_scaled(
+        self, i: int, T: float, near: Solved, gradient: GradientSettings | None = None
+    ) -> FloatArray:
         """The solve ``near`` of chain ``i`` stretched to ``T`` in the coefficients of a solve at ``T``
-        (fine knots, flat; least squares on the fine grid, offsets from the minimum-jerk move): it
-        passes each target at the same share of the duration, as :meth:`waypoints` asks at ``T``."""
-        g = self.gradient
+        (on ``gradient``'s knots, default the fine ones; flat; least squares on the fine grid, offsets
+        from the minimum-jerk move): it passes each target at the same share of the duration, as
+        :meth:`waypoints` asks at ``T``."""
+        g = self.gradient if gradient is None else gradient
         basis = SplineBasis(T, knot_spacing=g.spacing_for(T), degree=g.degree, dt=STEP)
         fine = basis.grid(STEP / g.check_factor)
         q0, q1 = self.by_index[i].path.q0, self.by_index[self.chains[i][-1]].path.q1
@@ -1552,6 +1659,13 @@ class CycleOptimizer:
                 self.tune_passes(i, (own if own in units else sorted(units)[len(units) // 2]) * STEP)
             except TimeBudgetSpent:
                 return out
+            if self._screens_durations(i, max(units)):
+                try:
+                    out[i].extend(self._screened(i, sorted(units)))
+                except TimeBudgetSpent:
+                    out[i].extend(s for (j, u), s in self.cache.items() if j == i and u in units)
+                    return out
+                continue
             for u in sorted(units):
                 try:
                     out[i].append(self.solve(i, u * STEP))
