@@ -817,7 +817,8 @@ class CycleOptimizer:
         the first from the best probe's path shifted in time to its pass times (:meth:`_time_warped`),
         at most :data:`LONG_PROBES` per target in a row without a gain, its first step 1/8 of a leg;
         the chain is then solved at the untuned pass times and, where a probe won, at the best
-        probe's, and the better is kept (the long fly-by chain of issue 36: 42 probes of 7-9 s each,
+        probe's, each from its probe (:meth:`_from_probe`), and the better is kept; the probe at the
+        kept pass times screens the time table's shorter durations (:meth:`_screened`) (the long fly-by chain of issue 36: 42 probes of 7-9 s each,
         every one ending at the smoothest path, -> 14 of about 1.5 s). Measured on
         pick_and_place (issue 36, with the re-timing's scaled search): 19.9 s at 12.19 %; the best
         pass times solved again on :data:`WITHIN_KNOTS`, kept where that beat the untuned solve
