@@ -7,7 +7,7 @@ import pytest
 import joulepath
 from joulepath.optimize import GradientSettings
 from joulepath.program import CycleSettings, parse_module, resolve_module
-from joulepath.program._cycle import LONG_PROBE_KNOTS, STEP, CycleOptimizer
+from joulepath.program._cycle import LONG_PROBE_KNOTS, ON_TAUGHT_MARGIN, STEP, CycleOptimizer
 from joulepath.trajectory import SplineBasis, minimum_jerk
 
 # few knots at most: this short chain counts as a long one (GradientSettings.is_long), as the
@@ -119,3 +119,86 @@ def test_a_probe_starts_from_the_best_path_shifted_to_its_pass_times(spec):
             k_new = int(np.argmin(np.abs(t - e_new * STEP)))
             was = near.fine.q[int(np.argmin(np.abs(near.fine.t - e_old * STEP)))]
             assert np.abs(q[k_new] - was).max() < 0.25 * np.abs(q_kept[k_new] - was).max()
+
+
+LOOP = """MODULE Loop
+    CONST jointtarget j1 := [[-40, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST jointtarget j2 := [[-15, 30, -10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    CONST jointtarget j3 := [[40, 10, 10, 0, 40, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+    PROC main()
+        WHILE TRUE DO
+            MoveAbsJ j2, v500, z50, tool0;
+            MoveAbsJ j3, v500, z50, tool0;
+            MoveAbsJ j1, v500, fine, tool0;
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+
+
+@pytest.fixture(scope="module")
+def loop():
+    """The chain of ``LOOP``, alone in its cycle, its time table at its own cycle time."""
+    spec = resolve_module(parse_module(LOOP, path="loop.mod"), joulepath.load_robot("irb120"))
+    opt = CycleOptimizer(spec, CycleSettings(gradient=LONG, pass_search=1))
+    budget = opt.budget(opt.plan.cycle_time, False)
+    return opt, opt.table(budget), budget
+
+
+def test_a_long_chain_alone_in_its_cycle_skips_only_durations_that_cannot_win(loop):
+    """A long chain alone in its cycle (no other unit takes the time its shorter durations leave;
+    taught slower than it can run, so its table spans 1.6-2.6 s): its time table solves a shorter
+    duration only where the coarse probe there could win (:meth:`CycleOptimizer._screened`), by the
+    rule its docstring states. Every duration it skips, solved as the table solves the others, takes
+    more energy than the longest, so the best allocation of the whole table is the one of the
+    screened table."""
+    opt, table, budget = loop
+    (i,) = opt.optimizable
+    assert len(opt.chains[i]) == 3
+    probed = sorted({u for (j, u, _) in opt.probes if j == i})
+    longest = probed[-1]
+    assert opt.gradient.is_long(longest * STEP) and opt._screens_durations(i, longest)
+    solved = {int(round(s.duration / STEP)) for s in table[i] if not s.taught and s.coefficients is not None}
+    assert longest in solved
+    skipped = [u for u in probed[:-1] if u not in solved]
+    assert skipped  # the test exercises the screen
+    best_longest = opt.cache[(i, longest)]
+    assert best_longest.usable
+    probes = {u: s for (j, u, _), s in opt.probes.items() if j == i}
+    ref = probes[longest]
+    bar = ref.energy_J + max(ref.energy_J - best_longest.energy_J, 0.0)
+    for u in probed[:-1]:  # solved where its probe is below the bar, or not usable
+        assert (u in solved) == (not probes[u].usable or probes[u].energy_J < bar)
+    full = {i: [*table[i]]}
+    for u in skipped:
+        s = opt.solve(i, u * STEP)
+        assert not s.usable or s.energy_J > best_longest.energy_J
+        full[i].append(s)
+    screened = opt.best(table, budget, opt.wait_total)
+    assert screened.energy_J == pytest.approx(opt.best(full, budget, opt.wait_total).energy_J, rel=1e-12)
+
+
+def test_a_long_chain_s_taught_motion_reshaped_from_its_solve_never_costs_the_plan(loop):
+    """A long chain's taught motion reshaped (:meth:`CycleOptimizer.solve_on_taught`) starts from
+    the chain's solve at its taught duration: it passes the targets where the taught motion does,
+    within every limit, and where it is not solved from the taught motion as well (it ends more than
+    ``ON_TAUGHT_MARGIN`` above the chain's solve), the one from the taught motion would not have
+    won the allocation either."""
+    opt, table, budget = loop
+    (i,) = opt.optimizable
+    n = int(np.floor(opt.span[i] / STEP + 1e-9))
+    kept = opt.cache[(i, -2)]
+    assert any(s is kept for s in table[i])
+    assert kept.usable and kept.duration == opt.span[i]
+    base = opt.base(i, n)
+    assert kept.passes == tuple(t for t, _ in opt._taught_passes(i, base))
+    assert opt.zone_miss_mm(i, kept) <= 1e-6
+    near = opt.cache[(i, n)]
+    cold = opt._on_taught_once(i, n)
+    if kept.energy_J > near.energy_J * (1 + ON_TAUGHT_MARGIN):  # the cold solve was skipped
+        assert not cold.usable or cold.energy_J > near.energy_J
+        with_cold = {i: [*table[i], cold]}
+        best = opt.best(table, budget, opt.wait_total).energy_J
+        assert best == pytest.approx(opt.best(with_cold, budget, opt.wait_total).energy_J, rel=1e-12)
+    else:  # both were solved: the lower kept
+        assert kept.energy_J <= cold.energy_J * (1 + 1e-12)

@@ -582,3 +582,25 @@ def test_pass_times_of_a_run_between_moveL_are_searched_never_to_its_loss(robot)
         if i in opt.shares:  # a better pass time was found: the kept result is solved at it
             (t_pass,) = [t for t, _ in opt.waypoints(i, T)]
             assert tuned.passes == (pytest.approx(t_pass),)
+
+
+def test_hermite_path_is_the_quintic_hermite_interpolation():
+    """The re-timing's joint path of a segment (``_hermite_path``, its Bernstein coefficients built
+    for every interval at once) is :func:`joulepath.trajectory.quintic_hermite`'s interpolation (one
+    interval at a time), in ``s`` on [0, 1]: the same positions and derivatives to the bit (the
+    re-timing's search is sensitive to the last bit), and the samples' at the samples."""
+    from joulepath.program._cycle import _hermite_path
+    from joulepath.trajectory import quintic_hermite
+
+    rng = np.random.default_rng(3)
+    t = 0.4 + np.cumsum(0.002 + 0.01 * rng.random(300))
+    q, qd, qdd = rng.normal(size=(3, t.size, 6))
+    at = _hermite_path(t, q, qd, qdd)
+    span = t[-1] - t[0]
+    ref = quintic_hermite((t - t[0]) / span, q, qd * span, qdd * span * span)
+    s = np.linspace(0.0, 1.0, 4001)
+    for k, got in enumerate(at(s)):
+        assert np.array_equal(got, ref.derivative(k)(s) if k else ref(s))
+    q_at, d_at, dd_at = at((t - t[0]) / span)
+    assert np.allclose(q_at, q, atol=1e-12) and np.allclose(d_at, qd * span, atol=1e-10)
+    assert np.allclose(dd_at, qdd * span * span, atol=1e-8)

@@ -5,7 +5,7 @@ import pytest
 
 import joulepath
 from joulepath.errors import InvalidInput
-from joulepath.kinematics._ik import check_layout, confdata, ik_branches, pose_error, solve_ik
+from joulepath.kinematics._ik import check_layout, confdata, ik_branches, pose_error, solve_ik, solve_ik_along
 
 
 @pytest.fixture(scope="module")
@@ -84,3 +84,25 @@ def test_other_layout_refused(robot):
     chain = replace(robot.chain, axes=np.roll(robot.chain.axes, 1, axis=1))
     with pytest.raises(InvalidInput, match="IRB 120 layout"):
         check_layout(chain)
+
+
+def test_ik_along_a_path_agrees_with_solve_ik_pose_by_pose(robot):
+    """:func:`solve_ik_along` (the branches of every pose at once) picks, pose after pose, what
+    :func:`solve_ik` picks nearest the solution before; it ends at the first pose out of reach."""
+    lo, hi = robot.joint_ranges()
+    q0 = np.radians([10, 20, -10, 30, 40, 50])
+    q1 = np.radians([-60, 35, 5, -40, 70, 120])
+    s = np.linspace(0.0, 1.0, 40)[1:, None]
+    poses = robot.fk(q0 + s * (q1 - q0)).homogeneous
+    along = solve_ik_along(robot.chain, poses, lower=lo, upper=hi, start=q0)
+    near = q0
+    assert len(along) == len(poses)
+    for pose, q in zip(poses, along, strict=True):
+        ref = solve_ik(robot.chain, pose, None, lower=lo, upper=hi, near=near)
+        assert q is not None and ref is not None and np.abs(q - ref).max() < 1e-12
+        near = ref
+    assert np.abs(along[-1] - q1).max() < 1e-6
+    far = poses.copy()
+    far[5:, :3, 3] *= 10.0  # out of reach from the sixth pose on
+    cut = solve_ik_along(robot.chain, far, lower=lo, upper=hi, start=q0)
+    assert len(cut) == 6 and cut[-1] is None and all(q is not None for q in cut[:-1])

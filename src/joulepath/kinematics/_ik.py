@@ -219,7 +219,40 @@ def solve_ik(
     matches.
     """
     qs, valid = ik_branches(chain, np.asarray(pose, dtype=float))
+    return _pick(qs, valid, branch_cfx(chain, qs), conf, lower=lower, upper=upper, near=near)
+
+
+def solve_ik_along(
+    chain: Chain, poses: FloatArray, *, lower: FloatArray, upper: FloatArray, start: FloatArray
+) -> list[FloatArray | None]:
+    """The joint values along tool0 poses ``poses`` (N, 4, 4), each the solution nearest the one
+    before (the first: nearest ``start``) within the ranges: :func:`solve_ik` with ``conf=None`` and
+    ``near`` the previous solution, pose after pose, its branches computed for every pose at once.
+    The list ends at the first pose without a solution (None)."""
+    qs, valid = ik_branches(chain, np.asarray(poses, dtype=float))
     cfx = branch_cfx(chain, qs)
+    out: list[FloatArray | None] = []
+    near = start
+    for k in range(qs.shape[0]):
+        q = _pick(qs[k], valid[k], cfx[k], None, lower=lower, upper=upper, near=near)
+        out.append(q)
+        if q is None:
+            break
+        near = q
+    return out
+
+
+def _pick(
+    qs: FloatArray,
+    valid: FloatArray,
+    cfx: FloatArray,
+    conf: tuple[int, int, int, int] | None,
+    *,
+    lower: FloatArray,
+    upper: FloatArray,
+    near: FloatArray | None,
+) -> FloatArray | None:
+    """:func:`solve_ik`'s choice among the branches ``qs`` (8, 6) of one pose."""
     best: FloatArray | None = None
     best_d = np.inf
     for k in range(8):

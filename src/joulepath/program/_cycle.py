@@ -40,6 +40,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+from scipy.interpolate import BPoly
 
 from joulepath._typing import FloatArray
 from joulepath._work import check_work
@@ -79,7 +80,7 @@ from joulepath.sim import (
     via_layout,
 )
 from joulepath.sim import tcp_pose as _tcp
-from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk, quintic_hermite
+from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk
 from joulepath.units import SAMPLE_PERIOD
 
 STEP = SAMPLE_PERIOD
@@ -223,7 +224,27 @@ def _hermite_path(
     """A motion's samples as a joint path ``q(s)``, ``s = (t - t0) / T`` in [0, 1]: the quintic Hermite
     interpolation of position, speed and acceleration (C², exact at the samples)."""
     span = float(t[-1] - t[0])
-    poly = quintic_hermite((t - t[0]) / span, q, qd * span, qdd * span * span)
+    x = (t - t[0]) / span
+    d, dd = qd * span, qdd * span * span
+    # its Bernstein coefficients on every interval at once, by the operations, in their order, of
+    # ``BPoly.from_derivatives`` (``quintic_hermite``), which builds them one interval at a time:
+    # the same coefficients to the bit, in a fiftieth of the time
+    h = (x[1:] - x[:-1])[:, None]
+    h2 = h**2
+    c = np.empty((6, x.size - 1, q.shape[1]))
+    c[0] = q[:-1] / 1.0 * 1.0
+    c[1] = d[:-1] / 5.0 * h
+    c[1] -= -1.0 * c[0]
+    c[2] = dd[:-1] / 20.0 * h2
+    c[2] -= 1.0 * c[0]
+    c[2] -= -2.0 * c[1]
+    c[5] = q[1:] / 1.0 * 1 * 1.0
+    c[4] = d[1:] / 5.0 * -1 * h
+    c[4] -= -1.0 * c[5]
+    c[3] = dd[1:] / 20.0 * 1 * h2
+    c[3] -= -2.0 * c[4]
+    c[3] -= 1.0 * c[5]
+    poly = BPoly(c, x)
     d1, d2 = poly.derivative(1), poly.derivative(2)
 
     def at(s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -494,6 +515,13 @@ first step 1/8 of a leg; ``pass_search`` per target in all, at most). Measured o
 chain of issue 36: the pattern search run on to 53 probes (about 1.4 s each) found pass times 0.017 %
 better than the untuned ones on the probes' knots, within the scatter of the solves; 14 find none."""
 
+ON_TAUGHT_MARGIN = 0.01
+"""Share above a long chain's solve at its taught duration within which its reshaped taught motion,
+started from that solve (:meth:`CycleOptimizer.solve_on_taught`), is also solved from the taught
+motion. Measured on the long fly-by chain of issue 36 (one BLAS thread): from the taught motion
+43.375 J in 10.0 s, from the solve (42.277 J) 43.556 J in 5.0 s, 0.4 % above the one from the
+taught motion and 3.0 % above the solve."""
+
 TIME_UNIT = FINE_DT
 """s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
 
@@ -551,6 +579,8 @@ class CycleOptimizer:
         self.linear: set[int] = set()  # MoveL units: re-timed along their line (retime_on_path)
         self.shares: dict[int, tuple[float, ...]] = {}  # by chain: when it passes its targets (tune_passes)
         self.tuned: set[int] = set()  # chains whose pass times were searched
+        # a long chain's coarse probes by (chain, duration in samples, pass times in samples)
+        self.probes: dict[tuple[int, int, tuple[int, ...]], Solved] = {}
         for seg in self.segments:
             for members, window, inner in self._units_of(seg):
                 self.chains[members[0]] = members
@@ -795,8 +825,10 @@ class CycleOptimizer:
         the first from the best probe's path shifted in time to its pass times (:meth:`_time_warped`),
         at most :data:`LONG_PROBES` per target in a row without a gain, its first step 1/8 of a leg;
         the chain is then solved at the untuned pass times and, where a probe won, at the best
-        probe's, and the better is kept (the long fly-by chain of issue 36: 42 probes of 7-9 s each,
-        every one ending at the smoothest path, -> 14 of about 1.5 s). Measured on
+        probe's, each from its probe (:meth:`_from_probe`), and the better is kept; the probe at the
+        kept pass times screens the time table's shorter durations (:meth:`_screened`) (the long
+        fly-by chain of issue 36: 42 probes of 7-9 s each, every one ending at the smoothest path,
+        -> 14 of about 1.5 s). Measured on
         pick_and_place (issue 36, with the re-timing's scaled search): 19.9 s at 12.19 %; the best
         pass times solved again on :data:`WITHIN_KNOTS`, kept where that beat the untuned solve
         there (two solves of 144 variables, about 3 s each), as before: 25.0 s at 12.15 %; solved
@@ -819,12 +851,7 @@ class CycleOptimizer:
         if coarse:
             probe = replace(probe, knot_spacing=max(probe.knot_spacing, ON_TAUGHT_KNOTS))
         elif long:
-            probe = replace(
-                probe,
-                knot_spacing=max(probe.knot_spacing, LONG_PROBE_KNOTS),
-                coarse_factor=1,
-                continuation=probe.continuation[:-1] or probe.continuation,
-            )
+            probe = self._long_probe_settings()
         elif first is not None and all(abs(e * STEP - t) < 1e-9 for e, t in zip(start, untuned, strict=True)):
             seen[start] = first
 
@@ -882,13 +909,16 @@ class CycleOptimizer:
             if not moved:
                 step //= 2
         if long:  # on its own knots: at the untuned pass times, and at the best probe's where it won
-            first = self._solve_once(m, units * STEP, units, corridor, way=way_at(start))
-            tuned = self._solve_once(m, units * STEP, units, corridor, way=way_at(best)) if won else None
+            first = self._from_probe(i, units, way_at(start), seen.get(start))
+            tuned = self._from_probe(i, units, way_at(best), seen[best]) if won else None
             if tuned is not None and tuned.usable and (not first.usable or tuned.energy_J < first.energy_J):
                 self.shares[i] = tuple(e / units for e in best)
                 self.cache[(i, units)] = tuned
             elif first.usable:
                 self.cache[(i, units)] = first
+            kept = best if i in self.shares else start  # the pass times of the chain's solves
+            if kept in seen:  # the probe there, for the screen of the time table (:meth:`_screened`)
+                self.probes[(i, units, kept)] = seen[kept]
             return
         if won:  # the best probe (inside a MoveL segment: on its wider knots), verified as every solve is
             self.shares[i] = tuple(e / units for e in best)
@@ -898,6 +928,110 @@ class CycleOptimizer:
             first = self._solve_once(m, units * STEP, units, corridor)
         if first.usable:
             self.cache[(i, units)] = first
+
+    def _long_probe_settings(self) -> GradientSettings:
+        """The search of a long chain's coarse probes (:meth:`tune_passes`, :meth:`_screened`): knots
+        :data:`LONG_PROBE_KNOTS` apart, the continuation stages but the last, ``give_up`` and at most
+        :data:`PROBE_ROUNDS` rounds per stage."""
+        g = self.gradient
+        return replace(
+            g,
+            give_up=True,
+            max_rounds=min(g.max_rounds, PROBE_ROUNDS),
+            knot_spacing=max(g.knot_spacing, LONG_PROBE_KNOTS),
+            coarse_factor=1,
+            continuation=g.continuation[:-1] or g.continuation,
+        )
+
+    def _from_probe(
+        self, i: int, units: int, way: tuple[tuple[float, FloatArray], ...], probe: Solved | None
+    ) -> Solved:
+        """Long chain ``i`` solved at ``units`` samples through its targets at ``way`` on its own knots,
+        from its coarse ``probe`` there (:meth:`_long_probe_settings`: the stages but the last, on
+        wider knots; its path fitted to the chain's knots, :meth:`_time_scaled`) through the last
+        ``refine_stages`` continuation stages, as the wide knots of a cold solve hand over to the fine
+        ones; a cold solve where the probe or that solve is not usable. Measured on the long fly-by
+        chain of issue 36 (one BLAS thread): 7.5 s at 42.277 J, cold 8.9 s at 42.286 J (its own wide
+        knots, 0.166 s apart, take the first stages again)."""
+        m = self.by_index[i]
+        T = units * STEP
+        corridor = self.settings.corridor_mm
+        if probe is not None and probe.usable and probe.coefficients is not None:
+            g = self.gradient
+            refine = replace(g, n_starts=1, coarse_factor=1, continuation=g.continuation[-g.refine_stages :])
+            start = self._time_scaled(i, T, probe)
+            out = self._solve_once(m, T, units, corridor, way=way, gradient=refine, initial=start)
+            if out.usable:
+                return out
+        return self._solve_once(m, T, units, corridor, way=way)
+
+    def _long_probe(self, i: int, units: int) -> Solved:
+        """Chain ``i``'s coarse probe at ``units`` samples, through its targets where its solves pass
+        them (:meth:`waypoints`), as :meth:`tune_passes` probes a long chain; cached. It starts from
+        its nearest probe (at another duration) stretched in time (:meth:`_time_scaled`), through the
+        last :data:`PROBE_WARM_STAGES` stages, and cold where that one is not usable."""
+        T = units * STEP
+        way = self.waypoints(i, T)
+        edges = tuple(int(round(t / STEP)) for t, _ in way)
+        key = (i, units, edges)
+        if key in self.probes:
+            return self.probes[key]
+        self._before_solve()
+        m = self.by_index[i]
+        probe = self._long_probe_settings()
+        corridor = self.settings.corridor_mm
+        near = [
+            s for (j, _, _), s in self.probes.items() if j == i and s.usable and s.coefficients is not None
+        ]
+        out: Solved | None = None
+        if near and PROBE_WARM_STAGES:
+            nearest = min(near, key=lambda s: abs(s.duration - T))
+            warm = replace(probe, continuation=probe.continuation[-PROBE_WARM_STAGES:])
+            start = self._time_scaled(i, T, nearest, probe)
+            out = self._solve_once(m, T, units, corridor, way=way, gradient=warm, initial=start)
+        if out is None or not out.usable:
+            out = self._solve_once(m, T, units, corridor, way=way, gradient=probe)
+        self.probes[key] = out
+        return out
+
+    def _screens_durations(self, i: int, longest: int) -> bool:
+        """Whether unit ``i``'s shorter durations in the time table are screened by coarse probes
+        (:meth:`_screened`): a long fly-by chain (past the gradient's ``max_knots`` at ``longest``
+        samples, :meth:`GradientSettings.is_long`) from rest to rest, alone in its cycle (no other
+        unit takes the time its shorter durations leave: they count only where one of them takes
+        less energy than its longest duration)."""
+        return (
+            len(self.optimizable) == 1
+            and len(self.chains[i]) > 1
+            and i not in self.within
+            and i not in self.linear
+            and self.gradient.is_long(longest * STEP)
+        )
+
+    def _screened(self, i: int, units: list[int]) -> list[Solved]:
+        """Unit ``i`` solved at its durations ``units`` (samples, ascending), alone in its cycle
+        (:meth:`_screens_durations`): at the longest as every duration is (:meth:`solve`), at a shorter
+        one only where its coarse probe (:meth:`_long_probe`) could win, i.e. is below the coarse
+        probe at the longest by less than the longest's own gain from its probe to its solve (a
+        shorter duration whose probe is above that needs more than twice that gain to win), or where
+        either probe is not usable. Measured on the long fly-by chain of issue 36 (5.0, 5.025, 5.075
+        and 5.325 s): probes 48.25, 47.77, 47.12 and 44.27 J (about 1 s each), solves 45.20, 44.95,
+        44.45 and 42.29 J (14-16 s each under load): the gains 3.05, 2.82, 2.67 and 1.98 J, the
+        shorter durations' at most 1.6 times the longest's; the three are screened out."""
+        longest = self.solve(i, units[-1] * STEP)
+        out = [longest]
+        bar = np.inf
+        if longest.usable:
+            ref = self._long_probe(i, units[-1])
+            if ref.usable:
+                bar = ref.energy_J + max(ref.energy_J - longest.energy_J, 0.0)
+        for u in reversed(units[:-1]):  # the nearest first: each solve starts from its nearest
+            if np.isfinite(bar):
+                p = self._long_probe(i, u)
+                if p.usable and p.energy_J >= bar:
+                    continue
+            out.append(self.solve(i, u * STEP))
+        return sorted(out, key=lambda s: s.duration)
 
     def _time_warped(
         self, i: int, near: Solved, edges: tuple[int, ...], gradient: GradientSettings
@@ -984,7 +1118,12 @@ class CycleOptimizer:
         """A unit from rest to rest reshaped from its taught motion at its taught duration: the shape
         is added to the taught motion over its whole 25 ms samples (the rest of it, less than one
         sample to the stop, stays taught), through its targets where the taught motion passes them.
-        It starts where the controller's own motion is, within every limit. None: under 0.15 s."""
+        It starts where the controller's own motion is, within every limit. None: under 0.15 s.
+
+        A long fly-by chain (:meth:`_long_on_taught`) with a usable solve at those whole samples
+        starts from that solve instead, shifted in time to the taught pass times, through the last
+        ``refine_stages`` continuation stages; it is solved from the taught motion as well only where
+        that start ends within :data:`ON_TAUGHT_MARGIN` of the solve, and the lower of the two is kept."""
         key = (i, -2)
         if key in self.cache:
             return self.cache[key]
@@ -993,6 +1132,38 @@ class CycleOptimizer:
         if n < 6 or i in self.within or i in self.linear or self.settings.follow == "via-points":
             return None  # (via points: planned within a lower acceleration limit than taught)
         self._before_solve()
+        near = self.cache.get((i, n)) if self._long_on_taught(i) else None
+        out: Solved | None = None
+        if near is not None and near.usable and near.coefficients is not None and near.passes is not None:
+            out = self._on_taught_once(i, n, near)
+            if out.usable and out.energy_J <= near.energy_J * (1 + ON_TAUGHT_MARGIN):
+                cold = self._on_taught_once(i, n)
+                out = cold if cold.usable and cold.energy_J < out.energy_J else out
+            elif not out.usable:
+                out = None
+        if out is None:
+            out = self._on_taught_once(i, n)
+        self.cache[key] = out
+        return out
+
+    def _long_on_taught(self, i: int) -> bool:
+        """Whether unit ``i`` is a long fly-by chain from rest to rest (past the gradient's
+        ``max_knots`` at its taught duration, :meth:`GradientSettings.is_long`): its reshaped taught
+        motion (:meth:`solve_on_taught`) comes after its solves in the time table and starts from
+        the one at its taught duration."""
+        return (
+            len(self.chains[i]) > 1
+            and i not in self.within
+            and i not in self.linear
+            and self.gradient.is_long(self.span[i])
+        )
+
+    def _on_taught_once(self, i: int, n: int, near: Solved | None = None) -> Solved:
+        """:meth:`solve_on_taught` over ``n`` samples: from the taught motion, or from the solve
+        ``near`` of the chain at ``n`` samples shifted in time to the taught pass times (each leg
+        stretched linearly in time; fitted by least squares) through the last ``refine_stages``
+        continuation stages."""
+        win = self.segment_of[i]
         m = self.by_index[i]
         robot = self._robot(m)
         base = self.base(i, n)
@@ -1001,13 +1172,27 @@ class CycleOptimizer:
         seq = np.random.SeedSequence([self.settings.seed, m.index, 10_000 + n])
         corridor = self.settings.corridor_mm
         g = self.settings.gradient  # on the taught motion: the objective on the samples (see energy_every)
+        g = replace(g, knot_spacing=max(g.knot_spacing, ON_TAUGHT_KNOTS), coarse_factor=1)
+        initial: FloatArray | None = None
+        if near is not None:
+            assert near.passes is not None
+            g = replace(g, n_starts=1, continuation=g.continuation[-g.refine_stages :])
+            T = n * STEP
+            basis = SplineBasis(T, knot_spacing=g.spacing_for(T), degree=g.degree, dt=STEP)
+            grid = basis.grid(STEP / g.check_factor)
+            t_old = np.interp(grid.t, [0.0, *(t for t, _ in way), T], [0.0, *near.passes, near.duration])
+            q_old = np.column_stack(
+                [np.interp(t_old, near.fine.t, near.fine.q[:, j]) for j in range(robot.n_joints)]
+            )
+            q_base = np.column_stack([np.interp(grid.t, base.t, base.q[:, j]) for j in range(robot.n_joints)])
+            initial = np.asarray(np.linalg.lstsq(grid.B, q_old - q_base, rcond=None)[0], dtype=float).ravel()
         res, problem = solve_move(
             robot,
             base.q[0],
             base.q[-1],
             n * STEP,
             friction=NOMINAL_FRICTION,
-            settings=replace(g, knot_spacing=max(g.knot_spacing, ON_TAUGHT_KNOTS), coarse_factor=1),
+            settings=g,
             rng=np.random.default_rng(seq),
             acceleration_limit=amax,
             max_deviation_m=None if corridor is None else corridor / 1000,
@@ -1017,6 +1202,7 @@ class CycleOptimizer:
             base=base,
             energy_measure=self.settings.energy,
             deadline=self.deadline,
+            initial=initial,
         )
         self.n_solves += 1
         x = res.coefficients.ravel()
@@ -1036,7 +1222,7 @@ class CycleOptimizer:
             qd=np.vstack([samples.qd, fine.qd[-1:]]),
             qdd=np.vstack([samples.qdd, fine.qdd[-1:]]),
         )
-        out = Solved(
+        return Solved(
             win.span,
             e,
             e_lab,
@@ -1049,8 +1235,6 @@ class CycleOptimizer:
             corridor,
             passes=tuple(t for t, _ in way),
         )
-        self.cache[key] = out
-        return out
 
     def to_stop(self, i: int, piece: Solved) -> Solved:
         """The last move's ``piece`` of unit ``i`` (inside a ``MoveL`` segment, its run ending at a
@@ -1301,11 +1485,14 @@ class CycleOptimizer:
         self.cache[key] = out
         return out
 
-    def _time_scaled(self, i: int, T: float, near: Solved) -> FloatArray:
+    def _time_scaled(
+        self, i: int, T: float, near: Solved, gradient: GradientSettings | None = None
+    ) -> FloatArray:
         """The solve ``near`` of chain ``i`` stretched to ``T`` in the coefficients of a solve at ``T``
-        (fine knots, flat; least squares on the fine grid, offsets from the minimum-jerk move): it
-        passes each target at the same share of the duration, as :meth:`waypoints` asks at ``T``."""
-        g = self.gradient
+        (on ``gradient``'s knots, default the fine ones; flat; least squares on the fine grid, offsets
+        from the minimum-jerk move): it passes each target at the same share of the duration, as
+        :meth:`waypoints` asks at ``T``."""
+        g = self.gradient if gradient is None else gradient
         basis = SplineBasis(T, knot_spacing=g.spacing_for(T), degree=g.degree, dt=STEP)
         fine = basis.grid(STEP / g.check_factor)
         q0, q1 = self.by_index[i].path.q0, self.by_index[self.chains[i][-1]].path.q1
@@ -1523,6 +1710,8 @@ class CycleOptimizer:
         floor = {i: min(self.t_lo[i], self.span[i]) for i in self.optimizable}
         out: dict[int, list[Solved]] = {i: [self.taught(i)] for i in self.optimizable}
         for n_unit, i in enumerate(self.optimizable, start=1):  # each reshaped from its taught motion
+            if self._long_on_taught(i):
+                continue  # after its solves (solve_on_taught)
             self.progress(f"unit {n_unit}/{len(self.optimizable)}: reshaping its taught motion")
             try:
                 reshaped = self.solve_on_taught(i)
@@ -1552,11 +1741,28 @@ class CycleOptimizer:
                 self.tune_passes(i, (own if own in units else sorted(units)[len(units) // 2]) * STEP)
             except TimeBudgetSpent:
                 return out
+            if self._screens_durations(i, max(units)):
+                try:
+                    out[i].extend(self._screened(i, sorted(units)))
+                except TimeBudgetSpent:
+                    out[i].extend(s for (j, u), s in self.cache.items() if j == i and u in units)
+                    return out
+                continue
             for u in sorted(units):
                 try:
                     out[i].append(self.solve(i, u * STEP))
                 except TimeBudgetSpent:
                     return out
+        for n_unit, i in enumerate(self.optimizable, start=1):  # a long chain's, from its solve
+            if not self._long_on_taught(i):
+                continue
+            self.progress(f"unit {n_unit}/{len(self.optimizable)}: reshaping its taught motion")
+            try:
+                reshaped = self.solve_on_taught(i)
+            except TimeBudgetSpent:
+                return out
+            if reshaped is not None:
+                out[i].append(reshaped)
         return out
 
     def dp(self, table: dict[int, list[Solved]], budget: float) -> dict[int, Solved] | None:

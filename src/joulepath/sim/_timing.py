@@ -52,7 +52,7 @@ from joulepath._typing import FloatArray
 from joulepath._work import check_work
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
-from joulepath.kinematics._ik import solve_ik
+from joulepath.kinematics._ik import solve_ik_along
 from joulepath.sim._controller import ControllerConfig
 from joulepath.sim._limits import jerk_limit
 from joulepath.sim._profile import Profile, evaluate_profile, plan_profile, time_at_fraction
@@ -212,12 +212,13 @@ def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:
         points = arc_points(p0, pv, p1, s, f"{where}:{step.line}: {step.label}")
     inv_tcp = np.linalg.inv(step.tcp)
     lo, hi = robot.joint_ranges()
+    poses = np.zeros((LINE_POINTS - 1, 4, 4))
+    poses[:, :3, :3] = rots[1:]
+    poses[:, :3, 3] = points[1:]
+    poses[:, 3, 3] = 1.0
+    along = solve_ik_along(robot.chain, poses @ inv_tcp, lower=lo, upper=hi, start=q0)
     qs = [q0]
-    for k in range(1, LINE_POINTS):
-        pose = np.eye(4)
-        pose[:3, :3] = rots[k]
-        pose[:3, 3] = points[k]
-        q = solve_ik(robot.chain, pose @ inv_tcp, None, lower=lo, upper=hi, near=qs[-1])
+    for k, q in enumerate(along, start=1):
         if q is None or np.abs(q - qs[-1]).max() > 0.5:
             raise InvalidInput(
                 f"{where}:{step.line}: {step.label}: the straight line leaves the reachable space or "
