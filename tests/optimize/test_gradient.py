@@ -359,7 +359,7 @@ def test_jerk_limit_costs_saving_but_keeps_some(fixed, fixed_no_jerk, irb120):
 
 def test_jerk_time_zero_is_the_search_without_a_jerk_limit(fixed_no_jerk, irb120):
     """``jerk_time=0`` runs exactly the search as it was before jerk limits (no jerk argument at all)."""
-    from joulepath.optimize import GradientSettings
+    from joulepath.optimize import MOVE_SEARCH, GradientSettings
     from joulepath.optimize._gradient import solve_move
 
     res, _ = solve_move(
@@ -368,7 +368,7 @@ def test_jerk_time_zero_is_the_search_without_a_jerk_limit(fixed_no_jerk, irb120
         QF,
         1.6,
         friction=irb120.friction,
-        settings=GradientSettings(knot_spacing=OptimizeConfig().knot_spacing, check_factor=10),
+        settings=GradientSettings(knot_spacing=OptimizeConfig().knot_spacing, check_factor=10, **MOVE_SEARCH),
         rng=np.random.default_rng(1),
         acceleration_limit=acceleration_limit(irb120, ACCEL_TIME),
     )

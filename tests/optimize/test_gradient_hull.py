@@ -9,6 +9,7 @@ from joulepath.errors import InvalidInput
 from joulepath.optimize import (
     ACCEL_TIME,
     JERK_TIME,
+    MOVE_SEARCH,
     GradientSettings,
     SplineProblem,
     acceleration_limit,
@@ -159,7 +160,7 @@ def test_default_search_reaches_the_search_before_within_every_limit(irb120):
     jmax = jerk_limit(irb120, ACCEL_TIME, JERK_TIME)
     before = GradientSettings(rate_rows="grid", precondition=0.0, max_iter=200, ftol=1e-7)
     saved = {}
-    for label, settings in (("default", GradientSettings()), ("before", before)):
+    for label, settings in (("default", GradientSettings(**MOVE_SEARCH)), ("before", before)):
         res, problem = solve_move(
             irb120,
             Q0,

@@ -18,8 +18,6 @@ from joulepath.description import DEFAULT_ROBOT
 def _models(
     model_dir: Path | None, fitness: str, family: str, robot_name: str, n_joints: int, robot_arg: str = ""
 ) -> tuple[tuple[object, ...], tuple[int, ...] | None]:
-    from joulepath.errors import InvalidModel
-    from joulepath.learn import best_model, read_joints_json
     from joulepath.optimize import fitness_kind
 
     targets = fitness_kind(fitness).model_targets(n_joints)
@@ -34,6 +32,9 @@ def _models(
         raise typer.BadParameter(
             f"--fitness {fitness} needs --model (a `joulepath train` output folder)", param_hint="--model"
         )
+    from joulepath.errors import InvalidModel
+    from joulepath.learn import best_model, read_joints_json  # scikit-learn: only with a learned model
+
     models = tuple(best_model(model_dir, t, family=family or None) for t in targets)
     for m in models:
         on_card, source = m.card.get("robot"), m.card.get("robot_source")

@@ -6,7 +6,6 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.signal import find_peaks
 
 from joulepath._typing import FloatArray
 from joulepath.data._logs import JointLog
@@ -91,6 +90,8 @@ def segment_moves(t: FloatArray, qd: FloatArray, *, speed_scale: FloatArray | No
         seg = speed[s : e + 1]
         if seg.size < 5:
             continue
+        from scipy.signal import find_peaks  # here: SciPy's signal package costs 0.3 s to import
+
         minima = find_peaks(-seg, prominence=0.01 * seg.max())[0]
         last = 0
         for k, m in enumerate(minima):

@@ -12,6 +12,7 @@ from joulepath.optimize._execute import EXECUTION_TOLERANCES, Execution, rapid_e
 from joulepath.optimize._features import path_features
 from joulepath.optimize._gradient import (
     GRID_SEARCH,
+    MOVE_SEARCH,
     SEARCH_BEFORE_HULL,
     GradientResult,
     GradientSettings,
@@ -96,6 +97,7 @@ __all__ = [
     "LimitExcess",
     "LimitReport",
     "MAX_DURATION",
+    "MOVE_SEARCH",
     "MeasureSummary",
     "MoveResult",
     "MoveSummary",

@@ -68,6 +68,9 @@ SCREEN_BAND = 0.25
 """A constraint enters the solve when its value is within this share of its limit (the rest are
 checked after each solve, and those it breaks or nears enter the next): the default of
 :attr:`GradientSettings.screen_band`."""
+EFFORT_BAND = 0.05
+"""The single move's :attr:`GradientSettings.effort_band` (:data:`MOVE_SEARCH`): an effort row enters a solve
+within this share of its limit."""
 THIN_ROWS = 2
 """Rows of one rate kind, per variable, above which only each bump's deepest samples enter a solve."""
 RANGE_MARGIN = 1e-6
@@ -121,6 +124,20 @@ class GradientSettings:
     every limit starts again from the rows within the band there (and the known ones), not with every
     row the earlier rounds gathered (:func:`_solve_from`).
 
+    ``effort_band``: an effort row (the torque limits, where the robot states them) enters a solve within
+    this share of its limit, and the coarse level's effort rows are not carried into the fine level (None:
+    ``screen_band``, and carried, as the other rows of the fine grid). An effort row is nonlinear: SLSQP
+    evaluates it and its gradient at every step, the dynamics' derivatives at each of its points, where a
+    linear row costs a matrix product; and every effort row is checked on the fine grid after each solve, so
+    one that breaks enters the next round. The fine level starts on the coarse level's own path (nested
+    knots), so the effort rows it screens there are those near their limits at the coarse result; the ones
+    the coarse level carried besides were gathered at iterates on its way (a first round without rows runs
+    far past the limits). Measured on the Panda's 2 s move (issue 36): of the 74 effort rows the search
+    carried, none was within 0.1 of its limit at a round's end after the first; its search 4.4-4.7 ->
+    3.3-3.4 s of CPU, 37.821 -> 37.827 % (0.1: the same iterates, 3.6 s). The IRB 120 states no torque
+    limits (no effort rows), the UR5's README move carries none: both unchanged. :data:`MOVE_SEARCH` sets
+    it for the single move; the cycle and the plan for RAPID via points keep None.
+
     ``precondition``: each continuation stage's round solves in coordinates ``y`` with ``x = x_at + W y``,
     ``Wᵀ H W`` near the identity for the smoothed energy's Hessian ``H`` at the round's start (its
     eigenvalues' magnitudes held at least this share of the largest; 0: the plain coefficients).
@@ -149,6 +166,7 @@ class GradientSettings:
     precondition: float = 1e-3
     screen_band: float = SCREEN_BAND
     prune_stages: bool = False
+    effort_band: float | None = None
 
     def __post_init__(self) -> None:
         if self.rate_rows not in RATE_ROWS:
@@ -157,6 +175,11 @@ class GradientSettings:
             raise InvalidInput(f"precondition must be in [0, 1) (0: none), got {self.precondition}")
         if not 0.0 < self.screen_band <= 1.0:
             raise InvalidInput(f"screen_band must be in (0, 1] (a share of a limit), got {self.screen_band}")
+        if self.effort_band is not None and not 0.0 < self.effort_band <= 1.0:
+            raise InvalidInput(
+                f"effort_band must be in (0, 1] (a share of a limit) or None (screen_band), "
+                f"got {self.effort_band}"
+            )
         if not 1 <= self.hull_refine <= 8:
             raise InvalidInput(f"hull_refine must be 1..8, got {self.hull_refine}")
         if self.refine_stages < 1 or self.coarse_stages < 0:
@@ -186,6 +209,23 @@ SEARCH_BEFORE_HULL: dict[str, Any] = {"rate_rows": "grid", "precondition": 0.0, 
 """:class:`GradientSettings` of the single move's search before the hull rows (issue 36): a row per point
 of the fine grid for the accelerations and jerks, SLSQP in the plain coefficients. The single move's
 ``gradient-grid``, the yardstick of its speed-up."""
+
+MOVE_SEARCH: dict[str, Any] = {"effort_band": EFFORT_BAND, "prune_stages": True}
+""":class:`GradientSettings` overrides of the single move's default search (``gradient``,
+``gradient-fast``; not the plan for RAPID via points, :func:`joulepath.optimize._search.via_point_settings`,
+nor ``gradient-grid``, the yardstick, nor the cycle's :data:`GRID_SEARCH`), for issue 36's 7-joint arm:
+
+* ``effort_band`` (:data:`EFFORT_BAND`): effort rows only near their limits, none carried from the coarse
+  level into the fine one (:attr:`GradientSettings.effort_band`);
+* ``prune_stages``: a continuation stage that starts within every limit starts again from the rows near
+  their limits there (:func:`_solve_from`). The Panda's 2 s move carried 668 hull rows into its second
+  coarse stage, 155 of them near their limits (its first stage's first round, without rows, ran far past
+  them): its search 3.4 -> 2.9 s of CPU, 37.827 -> 37.778 %; the IRB 120's 21 tasks of
+  ``benchmarks/optimizer_speed.py`` as fast (the median of the per-task CPU ratios 0.95), 97.23 -> 97.20 %
+  of the jerk-limited optimum, every result within every limit (BENCHMARKS.md).
+
+The Panda's 2 s move with both, as a user runs it (the whole process, imports and plots included):
+4.3-5.1 s of CPU against 6.8-7.5 s before, 37.78 % saved (CMA-ES: 25.82 %)."""
 
 GRID_SEARCH: dict[str, Any] = {**SEARCH_BEFORE_HULL, "ftol": 3e-7, "screen_band": 0.1, "prune_stages": True}
 """:class:`GradientSettings` of the cycle (:class:`joulepath.program.CycleSettings`' default): the rows on
@@ -650,8 +690,9 @@ class SplineProblem:
         bound = self.max_deviation_m * (1.0 - RATE_MARGIN)  # solver tolerance, as for the rates
         return bound**2 - (delta * delta).sum(axis=1), grad
 
-    def screen(self, x: FloatArray, band: float) -> dict[str, np.ndarray]:
-        """Indices of the constraints within ``band`` of their limits, or violated."""
+    def screen(self, x: FloatArray, band: float, effort_band: float | None = None) -> dict[str, np.ndarray]:
+        """Indices of the constraints within ``band`` of their limits, or violated (the effort rows within
+        ``effort_band`` where it is narrower: :attr:`GradientSettings.effort_band`)."""
         cap = THIN_ROWS * self.m * self.n if self.thin_rows else np.iinfo(np.int64).max
         out = {"hull": np.flatnonzero(self.hull_slack(x) < band * self.hull_scale)}
         if not self.rate_hull:
@@ -660,7 +701,8 @@ class SplineProblem:
             out["qddd"] = _near_limit(self.jerk_slack(x), band * self.jmax, cap)
         if self.has_effort:
             lim = np.where(np.isfinite(self.emax), self.emax, np.inf)
-            out["tau"] = _near_limit(self.effort_slack(x), band * lim, cap)
+            tau_band = band if effort_band is None else min(band, effort_band)
+            out["tau"] = _near_limit(self.effort_slack(x), tau_band * lim, cap)
         if self.max_deviation_m is not None:
             out["tcp"] = np.flatnonzero(self.deviation(x) > (1.0 - band) * self.max_deviation_m)
         return out
@@ -863,7 +905,7 @@ def _solve_from(
 
     x = x0.copy()
     n_iter = 0
-    active = problem.screen(x, settings.screen_band)
+    active = problem.screen(x, settings.screen_band, settings.effort_band)
     if known:
         active = _merge(active, known)
     for stage, share in enumerate(settings.continuation):
@@ -872,7 +914,7 @@ def _solve_from(
             # a later stage starts from a point within every limit: only the rows near their limits
             # there (and the known ones), not every row an earlier round's iterate came near on its
             # way (the dense QP's work grows with its rows; those it breaks enter again after the solve)
-            active = problem.screen(x, settings.screen_band)
+            active = problem.screen(x, settings.screen_band, settings.effort_band)
             if known:
                 active = _merge(active, known)
 
@@ -919,7 +961,7 @@ def _solve_from(
             if np.all(np.isfinite(cand)):
                 x = cand
             history.append(problem.true_energy(x))
-            active = _merge(active, problem.screen(x, settings.screen_band))
+            active = _merge(active, problem.screen(x, settings.screen_band, settings.effort_band))
             if problem.violation(x) == 0.0 or _past(deadline):
                 break
         if (settings.give_up and problem.violation(x) > 0.0) or _past(deadline):
@@ -1093,8 +1135,13 @@ def solve_move(
     start: FloatArray = np.asarray(np.linalg.lstsq(fine.fine.B, target, rcond=None)[0], dtype=float)
     refine = replace(settings, n_starts=1, continuation=settings.continuation[-settings.refine_stages :])
     # the limit grids (accelerations, jerks, efforts, corridor) are the same in both bases;
-    # the control-point (hull) rows are not
-    known = {kind: rows for kind, rows in first.active.items() if kind != "hull"}
+    # the control-point (hull) rows are not; with an effort band, the fine level screens the effort
+    # rows at its start (the coarse level's path) and takes none of those the coarse level gathered
+    known = {
+        kind: rows
+        for kind, rows in first.active.items()
+        if kind != "hull" and not (kind == "tau" and settings.effort_band is not None)
+    }
     second = optimize_spline(fine, refine, rng=rng, initial=start, known=known, deadline=deadline)
     merged_history = np.minimum.accumulate(np.concatenate([first.history, second.history]))
     best, problem = (

@@ -611,7 +611,7 @@ def plot_run(result: MoveResult, robot: Robot, out: Path) -> list[Path]:
         ax.set_ylabel(label)
     axes[0].legend(ncol=n, fontsize=7, title="solid: optimized, dashed: default", title_fontsize=7)
     axes[-1].set_xlabel("t [s]")
-    fig.tight_layout()
+    _margins(fig, hspace=0.09)
     paths.append(_save(fig, out / "joints.png"))
     fig = Figure(figsize=(8, 3.5))
     ax = fig.subplots()
@@ -621,16 +621,23 @@ def plot_run(result: MoveResult, robot: Robot, out: Path) -> list[Path]:
     ax.set_xlabel("t [s]")
     ax.set_ylabel("Σ |τ·qd| [W]")
     ax.legend()
-    fig.tight_layout()
+    _margins(fig)
     paths.append(_save(fig, out / "power.png"))
     fig = Figure(figsize=(6, 3.5))
     ax = fig.subplots()
     ax.plot(np.arange(result.history.size), result.history)
     ax.set_xlabel("iteration" if result.summary.representation == "bspline" else "generation")
     ax.set_ylabel("best fitness [J]")
-    fig.tight_layout()
+    _margins(fig)
     paths.append(_save(fig, out / "convergence.png"))
     return paths
+
+
+def _margins(fig: Any, *, hspace: float = 0.2) -> None:
+    """Fixed margins in inches (room for the tick labels and an axis label), in place of ``tight_layout``:
+    that lays a figure out by drawing it once more before it is saved (a third of the plots' time)."""
+    w, h = fig.get_size_inches()
+    fig.subplots_adjust(left=0.8 / w, right=1 - 0.15 / w, bottom=0.6 / h, top=1 - 0.15 / h, hspace=hspace)
 
 
 def _save(fig: Any, path: Path) -> Path:

@@ -28,7 +28,7 @@ from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, MissingDependency
 from joulepath.evolve import DE, GA, MA, Termination, minimize
-from joulepath.optimize._gradient import SEARCH_BEFORE_HULL, GradientSettings, solve_move
+from joulepath.optimize._gradient import MOVE_SEARCH, SEARCH_BEFORE_HULL, GradientSettings, solve_move
 from joulepath.optimize._problem import FINE_FACTOR, FITNESS, PENALTY, TrajectoryProblem, limit_violation
 from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk, rest_to_rest, thesis_quintic
 
@@ -147,12 +147,15 @@ def via_point_settings(config: SearchSettings) -> dict[str, Any]:
 def _gradient(task: SearchTask, config: SearchSettings, rng: np.random.Generator) -> SearchOutcome:
     if config.follow == "via-points":
         return _gradient_with(task, config, rng, via_point_settings(config))
-    return _gradient_with(task, config, rng, {})
+    return _gradient_with(task, config, rng, MOVE_SEARCH)
 
 
 def _gradient_fast(task: SearchTask, config: SearchSettings, rng: np.random.Generator) -> SearchOutcome:
     return _gradient_with(
-        task, config, rng, {"knot_spacing": FAST_KNOT_FACTOR * config.knot_spacing, "coarse_factor": 1}
+        task,
+        config,
+        rng,
+        {**MOVE_SEARCH, "knot_spacing": FAST_KNOT_FACTOR * config.knot_spacing, "coarse_factor": 1},
     )
 
 

@@ -30,7 +30,6 @@ from pathlib import Path
 from typing import Protocol
 
 import numpy as np
-from scipy import signal
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Friction, Robot
@@ -249,6 +248,8 @@ def _track(
     plan: MotionPlan | Commanded, t: FloatArray, hz: float
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Actual motion: the command through ``w²/(s² + 2ws + w²)``, sampled at ``t``."""
+    from scipy import signal  # here: SciPy's signal package costs 0.3 s to import, needed only here
+
     step = 0.002
     grid = np.arange(0.0, t[-1] + 2 * step, step)
     q_c, qd_c, qdd_c = _commanded(plan, grid)
