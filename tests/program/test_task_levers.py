@@ -12,10 +12,12 @@ import numpy as np
 import pytest
 
 import joulepath
+from joulepath.dynamics import NOMINAL_FRICTION
+from joulepath.energy import measure_power
 from joulepath.program import read_cycle_program
 from joulepath.program._task_levers import task_levers
 from joulepath.sim import ControllerConfig
-from joulepath.sim._timing import plan_cycle
+from joulepath.sim._timing import FINE_DT, evaluate_cycle, plan_cycle
 
 CORPUS = Path(__file__).parents[1] / "fixtures" / "rapid_corpus"
 
@@ -63,6 +65,13 @@ def test_levers_written_into_the_task_as_written(name, tmp_path):
     again, _ = read_cycle_program(again_paths, robot, io=e.get("io"), routine=e.get("routine"))
     plan = plan_cycle(again, ControllerConfig())
     assert plan.cycle_time == pytest.approx(lev.cycle_s, abs=1e-9)
+    # its executed energy, recomputed here from its own motion (the 2.5 ms grid, each sample to the next)
+    t = np.linspace(0.0, plan.cycle_time, int(np.ceil(plan.cycle_time / FINE_DT)) + 1)
+    traj = evaluate_cycle(plan, t)
+    r = plan.moves[0].step.robot
+    tau = r.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
+    power = measure_power("thesis", tau, traj.qd, r.drivetrain).value
+    assert float((power * np.append(np.diff(traj.t), 0.0)).sum()) == pytest.approx(lev.energy_J, rel=1e-9)
     a = [s.q for s in spec.steps if s.kind == "move"]
     b = [s.q for s in again.steps if s.kind == "move"]
     assert len(a) == len(b) and all(np.abs(x - y).max() < 1e-9 for x, y in zip(a, b, strict=True))
