@@ -1709,16 +1709,8 @@ class CycleOptimizer:
         shares = np.concatenate([[0.0], np.geomspace(0.06, 1.0, k - 1)])
         floor = {i: min(self.t_lo[i], self.span[i]) for i in self.optimizable}
         out: dict[int, list[Solved]] = {i: [self.taught(i)] for i in self.optimizable}
-        for n_unit, i in enumerate(self.optimizable, start=1):  # each reshaped from its taught motion
-            if self._long_on_taught(i):
-                continue  # after its solves (solve_on_taught)
-            self.progress(f"unit {n_unit}/{len(self.optimizable)}: reshaping its taught motion")
-            try:
-                reshaped = self.solve_on_taught(i)
-            except TimeBudgetSpent:
-                return out
-            if reshaped is not None:
-                out[i].append(reshaped)
+        if not self._reshape(out, long=False):  # each reshaped from its taught motion (a long chain's
+            return out  # after its solves: solve_on_taught)
         for n_move, i in enumerate(self.optimizable, start=1):
             hi = budget - (sum(floor.values()) - floor[i])
             if hi < self.t_lo[i] - 1e-9:
@@ -1753,17 +1745,24 @@ class CycleOptimizer:
                     out[i].append(self.solve(i, u * STEP))
                 except TimeBudgetSpent:
                     return out
-        for n_unit, i in enumerate(self.optimizable, start=1):  # a long chain's, from its solve
-            if not self._long_on_taught(i):
+        self._reshape(out, long=True)  # a long chain's, from its solve
+        return out
+
+    def _reshape(self, out: dict[int, list[Solved]], *, long: bool) -> bool:
+        """The units reshaped from their taught motion (:meth:`solve_on_taught`) into ``out``: those whose
+        reshaping starts from their solve (``long``, :meth:`_long_on_taught`) or the others; False where
+        the time budget ran out."""
+        for n_unit, i in enumerate(self.optimizable, start=1):
+            if self._long_on_taught(i) != long:
                 continue
             self.progress(f"unit {n_unit}/{len(self.optimizable)}: reshaping its taught motion")
             try:
                 reshaped = self.solve_on_taught(i)
             except TimeBudgetSpent:
-                return out
+                return False
             if reshaped is not None:
                 out[i].append(reshaped)
-        return out
+        return True
 
     def dp(self, table: dict[int, list[Solved]], budget: float) -> dict[int, Solved] | None:
         """The least-energy choice of one usable entry per unit with Σ durations ≤ budget, on a
