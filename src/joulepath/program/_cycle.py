@@ -193,10 +193,10 @@ FAST_CYCLE: dict[str, Any] = {"pass_search": 2, "table_points": 3, "retime_segme
 """:class:`CycleSettings` for interactive use (``CycleSettings(**FAST_CYCLE)``; issue 36): at most 2 probes
 per inner target in the pass-time search, 3 durations per unit in the time table, and no re-timing of
 the segments with a ``MoveL`` along their paths. Measured on the bundled examples (one BLAS thread,
-CPU s and saving, default -> fast): pick_and_place 23.1 -> 8.0 s, 12.15 -> 10.80 %; palletizing
-26.7 -> 8.5 s, 22.30 -> 20.32 %; machine_tending 6.5 -> 2.4 s, 12.69 -> 11.18 %; inspection 8.6 ->
-8.8 s, 17.46 % both; approach_depart 9.1 -> 3.1 s, 13.60 -> 12.71 %; payload_tool 4.8 -> 2.6 s,
-12.67 -> 12.29 % (BENCHMARKS.md, benchmarks/cycle_examples.py with ``FAST=1``)."""
+CPU s and saving, default -> fast, one run each on the same code): pick_and_place 7.0 -> 2.3 s, 12.19 ->
+10.9 %; palletizing 8.4 -> 4.4 s, 22.37 -> 20.3 %; machine_tending 3.1 -> 1.4 s, 12.70 -> 11.2 %;
+inspection 3.7 -> 3.8 s, 17.46 % both; approach_depart 2.3 -> 0.7 s, 13.65 -> 12.7 %; payload_tool 2.9
+-> 1.7 s, 12.66 -> 12.3 % (BENCHMARKS.md, benchmarks/cycle_examples.py with ``FAST=1``)."""
 
 
 class TimeBudgetSpent(Exception):
