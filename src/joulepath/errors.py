@@ -6,6 +6,7 @@ derives from the matching built-in so that ``except ValueError`` keeps working::
     JoulepathError
     ├── InvalidRobotDescription (ValueError)   a robot file that cannot be used
     ├── InvalidInput (ValueError)              arrays or arguments of the wrong shape or range
+    │   └── RapidError                         a RAPID program that cannot be read or run
     ├── InvalidLog (ValueError)                a joint log or energy table that cannot be used
     ├── LimitViolation (ValueError)            a result that would drive a joint past a limit
     ├── InvalidModel (ValueError)              a model file refused, or a table it cannot read
@@ -29,6 +30,10 @@ class InvalidRobotDescription(JoulepathError, ValueError):
 
 class InvalidInput(JoulepathError, ValueError):
     """An argument has the wrong shape, type or range."""
+
+
+class RapidError(InvalidInput):
+    """A RAPID program joulepath cannot read or run: the message starts with ``file:line:``."""
 
 
 class InvalidLog(JoulepathError, ValueError):

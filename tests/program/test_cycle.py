@@ -206,7 +206,7 @@ def test_cli_writes_a_program_that_reads_back(tmp_path, robot):
     args = ["--use-waits", "--idle-wait", "11", "--knot-spacing", "0.1", "--table-points", "2"]
     # the plan's own via-point module is what this test reads back: no search of the controller's
     # levers (tests/program/test_levers*.py, test_via_levers.py and test_export_choice.py test those)
-    args += ["--levers-seconds", "0"]
+    args += ["--lever-plans", "0"]
     rc = main(["cycle", str(prog), "--out", str(tmp_path / "strict"), "--export", "rapid", *args])
     strict = json.loads((tmp_path / "strict" / "cycle.json").read_text())
     if strict["written_program_matches_plan"]:
@@ -268,7 +268,7 @@ def test_cli_writes_a_program_that_reads_back(tmp_path, robot):
             "0.1",
             "--table-points",
             "2",
-            "--levers-seconds",
+            "--lever-plans",
             "0",
         ]
     ) in (0, 1)

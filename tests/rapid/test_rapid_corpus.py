@@ -66,6 +66,8 @@ def test_each_program_is_read_or_refused_as_expected(folder, robot):
         assert ":" in move and ":" in why
     if not e.get("io") and e.get("kept_at_least", 0) == 0:
         assert not kept  # nothing in it depends on run-time data
+    # a partial task: exactly the names it declares nowhere, each with the role the program gives it
+    assert {a.name: a.role for a in spec.assumed} == e.get("assumed", {})
 
 
 @pytest.mark.parametrize(

@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
-import json
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import typer
 
 from joulepath.cli._common import check_out_folder, console, progress_lines
 from joulepath.cli._robot import load_robot_for_cli, unchecked_option
+from joulepath.program import LEVER_PLANS
 
 
 def _cycle_time(text: str) -> float | None:
@@ -26,30 +27,17 @@ def _cycle_time(text: str) -> float | None:
     return value
 
 
-LEVERS_SECONDS = 30.0
-"""s of wall time the search of the controller's levers takes at most (then what it found is written)."""
+def _scenario(pairs: list[str], path: Path | None) -> Any:
+    """The scenario: the ``--scenario`` file (:func:`joulepath.program.read_scenario`), then ``--io
+    NAME=VALUE`` pairs over its ``[io]`` values."""
+    from joulepath.program import Scenario, read_scenario
 
-
-def _scenario(pairs: list[str], path: Path | None) -> dict[str, float | str | bool]:
-    """The I/O scenario: ``--scenario`` file values, then ``--io NAME=VALUE`` pairs over them."""
-    out: dict[str, float | str | bool] = {}
-    if path is not None:
-        from joulepath._io import load_toml
-
-        data = load_toml(path, max_bytes=1 << 20, what="an I/O scenario (TOML)")
-        table = data.get("io", data)
-        if not isinstance(table, dict):
-            raise typer.BadParameter(f"{path}: [io] must be a table of NAME = VALUE", param_hint="--scenario")
-        for k, v in table.items():
-            if not isinstance(v, (int, float, str, bool)):
-                raise typer.BadParameter(
-                    f"{path}: {k} = {v!r}: give a number, a string or a bool", param_hint="--scenario"
-                )
-            out[str(k)] = float(v) if isinstance(v, int) and not isinstance(v, bool) else v
+    base = read_scenario(path) if path is not None else Scenario()
+    out: dict[str, float | str | bool] = dict(base.io)
     for pair in pairs:
         name, sep, value = pair.partition("=")
         if not sep or not name.strip() or not value.strip():
-            raise typer.BadParameter(f"{pair!r}: give NAME=VALUE, e.g. diPartReady=1", param_hint="--io")
+            raise typer.BadParameter(f"{pair[:60]!r}: give NAME=VALUE, e.g. diPartReady=1", param_hint="--io")
         text = value.strip()
         parsed: float | str | bool
         if text.upper() in ("TRUE", "FALSE"):
@@ -60,7 +48,7 @@ def _scenario(pairs: list[str], path: Path | None) -> dict[str, float | str | bo
             except ValueError:
                 parsed = text.strip('"')
         out[name.strip()] = parsed
-    return out
+    return Scenario(out, base.given)
 
 
 def cycle(
@@ -145,13 +133,13 @@ def cycle(
         "Measured on the bundled examples: at most 4.4 s of CPU each (the default: 8.4 s), 0-2.1 points "
         "less saving.",
     ),
-    levers_seconds: float = typer.Option(
-        LEVERS_SECONDS,
-        "--levers-seconds",
-        min=0.0,
-        max=3600.0,
-        help="s of wall time for each search of the controller's levers on the emulation (RAPID export; "
-        "what the search found by then is checked and written; 0: no lever search).",
+    lever_plans: int = typer.Option(
+        LEVER_PLANS,
+        "--lever-plans",
+        min=0,
+        max=100_000,
+        help="Cycle plans each search of the controller's levers makes at most on the emulation (RAPID "
+        "export): a bound of work, so the written program is the same on any machine; 0: no lever search.",
     ),
     corridor: float = typer.Option(
         100.0,
@@ -179,7 +167,10 @@ def cycle(
         "the operator fills); repeatable. Moves decided by what is not given are kept as taught.",
     ),
     scenario: Path = typer.Option(
-        None, "--scenario", help="TOML file of NAME = VALUE pairs (an [io] table or top-level keys): as --io."
+        None,
+        "--scenario",
+        help="TOML file: [io] NAME = VALUE pairs (as --io); [tool.NAME], [wobj.NAME], [targets], [data] for "
+        "what a partial task uses and does not declare (docs/reference/formats.md#scenario-files).",
     ),
     routine: str = typer.Option(
         None, "--routine", help="Run this routine instead of main (a library of paths, or one routine)."
@@ -197,11 +188,10 @@ def cycle(
         CYCLE_FILES,
         FAST_CYCLE,
         CycleSettings,
-        optimize_cycle,
-        read_cycle_program,
-        write_cycle_run,
+        ProgramSettings,
+        optimize_program,
+        read_cell,
     )
-    from joulepath.program import pareto as run_pareto
 
     target = _cycle_time(cycle_time)
     if export not in ("auto", "rapid", "egm"):
@@ -210,96 +200,36 @@ def cycle(
     for p in program:
         if not p.exists():  # anything else but a regular file or folder is refused by name when read
             raise typer.BadParameter(f"{p}: no such file or folder", param_hint="PROGRAM")
-    scenario_values = _scenario(io, scenario)
     r = load_robot_for_cli(robot, unchecked=unchecked)
     check_measure(energy, r.drivetrain)  # one line saying what to provide
-    from joulepath.program._cell import read_cell
-
-    settings = CycleSettings(
-        cycle_time=target,
-        use_waits=use_waits,
-        fly_by=not stop_at_targets,
-        zones=not exact_targets,
-        max_time_s=max_time,
-        accel_time=accel_time,
-        seed=seed,
-        table_points=table_points,
-        corridor_mm=corridor or None,
+    given = _scenario(io, scenario)
+    cs = CycleSettings(
+        cycle_time=target, use_waits=use_waits, fly_by=not stop_at_targets, zones=not exact_targets,
+        max_time_s=max_time, accel_time=accel_time, seed=seed, table_points=table_points,
+        corridor_mm=corridor or None, energy=energy,
         gradient=replace(CycleSettings().gradient, knot_spacing=knot_spacing),
-        energy=energy,
-    )
-    if fast:
-        settings = replace(settings, **FAST_CYCLE)
-    if jerk_time is not None:  # else the controller's default (CycleSettings')
-        settings = replace(settings, jerk_time=jerk_time)
+    )  # fmt: skip
+    cs = replace(cs, **FAST_CYCLE) if fast else cs
+    cs = replace(cs, jerk_time=jerk_time) if jerk_time is not None else cs  # else the controller's default
+    settings = ProgramSettings(
+        cycle=cs, export=export, lever_plans=lever_plans, write_anyway=write_anyway,  # type: ignore[arg-type]
+        pareto_points=points if pareto else 0, io=given.io, given=given.given, routine=routine,
+        idle_waits=tuple(idle_wait),
+    )  # fmt: skip
     with progress_lines("optimizing the cycle...") as say:  # on stderr only: stdout keeps the results
-        spec, rapid = read_cycle_program(
-            program, r, idle_waits=idle_wait, progress=say, io=scenario_values, routine=routine, seed=seed
-        )
         cell_data = read_cell(cell, progress=say) if cell is not None else None
-        result, opt = optimize_cycle(spec, replace(settings, cell=cell_data), progress=say)
-        front = None
-        if pareto:
-            say("energy against cycle time...")
-            front = run_pareto(opt, points=points, use_waits=use_waits)
-        levers = None
-        if rapid and export != "egm" and result.limits_ok and levers_seconds > 0:
-            from joulepath.program import levers_module
-            from joulepath.program._task_levers import task_levers
+        done = optimize_program(program, r, out, settings, cell=cell_data, progress=say)
+    return print_program_result(done, out, r, use_waits=use_waits, cell=cell_data)
 
-            say("searching the controller's levers (AccSet, speed data, zones) on the controller emulation")
-            if spec.module is not None:
-                levers = levers_module(
-                    spec, r, energy=energy, use_waits=use_waits, max_seconds=levers_seconds
-                )
-            else:
-                levers = task_levers(
-                    spec,
-                    r,
-                    energy=energy,
-                    io=scenario_values or None,
-                    routine=routine,
-                    max_seconds=levers_seconds,
-                )
-        via = None
-        searched = levers_seconds > 0
-        if (
-            rapid
-            and export != "egm"
-            and result.limits_ok
-            and spec.module is not None
-            and result.paths
-            and searched
-        ):
-            from joulepath.program import via_levers
 
-            say("searching the levers of the plan's via points on the controller emulation")
-            via = via_levers(
-                result,
-                r,
-                energy=energy,
-                corridor_mm=settings.corridor_mm,
-                cell=cell_data,
-                max_seconds=levers_seconds,
-            )
-        say(f"writing {out} (the written program is checked on the controller emulation)")
-        files = write_cycle_run(
-            out,
-            result,
-            pareto=front,
-            write_rapid=rapid,
-            cell=cell_data,
-            write_anyway=write_anyway,
-            egm="always" if export == "egm" else "fallback" if export == "auto" else "never",
-            levers=levers,
-            via_levers=via,
-        )
+def print_program_result(done: Any, out: Path, r: Any, *, use_waits: bool, cell: Any) -> int:
+    """Print a :class:`~joulepath.program.ProgramResult` (stdout); the exit code of ``cycle``."""
+    result, spec, files, saved, rapid = done.cycle, done.spec, done.files, done.summary, done.rapid
     if use_waits and not any(s.idle for s in spec.steps if s.kind == "wait"):
         console.print(
             "note: --use-waits: no wait is declared idle (`! joulepath: idle` on its line, or --idle-wait "
             "LINE); every wait is process time and keeps its length"
         )
-    saved = json.loads(files["cycle.json"].read_text())
     if not result.limits_ok:
         console.print(
             "REFUSED: the optimized cycle breaks a limit or the cell's margin; no program was written "
@@ -364,7 +294,7 @@ def cycle(
             else f"; on the lab robot ({result.energy_measure}, motion) {saved['lab_default_J']:.2f} -> "
             f"{saved['lab_optimized_J']:.2f} J ({lab_pct:.1f} % saved)"
         )
-        + (" (every unit kept as taught)" if len(result.taught_units) == len(opt.optimizable) else "")
+        + (" (every unit kept as taught)" if done.every_unit_taught else "")
     )
     for e in result.energies:
         lab = (
@@ -395,6 +325,8 @@ def cycle(
     )
     for choice in spec.choices:
         console.print(f"read: {choice}", markup=False)
+    for a in spec.assumed:
+        console.print(f"assumed: {a.line()}", markup=False)
     if spec.kept:
         console.print(
             f"kept as taught: {len(spec.kept)} of {sum(st.kind == 'move' for st in spec.steps)} moves "
@@ -405,7 +337,7 @@ def cycle(
             console.print(f"  {move}: {why}", markup=False)
     if result.timed_out:
         console.print("--max-time reached: the best verified result of the moves solved by then")
-    if cell_data is not None:
+    if cell is not None:
         near = [m for m in result.moves if m.default_clearance_mm is not None and m.default_clearance_mm < 0]
         for m in near:
             console.print(

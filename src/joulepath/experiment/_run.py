@@ -1006,16 +1006,9 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
     Its key holds the program's and the cell file's content (and its meshes'), so editing any
     runs it again.
     """
-    from joulepath._runfolder import CYCLE_JSON, CYCLE_STAGE
+    from joulepath._runfolder import CYCLE_STAGE
     from joulepath.dynamics import load_robot
-    from joulepath.program import (
-        CycleSettings,
-        optimize_cycle,
-        read_cycle_program,
-        write_cycle_run,
-    )
-    from joulepath.program import pareto as run_pareto
-    from joulepath.program._cell import read_cell
+    from joulepath.program import CycleSettings, ProgramSettings, optimize_program, read_cell
 
     exp, st = ctx.exp, ctx.exp.cycle
     program = Path(resolve_logs(exp, (st.program,))[0])
@@ -1033,28 +1026,24 @@ def _cycle_stage(ctx: _Context) -> dict[str, Any]:
 
     def body(folder: Path) -> dict[str, Any]:
         robot = load_robot(exp.robot)
-        spec, rapid = read_cycle_program(program, robot)
-        settings = CycleSettings(
-            cell=cell_data,
-            cycle_time=st.cycle_time or None,
-            use_waits=st.use_waits,
-            fly_by=st.fly_by,
-            corridor_mm=st.corridor_mm or None,
-            seed=exp.seed,
+        settings = ProgramSettings(
+            cycle=CycleSettings(
+                cycle_time=st.cycle_time or None,
+                use_waits=st.use_waits,
+                fly_by=st.fly_by,
+                corridor_mm=st.corridor_mm or None,
+                seed=exp.seed,
+            ),
+            export="rapid",  # the study's plan and its via-point module, no EGM files
+            lever_plans=0,  # the study compares the plan: no search of the controller's levers
+            write_anyway=st.write_anyway,
+            pareto_points=st.pareto_points,
         )
         ctx.progress("cycle", 0, 1)
-        result, opt = optimize_cycle(spec, settings)
-        front = run_pareto(opt, points=st.pareto_points, use_waits=st.use_waits) if st.pareto_points else None
-        files = write_cycle_run(
-            folder,
-            result,
-            pareto=front,
-            write_rapid=rapid,
-            cell=cell_data,
-            write_anyway=st.write_anyway,
-        )
+        done = optimize_program(program, robot, folder, settings, cell=cell_data)
+        result, files, rapid = done.cycle, done.files, done.rapid
         ctx.progress("cycle", 1, 1)
-        check = json.loads((folder / CYCLE_JSON).read_text(encoding="utf-8")).get("written_program_check")
+        check = done.summary.get("written_program_check")
         written = "optimized.mod" in files or not rapid
         ctx.tell(
             f"{CYCLE_STAGE}: cycle {result.default_cycle_s:.3f} s -> {result.optimized_cycle_s:.3f} s, "

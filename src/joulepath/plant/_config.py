@@ -100,6 +100,7 @@ CELL_SETTINGS: dict[str, Any] = {
     "stop_at_targets": _boolean,
     "exact_targets": _boolean,
     "export": _choice("auto", "rapid", "egm"),
+    "lever_plans": _integer(0, 100_000),
     "max_time": _number(1.0, 1e6),
     "accel_time": _number(0.05, 10.0),
     "jerk_time": _number(0.0, 10.0),
@@ -115,7 +116,8 @@ CELL_SETTINGS: dict[str, Any] = {
 }
 """The settings a plant's ``[defaults]`` or a cell may give: ``joulepath cycle``'s options (``--max-time``
 is ``max_time``, ``--idle-wait`` is ``idle_wait``, a list), and ``pass_search``, ``rapid_plan`` and
-``retime_segments`` (:class:`joulepath.program.CycleSettings`' fields: false for the last two plans
+``retime_segments`` (:class:`joulepath.program.CycleSettings`' fields; ``lever_plans`` is
+:class:`joulepath.program.ProgramSettings`': false for the last two plans
 for EGM samples only, much faster, at the risk of no RAPID program written). Each maps to its check
 (None: valid, else what is expected)."""
 

@@ -79,14 +79,20 @@ def cycle_settings(settings: Mapping[str, Any]) -> Any:
     return out
 
 
-def _read_program(task: CellTask, robot: Any, idle_waits: list[int]) -> tuple[Any, bool]:
-    """The program's cycle: the task's modules run by the RAPID interpreter, with the cell's I/O
-    scenario and entry routine."""
-    from joulepath.program import read_cycle_program
+def program_settings(task: CellTask) -> Any:
+    """The :class:`~joulepath.program.ProgramSettings` of a cell (as ``joulepath cycle`` builds them
+    from the same options): its cycle settings, export, lever search, I/O scenario and routine."""
+    from joulepath.program import LEVER_PLANS, ProgramSettings
 
-    routine = None if task.routine in (None, "main") else task.routine
-    return read_cycle_program(
-        list(task.program), robot, idle_waits=idle_waits, io=dict(task.io) or None, routine=routine
+    s = task.settings
+    return ProgramSettings(
+        cycle=cycle_settings(s),
+        export=str(s.get("export", "auto")),  # type: ignore[arg-type]
+        lever_plans=int(s.get("lever_plans", LEVER_PLANS)),
+        write_anyway=bool(s.get("write_anyway", False)),
+        io=dict(task.io),
+        routine=None if task.routine in (None, "main") else task.routine,
+        idle_waits=tuple(int(k) for k in s.get("idle_wait", [])),
     )
 
 
@@ -176,26 +182,15 @@ def run_cell(task: CellTask) -> dict[str, Any]:
 
 def _run(task: CellTask) -> dict[str, Any]:
     from joulepath.dynamics import load_robot
-    from joulepath.program import optimize_cycle, write_cycle_run
-    from joulepath.program._cell import read_cell
+    from joulepath.program import optimize_program, read_cell
 
-    settings = cycle_settings(task.settings)
     robot = load_robot(task.robot)
-    spec, rapid = _read_program(task, robot, [int(k) for k in task.settings.get("idle_wait", [])])
     cell = read_cell(task.cell) if task.cell is not None else None
-    result, opt = optimize_cycle(spec, replace(settings, cell=cell))
-    export = str(task.settings.get("export", "auto"))
     with tempfile.TemporaryDirectory(prefix="joulepath-cell-") as scratch:
-        files = write_cycle_run(
-            Path(scratch),
-            result,
-            pareto=None,
-            write_rapid=rapid,
-            cell=cell,
-            write_anyway=bool(task.settings.get("write_anyway", False)),
-            egm="always" if export == "egm" else "fallback" if export == "auto" else "never",
-        )
+        done = optimize_program(list(task.program), robot, Path(scratch), program_settings(task), cell=cell)
+        files = done.files
         texts = {n: files[n].read_text(encoding="utf-8") for n in RETURNED_FILES if n in files}
+    result, spec = done.cycle, done.spec
     saved = json.loads(texts["cycle.json"])
     energies = {e.measure: e for e in result.energies}
     measure = REPORT_MEASURE if REPORT_MEASURE in energies else result.energy_measure
@@ -216,7 +211,7 @@ def _run(task: CellTask) -> dict[str, Any]:
     optimized_J = (e.optimized_J if e is not None else result.optimized_energy_J) if claimed else default_J
     optimized_cycle = result.optimized_cycle_s if claimed else result.default_cycle_s
     carrying = next((s.robot for s in spec.steps if s.kind == "move" and s.robot is not None), robot)
-    split_default = _split(carrying, opt.default_motion().trajectory, result.default_cycle_s, measure)
+    split_default = _split(carrying, done.default_trajectory, result.default_cycle_s, measure)
     split_optimized = (
         _split(carrying, result.planned, result.optimized_cycle_s, measure)
         if claimed and result.planned is not None

@@ -1,6 +1,7 @@
 """Robot programs: read a RAPID module (or a plain cycle file), run its cycle as the
 controller does, optimize it."""
 
+from joulepath.program._cell import Cell, read_cell
 from joulepath.program._cycle import (
     FAST_CYCLE,
     Breakdown,
@@ -16,7 +17,14 @@ from joulepath.program._levers import LeverResult, MoveLever, levers_module
 from joulepath.program._model import Module, RapidError
 from joulepath.program._output import CYCLE_FILES, optimized_module, write_cycle_run
 from joulepath.program._parse import parse_module, read_module
+from joulepath.program._pipeline import (
+    LEVER_PLANS,
+    ProgramResult,
+    ProgramSettings,
+    optimize_program,
+)
 from joulepath.program._resolve import CycleSpec, read_cycle_program, read_cycle_toml, resolve_module
+from joulepath.program._scenario import Scenario, read_scenario, scenario_from_dict
 from joulepath.program._simulate import ProgramMotion, ProgramRun, program_motion, simulate_program
 from joulepath.program._via_levers import ViaLevers, via_levers
 from joulepath.program._write import format_move, write_module
@@ -25,32 +33,41 @@ from joulepath.sim import plan_cycle
 __all__ = [
     "Breakdown",
     "CYCLE_FILES",
+    "Cell",
     "CycleOptimizer",
     "CycleResult",
     "CycleSettings",
     "CycleSpec",
     "FAST_CYCLE",
+    "LEVER_PLANS",
     "LeverResult",
     "Module",
     "MoveLever",
     "MoveOutcome",
     "ParetoPoint",
+    "ProgramResult",
+    "ProgramSettings",
     "ProgramMotion",
     "ProgramRun",
     "RapidError",
+    "Scenario",
     "ViaLevers",
     "format_move",
     "levers_module",
     "optimize_cycle",
+    "optimize_program",
     "optimized_module",
     "pareto",
     "parse_module",
     "plan_cycle",
     "program_motion",
     "read_cycle_program",
+    "read_cell",
     "read_cycle_toml",
     "read_module",
+    "read_scenario",
     "resolve_module",
+    "scenario_from_dict",
     "simulate_program",
     "via_levers",
     "write_cycle_run",

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from joulepath.rapid import RapidError  # noqa: E402  (one definition: the RAPID language's)
+from joulepath.errors import RapidError  # one definition: the RAPID language's
 from joulepath.sim import SpeedData
 
 __all__ = ["RapidError"]

@@ -302,6 +302,9 @@ def cycle_json(
         "choices": list(result.spec.choices),
         "read_notes": list(result.spec.choices),
         "kept_moves": [{"move": m, "why": why} for m, why in result.spec.kept],
+        "assumed": [a.as_json() for a in result.spec.assumed],
+        "assumed_note": "names the task uses and declares nowhere in what was given (a module, the I/O "
+        "configuration or an option not given), with what was taken for each; the saving is stated on them",
         "open_to_optimization_pct": _open_share(result),
         "open_to_optimization_note": "share of the taught cycle's motion energy (energy_default_J) in moves "
         "the optimizer may change: every move but those kept as taught (kept_moves: their target, speed, "

@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -72,6 +73,7 @@ class CycleSpec:
     choices: tuple[str, ...] = field(default=())
     kept: tuple[tuple[str, str], ...] = field(default=())  # (move, why it runs as taught)
     task: object | None = None  # the RAPID task's cycle (joulepath.program._task.TaskCycle)
+    assumed: tuple[Any, ...] = field(default=())  # names declared nowhere (joulepath.rapid Assumption)
 
 
 def tool_transform(tool: ToolData) -> FloatArray:
@@ -598,6 +600,7 @@ def read_cycle_program(
     io: Mapping[str, float | str | bool] | None = None,
     routine: str | None = None,
     seed: int = 0,
+    given: Mapping[str, Any] | None = None,
 ) -> tuple[CycleSpec, bool]:
     """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID task.
 
@@ -627,7 +630,7 @@ def read_cycle_program(
     restored = _restored(paths)
     if restored is not None:
         paths = [restored]
-    tc = read_task_cycle(paths, robot, io=io, routine=routine, seed=seed, progress=progress)
+    tc = read_task_cycle(paths, robot, io=io, routine=routine, seed=seed, progress=progress, given=given)
     steps = _mark_idle(tc, idle_waits)
     module = _static_view(tc, steps, robot, routine, io)
     if module is not None:
@@ -647,6 +650,7 @@ def read_cycle_program(
             tc.trace.notes,
             kept=tc.kept,
             task=tc,
+            assumed=tc.trace.assumed,
         ),
         True,
     )

@@ -13,7 +13,7 @@ with its reasons in ``Step.kept``.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -21,11 +21,10 @@ import numpy as np
 from joulepath._typing import FloatArray
 from joulepath._work import check_work
 from joulepath.dynamics import Robot
-from joulepath.errors import InvalidInput
+from joulepath.errors import InvalidInput, RapidError
 from joulepath.kinematics import check_layout, confdata, solve_ik
-from joulepath.rapid import RapidError
 from joulepath.rapid import _geometry as geo
-from joulepath.rapid.interpreter import Action, Interpreter, Motion, Trace, Wait
+from joulepath.rapid.interpreter import UNKNOWN_TARGET, Action, Interpreter, Motion, Trace, Wait
 from joulepath.rapid.task import Task, load_task
 from joulepath.rapid.values import Record, num, pos_values
 from joulepath.sim import SpeedData, Step
@@ -39,6 +38,7 @@ class RobotKinematics:
     def __init__(self, robot: Robot) -> None:
         self.robot = robot
         self.lo, self.hi = robot.joint_ranges()
+        self._reach: float | None = None
 
     def joints(
         self, flange: FloatArray, conf: tuple[int, int, int, int] | None, near: FloatArray | None
@@ -62,6 +62,15 @@ class RobotKinematics:
     def in_range(self, q: FloatArray) -> int | None:
         bad = np.nonzero((q < self.lo - 1e-9) | (q > self.hi + 1e-9))[0]
         return int(bad[0]) if bad.size else None
+
+    def reach_m(self) -> float:
+        """The farthest the flange comes from the base (m), over 4,096 seeded configurations within
+        the joint ranges (a lower bound of the true reach, within a few mm)."""
+        if self._reach is None:
+            rng = np.random.default_rng(0)
+            q = self.lo + rng.random((4096, self.robot.n_joints)) * (self.hi - self.lo)
+            self._reach = max(float(np.linalg.norm(self.robot.fk(qk).position_m)) for qk in q)
+        return self._reach
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -135,7 +144,8 @@ def steps_of(
             label = f"{e.instruction} {e.target_text}"
             tcp = tool_transform(e.tool) if bool(e.tool.get("robhold")) else np.eye(4)
             zone_mm = None if e.fine else e.zone_mm
-            reasons = tuple(sorted(e.kept))
+            # an unknown target first: it says where the target comes from
+            reasons = tuple(sorted(e.kept, key=lambda why: (UNKNOWN_TARGET not in why, why)))
             if reasons:
                 kept.append((f"{e.pos} {label}", reasons[0]))
             steps.append(
@@ -177,6 +187,7 @@ def read_task_cycle(
     routine: str | None = None,
     seed: int = 0,
     progress: Callable[[str], None] | None = None,
+    given: Mapping[str, object] | None = None,
 ) -> TaskCycle:
     """Run a task's program (modules and folders) on ``robot`` and give its cycle's steps.
 
@@ -198,7 +209,14 @@ def read_task_cycle(
     except InvalidInput as err:
         raise RapidError(f"{', '.join(map(str, paths))}: {err}") from err
     task = load_task(paths)
-    interp = Interpreter(task, io=io, seed=seed, kinematics=RobotKinematics(robot))
+    interp = Interpreter(
+        task,
+        io=io,
+        seed=seed,
+        kinematics=RobotKinematics(robot),
+        given=given,
+        rated_payload_kg=robot.rated_payload_kg,
+    )
     trace = interp.run(routine)
     moves = [e for e in trace.cycle if isinstance(e, Motion)]
     if not moves:
@@ -221,9 +239,7 @@ def read_task_cycle(
     notes = list(trace.notes)
     for k in unused:
         notes.append(f"--io {k}: the cycle never read it")
-    trace = Trace(
-        trace.events, trace.cycle_start, trace.cycle_end, tuple(notes), trace.routine, trace.loop, trace.steps
-    )
+    trace = replace(trace, notes=tuple(notes))
     return TaskCycle(task, trace, steps, kept)
 
 

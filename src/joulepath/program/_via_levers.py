@@ -299,6 +299,7 @@ def via_levers(
     max_seconds: float | None = None,
     config: ControllerConfig | None = None,
     timed_chains: bool = True,
+    max_plans: int = MAX_PLANS,
 ) -> ViaLevers:
     """The via-point module of ``result``'s plan with the controller's levers of its via points,
     as the controller emulation runs it (module docstring).
@@ -320,6 +321,8 @@ def via_levers(
         Wall time of the lever search (what it found by then is written).
     config : ControllerConfig, optional
         The emulated controller.
+    max_plans : int, optional
+        Cycle plans each lever search makes at most (the bound of work that ends it).
     timed_chains : bool, optional
         Also the plan's via points at equal arc length with each chain's ``\\T`` timed for the
         controller (:mod:`joulepath.program._via_timing`); the module that runs the taught cycle
@@ -484,7 +487,7 @@ def via_levers(
                 text=text,
                 config=config,
                 max_seconds=max_seconds,
-                max_evaluations=MAX_PLANS,
+                max_evaluations=max_plans,
                 baseline=(t_taught, e_taught, lab_taught),
                 only_lines=only,
                 bound=None if corridor_mm is None else past_corridor,  # each step keeps the corridor

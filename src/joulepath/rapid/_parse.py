@@ -18,13 +18,8 @@ from typing import Any
 import lark
 
 from joulepath._io import read_capped
-from joulepath.errors import InvalidInput
+from joulepath.errors import RapidError
 from joulepath.rapid import nodes as n
-
-
-class RapidError(InvalidInput):
-    """A RAPID program joulepath cannot read or run: the message starts with ``file:line:``."""
-
 
 MAX_BYTES = 16 * 1024 * 1024
 """Largest module file read (bytes); a controller's program memory is far smaller."""

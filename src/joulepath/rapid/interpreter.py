@@ -40,9 +40,10 @@ from typing import Protocol
 import numpy as np
 
 from joulepath._typing import FloatArray
+from joulepath.errors import RapidError
 from joulepath.rapid import _geometry as geo
+from joulepath.rapid import _standins as standins
 from joulepath.rapid import nodes as n
-from joulepath.rapid._parse import RapidError
 from joulepath.rapid.task import Task
 from joulepath.rapid.values import (
     NUM_TYPES,
@@ -72,11 +73,17 @@ MAX_DEPTH = 32
 """Deepest routine call (recursion) one run may take."""
 MAX_LOOP_TURNS = 200_000
 """Turns one loop may take."""
+UNTYPED = "(declared nowhere)"
+"""The type of a value declared nowhere whose role nothing fixes: it takes what it is assigned."""
+UNKNOWN_TARGET = "an unknown target"
+"""The words that mark a target the program does not give (declared nowhere, or known only at run time
+and not reachable as its stand-in): its move is placed where the arm is and kept as taught."""
 
 SPEEDS: tuple[int, ...] = (5, 10, 20, 30, 40, 50, 60, 80, 100, 150, 200, 300, 400, 500, 600, 800, 1000)
 SPEEDS += (1500, 2000, 2500, 3000, 4000, 5000, 6000, 7000)
 ZONES = (0, 1, 5, 10, 15, 20, 30, 40, 50, 60, 80, 100, 150, 200)
 
+RAPID_AXES = 6
 JOINT_MOTIONS = {"movej": "MoveJ", "movejdo": "MoveJ", "movejsync": "MoveJ", "triggj": "MoveJ"}
 LINEAR_MOTIONS = {
     "movel": "MoveL",
@@ -185,6 +192,8 @@ class Kinematics(Protocol):
     def confdata(self, q: FloatArray) -> tuple[int, int, int, int]: ...
 
     def in_range(self, q: FloatArray) -> int | None: ...
+
+    def reach_m(self) -> float | None: ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -298,6 +307,7 @@ class Trace:
     routine: str
     loop: n.Pos | None
     steps: int
+    assumed: tuple[standins.Assumption, ...] = ()
 
     @property
     def cycle(self) -> tuple[Event, ...]:
@@ -441,8 +451,14 @@ class Interpreter:
         max_steps: int = MAX_STEPS,
         max_seconds: float = MAX_SECONDS,
         progress: Callable[[str], None] | None = None,
+        given: Mapping[str, Value] | None = None,
+        rated_payload_kg: float | None = None,
     ) -> None:
         self.task = task
+        self.given = {k.lower(): v for k, v in (given or {}).items()}
+        self.rated_payload_kg = rated_payload_kg
+        self.assumed: list[standins.Assumption] = []
+        self._assumed_routines: set[str] = set()
         self.types = Types()
         self.kin = kinematics
         self.rng = np.random.default_rng(seed)
@@ -478,6 +494,7 @@ class Interpreter:
         self._index()
         self.assigned = self._assigned_names()
         self.signals_used = self._signal_names()
+        self.roles = standins.name_roles(self.task.modules, PROCESS_LINEAR, PROCESS_CIRCULAR)
         self._initialising: set[tuple[str, str]] = set()
 
     # ---- setup
@@ -668,10 +685,79 @@ class Interpreter:
             return self.cells[ck]
         if key == "errno" or key.startswith("err_"):
             return Cell(name, "errnum", "CONST", 0.0, CLEAN, None)
-        raise RapidError(
-            f"{pos}: {name} is declared nowhere in what was given ({self.task.source}); pass the module "
-            "that declares it (or the I/O configuration EIO.cfg for a signal)"
-        )
+        return self.stand_in(name, pos)
+
+    def stand_in(self, name: str, pos: n.Pos) -> Cell:
+        """A name declared nowhere in what was given: a stand-in by the role the program gives it
+        (:mod:`joulepath.rapid._standins`), or the scenario's value for it; said once, in
+        :attr:`Trace.assumed`."""
+        key = name.lower()
+        found = self.cells.get(("", key))
+        if found is not None:
+            return found
+        role = self.roles.get(key, "value")
+        taint: Taint = CLEAN
+        if key in self.given:
+            type_ = role if role != "value" else "num"
+            given = self.given[key]
+            try:
+                if isinstance(given, str) and type_ != "string":  # a RAPID literal: "[2000, 500, 5000, 1000]"
+                    given, _ = self.ev(_parse_literal(given))
+                value = self.types.coerce(given, type_)
+            except TypeErrorRapid as err:
+                raise RapidError(f"{pos}: the scenario's {name}: {err}; give a {type_}") from None
+            said = "the scenario's value"
+        else:
+            value, taint, said = self._stand_in_value(name, role, pos)
+        storage = "CONST" if role in ("tooldata", "wobjdata", "speeddata", "zonedata", "loaddata") else "VAR"
+        type_ = UNTYPED if role == "value" and key not in self.given else role
+        cell = Cell(name, type_, storage, value, taint, pos)
+        self.cells[("", key)] = cell
+        self.assumed.append(standins.Assumption(name, role, said, pos))
+        return cell
+
+    def _stand_in_value(self, name: str, role: str, pos: n.Pos) -> tuple[Value, Taint, str]:
+        pre = self.predefined
+        if role == "tooldata":
+            payload = self.rated_payload_kg
+            mass = 0.0 if payload is None else round(standins.LOAD_FRACTION * payload, 3)
+            cog = standins.LOAD_COG_MM if mass > 0 else 0.0
+            value = self.types.coerce(
+                (
+                    True,
+                    ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)),
+                    (mass, (0.0, 0.0, cog), (1.0, 0.0, 0.0, 0.0), 0.0, 0.0, 0.0),
+                ),
+                "tooldata",
+            )
+            load = (
+                f"a load of {mass:g} kg ({100 * standins.LOAD_FRACTION:.0f} % of the rated payload) "
+                f"{cog:g} mm out along tool0's z"
+                if mass > 0
+                else "no load (the robot's rated payload is not known)"
+            )
+            return value, CLEAN, f"tool0's frame and {load}; give [tool.{name}] in the scenario file"
+        if role == "wobjdata":
+            return (
+                pre["wobj0"].value,
+                CLEAN,
+                f"wobj0 (the robot's base frame); give [wobj.{name}] in the scenario file",
+            )
+        if role == "speeddata":
+            return pre["v1000"].value, CLEAN, f"v1000; give {name} in the scenario file's [data]"
+        if role == "zonedata":
+            return pre["fine"].value, CLEAN, f"fine (a stop point); give {name} in the scenario file's [data]"
+        if role == "loaddata":
+            return pre["load0"].value, CLEAN, f"load0 (no load); give {name} in the scenario file's [data]"
+        if role in standins.TARGET_TYPES:
+            why = frozenset({f"{pos}: {name} is declared nowhere in what was given: {UNKNOWN_TARGET}"})
+            said = (
+                f"{UNKNOWN_TARGET}: the moves to and from it are kept as taught; give it in the scenario's "
+                "[targets]"
+            )
+            return self.types.default(role), why, said
+        why = frozenset({f"{pos}: {name} is declared nowhere in what was given: known only at run time"})
+        return 0.0, why, "a value known only at run time (0 taken, and what it decides is marked)"
 
     def routine(self, name: str, pos: n.Pos) -> tuple[n.Routine, n.Module] | None:
         key = name.lower()
@@ -718,6 +804,12 @@ class Interpreter:
             value = Array(type_, dims, tuple(self.types.default(type_) for _ in range(size)))
         else:
             value = self.types.default(type_)
+            if type_ in standins.TARGET_TYPES and decl.storage == "VAR":  # known once the program sets it
+                given = self.given.get(decl.name.lower())
+                if given is not None:
+                    value = self.types.coerce(given, type_)
+                else:
+                    taint = frozenset({f"{decl.pos}: {decl.name} is declared without a value"})
         return Cell(decl.name, type_, decl.storage, value, taint, decl.pos)
 
     # ---- expressions
@@ -961,11 +1053,29 @@ class Interpreter:
                 ok = True
             except (RapidError, TypeErrorRapid):
                 ok = False
+        if t and not r.path and self._give(r):  # the scenario gives what the string brings
+            return True, CLEAN
         if ok:
             r.set(value, t | self.ctx_taint)
         elif t:
             r.set(cur, r.cell.taint | t)
         return ok, t
+
+    def _give(self, r: _Ref) -> bool:
+        """Set a datum the outside world writes to the scenario's value for it, where it gives one."""
+        given = self.given.get(r.cell.name.lower())
+        if given is None:
+            return False
+        cur = r.get()
+        try:
+            if isinstance(given, str) and not isinstance(cur, str):
+                given, _ = self.ev(_parse_literal(given))
+            value = self.types.coerce(given, cur.type) if isinstance(cur, Record) else given
+        except (RapidError, TypeErrorRapid) as err:
+            raise RapidError(f"the scenario's {r.cell.name}: {err}; give a value of its type") from None
+        self.io_used.add(r.cell.name.lower())
+        r.set(value, CLEAN)
+        return True
 
     def builtin(self, key: str, e: n.FuncCall, a: list[Value], opt: dict[str, Value]) -> tuple[Value, Taint]:
         pos = e.pos
@@ -1030,10 +1140,21 @@ class Interpreter:
             return KNOWN_FUNCTIONS_UNKNOWN_RESULT[key], frozenset({why})
         if key in _STRING_FUNCS:
             return _STRING_FUNCS[key](a, opt), CLEAN
-        raise RapidError(
-            f"{pos}: the function {e.name} is declared nowhere in what was given ({self.task.source}) and "
-            "is not a RAPID built-in joulepath knows; pass the module that declares it"
+        role = self.roles.get(key, "value")
+        if key not in self._assumed_routines:
+            self._assumed_routines.add(key)
+            said = (
+                f"{UNKNOWN_TARGET} (its value is known only at run time)"
+                if role in standins.TARGET_TYPES
+                else "a value known only at run time (0 taken, and what it decides is marked)"
+            )
+            self.assumed.append(standins.Assumption(e.name, "function", said, pos))
+        reason = f"{pos}: the function {e.name} is declared nowhere in what was given: " + (
+            UNKNOWN_TARGET if role in standins.TARGET_TYPES else "known only at run time"
         )
+        if role in standins.TARGET_TYPES:
+            return self.types.default(role), frozenset({reason})
+        return 0.0, frozenset({reason})
 
     def kinematic_function(
         self, key: str, e: n.FuncCall, a: list[Value], opt: dict[str, Value]
@@ -1090,26 +1211,57 @@ class Interpreter:
         ext = self.types.coerce((9e9,) * 6, "extjoint")
         return rt.replace("extax", ext)
 
-    def solve(self, rt: Record, tool: Record, wobj: Record, pos: n.Pos, what: str) -> FloatArray:
-        """Joint values (rad) of a robtarget in ``wobj`` with ``tool``; refused if out of reach."""
+    def solve(
+        self, rt: Record, tool: Record, wobj: Record, pos: n.Pos, what: str, *, linear: bool = False
+    ) -> FloatArray:
+        """Joint values (rad) of a robtarget in ``wobj`` with ``tool``, as the controller reaches it.
+
+        A joint move with ``ConfJ \\On`` goes to the target's confdata; where no solution matches it
+        exactly, the solution nearest the arm whose quadrants of axes 1, 4 and 6 lie within one of the
+        programmed ones and whose ``cfx`` is the programmed one is taken, with a warning (the
+        controller's configuration monitoring allows a quadrant's change); else the controller stops,
+        and so is the program refused. A linear or circular move's configuration follows its path
+        from where the arm is (``ConfL`` only monitors it): the solution nearest the arm, with a
+        warning where its confdata is not the programmed one. Out of reach: refused, saying how far
+        the target lies beyond the robot's reach (a program for a larger arm).
+        """
         assert self.kin is not None
         flange = target_flange(rt, tool, wobj, self.pdisp)
-        conf = _conf(rt) if self.settings.conf_j else None
+        conf = _conf(rt) if (self.settings.conf_l if linear else self.settings.conf_j) else None
         q = self.kin.joints(flange, conf, self.current_q)
-        if q is None and conf is not None:
-            anyq = self.kin.joints(flange, None, self.current_q)
-            if anyq is not None:
-                raise RapidError(
-                    f"{pos}: {what}: no joint solution matches the target's confdata {list(conf)}; the "
-                    f"reachable one is {list(self.kin.confdata(anyq))}: correct the confdata"
-                )
         if q is None:
-            where = [round(float(v), 1) for v in (geo.pose_matrix(rt)[:3, 3] * 1000.0)]
-            raise RapidError(
-                f"{pos}: {what}: the target at {where} mm (in its work object) is out of the robot's reach "
-                "with this orientation and tool; move the target"
-            )
+            q = self.kin.joints(flange, None, self.current_q)
+            if q is not None and conf is not None:
+                got = self.kin.confdata(q)
+                if not linear and (got[3] != conf[3] or any(abs(got[k] - conf[k]) > 1 for k in range(3))):
+                    raise RapidError(
+                        f"{pos}: {what}: no joint solution matches the target's confdata {list(conf)} (the "
+                        f"reachable one nearest the arm is {list(got)}); the controller stops here with "
+                        "ConfJ \\On: correct the confdata, or ConfJ \\Off"
+                    )
+                if got != conf:
+                    self.note(
+                        f"{pos}: {what}: its confdata {list(conf)} matches no joint solution exactly; "
+                        f"moved as the controller moves it, to {list(got)} (the solution nearest the arm)"
+                    )
+        if q is None:
+            raise RapidError(f"{pos}: {what}: {self._beyond_reach(rt, flange)}")
         return q
+
+    def _beyond_reach(self, rt: Record, flange: FloatArray) -> str:
+        where = [round(float(v), 1) for v in (geo.pose_matrix(rt)[:3, 3] * 1000.0)]
+        reach = self.kin.reach_m() if self.kin is not None else None
+        far = float(np.linalg.norm(flange[:3, 3]))
+        if reach is not None and far > reach:
+            return (
+                f"the target at {where} mm (in its work object) puts the flange {1000 * far:.0f} mm from the "
+                f"robot's base, {1000 * (far - reach):.0f} mm beyond its reach of {1000 * reach:.0f} mm: the "
+                "program is probably for a larger arm; give it with --robot (or move the target)"
+            )
+        return (
+            f"the target at {where} mm (in its work object) is out of the robot's reach with this "
+            "orientation and tool; move the target (or give the robot it was taught on with --robot)"
+        )
 
     # ---- routines
     def invoke(self, r: n.Routine, m: n.Module, args: tuple[n.Arg, ...], pos: n.Pos) -> tuple[Value, Taint]:
@@ -1220,7 +1372,9 @@ class Interpreter:
                 raise RapidError(f"{s.pos}: {cell.name} is a {cell.storage}; it cannot be assigned")
             try:
                 cur = r.get()
-                if isinstance(cur, Array):
+                if cell.type == UNTYPED and not r.path:  # a value declared nowhere: typed by what it gets
+                    pass
+                elif isinstance(cur, Array):
                     value = self.types.array(value, cur.type, cur.dims)
                 elif isinstance(cur, Record):
                     value = self.types.coerce(value, cur.type)
@@ -1474,6 +1628,12 @@ class Interpreter:
             raise RapidError(
                 f"{s.pos}: late binding needs a string (the procedure's name), not {describe(v)}"
             )
+        if t and self.routine(v, s.pos) is None:  # the name arrives at run time: which routine is unknown
+            why = f"{s.pos}: the procedure called here is chosen at run time ({'; '.join(sorted(t))})"
+            self.note(f"{why}: not run; the move after it starts from where that leaves the arm")
+            self.after_branch = self.after_branch | frozenset({why})
+            self.events.append(Action(s, "%late call%", self._context()))
+            return
         if t and not self.ctx_taint:
             self.note(f"{s.pos}: the procedure {v!r} is chosen at run time: {'; '.join(sorted(t))}")
         call = n.Call(s.pos, v, s.args)
@@ -1505,10 +1665,17 @@ class Interpreter:
         if key in KNOWN_INSTRUCTIONS or key in INPUT_WRITERS:
             self.instruction(s, key)
             return
-        raise RapidError(
-            f"{s.pos}: the procedure {s.name} is declared nowhere in what was given ({self.task.source}) and "
-            "is not a RAPID instruction joulepath knows; pass the module that declares it"
-        )
+        if not s.name.strip():
+            raise RapidError(f"{s.pos}: a call with no procedure name; give the procedure's name")
+        if key not in self._assumed_routines:
+            self._assumed_routines.add(key)
+            said = (
+                "a call that does not move the arm and takes no time (an option's instruction or a routine "
+                "of a module not given)"
+            )
+            self.assumed.append(standins.Assumption(s.name, "routine", said, s.pos))
+        self.write_inputs(s, key)
+        self.events.append(Action(s, s.name, self._context()))
 
     def instruction(self, s: n.Call, key: str) -> None:
         ctx = self._context()
@@ -1587,6 +1754,8 @@ class Interpreter:
                 if r.cell.storage in ("CONST", "IO"):
                     continue
                 key_name = r.cell.name.lower()
+                if not r.path and self._give(r):
+                    continue
                 if key_name in self.io:  # the scenario gives the value
                     v = self.io[key_name]
                     self.io_used.add(key_name)
@@ -1802,7 +1971,19 @@ class Interpreter:
         if conc:
             kept.add(f"{s.pos}: \\Conc: the instructions after it run while it moves")
         joints = circle_joints = None
-        if self.kin is not None:
+        unknown = self._unknown_target(targets, tool, wobj, s, kind)
+        if unknown is not None:
+            kept.add(unknown)
+            joints = self._where_the_arm_is()
+            if joints is not None:
+                circle_joints = joints if circle is not None else None
+                target = (
+                    _jointtarget(self.types, joints)
+                    if kind == "absjoint"
+                    else self._robtarget_at(joints, tool, wobj)
+                )
+                circle = target if circle is not None else None
+        elif self.kin is not None:
             if kind == "absjoint":
                 joints = np.radians(_robax(target))
                 bad = self.kin.in_range(joints)
@@ -1812,9 +1993,12 @@ class Interpreter:
                         "outside its range; correct the jointtarget"
                     )
             else:
-                joints = self.solve(target, tool, wobj, s.pos, f"{s.name} {target_text}")
+                linear = kind in ("linear", "circular")
+                joints = self.solve(target, tool, wobj, s.pos, f"{s.name} {target_text}", linear=linear)
                 if circle is not None:
-                    circle_joints = self.solve(circle, tool, wobj, s.pos, f"{s.name} circle point")
+                    circle_joints = self.solve(
+                        circle, tool, wobj, s.pos, f"{s.name} circle point", linear=True
+                    )
         m = Motion(
             instruction=s.name,
             kind=kind,
@@ -1842,8 +2026,42 @@ class Interpreter:
         if joints is not None:
             self.current_q = joints
         self.current_taint = target_t | self.ctx_taint | wobj_t | tool_t
+        if unknown is not None:
+            self.current_taint = self.current_taint | frozenset({unknown})
         if self.progress is not None and len(self.events) % 50 == 0:
             self.progress(f"reading the program: {self._moves()} moves")
+
+    def _where_the_arm_is(self) -> FloatArray | None:
+        """The arm's joints now: the last move's end, else every joint at 0 (the calibration position)."""
+        if self.kin is None:
+            return None
+        if self.current_q is not None:
+            return self.current_q.copy()
+        q = np.zeros(RAPID_AXES)
+        return q if self.kin.in_range(q) is None else None
+
+    def _unknown_target(
+        self, targets: list[tuple[Record, Taint, str]], tool: Record, wobj: Record, s: n.Call, kind: str
+    ) -> str | None:
+        """Why the move's target is unknown (None: it is known): declared nowhere, or known only at run
+        time and its stand-in out of reach. Such a move is placed where the arm is and kept as taught."""
+        for _rec, t, _text in targets:
+            marked = next((w for w in sorted(t) if UNKNOWN_TARGET in w), None)
+            if marked is not None:
+                return f"{marked}; the move to it and the one after it are kept as taught"
+        if self.kin is None or kind == "absjoint":
+            return None
+        for rec, t, text in targets:
+            if not t or rec.type != "robtarget":
+                continue
+            try:
+                self.solve(rec, tool, wobj, s.pos, f"{s.name} {text}")
+            except (RapidError, ValueError):  # out of reach, or no orientation at all
+                return (
+                    f"{s.pos}: {text} is {UNKNOWN_TARGET}: its value comes at run time "
+                    f"({'; '.join(sorted(t))}); the move to it and the one after it are kept as taught"
+                )
+        return None
 
     # ---- the run
     def run(self, routine: str | None = None) -> Trace:
@@ -1897,7 +2115,14 @@ class Interpreter:
             sys.setrecursionlimit(limit)
         end = self.cycle_end if self.cycle_end is not None else len(self.events)
         return Trace(
-            tuple(self.events), self.cycle_start, end, tuple(self.notes), r.name, self.loop, self.steps
+            tuple(self.events),
+            self.cycle_start,
+            end,
+            tuple(self.notes),
+            r.name,
+            self.loop,
+            self.steps,
+            tuple(self.assumed),
         )
 
 

@@ -15,8 +15,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from joulepath._io import read_capped
+from joulepath.errors import RapidError
 from joulepath.rapid import nodes as n
-from joulepath.rapid._parse import MAX_BYTES, RapidError, decode, read_module_file
+from joulepath.rapid._parse import MAX_BYTES, decode, read_module_file
 
 MODULE_SUFFIXES = (".mod", ".modx", ".sys", ".sysx", ".prg")
 """File suffixes read as RAPID modules."""

@@ -14,8 +14,8 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from joulepath.errors import RapidError
 from joulepath.rapid import nodes as n
-from joulepath.rapid._parse import RapidError
 from joulepath.rapid.task import Task
 
 
