@@ -25,6 +25,7 @@ from joulepath.errors import InvalidInput, RapidError
 from joulepath.kinematics import check_layout, confdata, solve_ik
 from joulepath.rapid import _geometry as geo
 from joulepath.rapid.interpreter import UNKNOWN_TARGET, Action, Interpreter, Motion, Trace, Wait
+from joulepath.rapid.interpreter import moves_in as _moves
 from joulepath.rapid.task import Task, load_task
 from joulepath.rapid.values import Record, num, pos_values
 from joulepath.sim import SpeedData, Step
@@ -227,7 +228,22 @@ def read_task_cycle(
                 (r for m in task.modules for r in m.routines if r.name.lower() == trace.routine.lower()), None
             )
             where = str(found.pos) if found is not None else task.source
-        raise RapidError(f"{where}: the cycle ({trace.routine}) holds no move; nothing to optimize")
+        movers = sorted(
+            {
+                r.name
+                for m in task.modules
+                for r in m.routines
+                if r.kind == "PROC" and _moves(r) and not r.params
+            }
+            - {trace.routine}
+        )
+        hint = (
+            f"; give --routine NAME, one of the routines that move the robot: {', '.join(movers[:8])}"
+            + (f" (and {len(movers) - 8} more)" if len(movers) > 8 else "")
+            if movers
+            else "; nothing to optimize"
+        )
+        raise RapidError(f"{where}: the cycle ({trace.routine}) holds no move{hint}")
     check_work(
         "moves",
         len(moves),

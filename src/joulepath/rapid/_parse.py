@@ -279,6 +279,20 @@ class _Builder(lark.Transformer[Any, Any]):
         return n.Arg(self._pos(meta), "opt", str(c[1]), c[2] if len(c) > 2 else None)
 
     @lark.v_args(meta=True)
+    def conditional(self, meta: Any, c: list[Any]) -> n.Arg:
+        """``\\Arg?Par``: the optional argument passed only where the caller's ``Par`` is present."""
+        pos = self._pos(meta)
+        return n.Arg(pos, "cond", str(c[1]), n.Name(pos, str(c[2])))
+
+    @lark.v_args(meta=True)
+    def placeholder(self, meta: Any, c: list[Any]) -> n.Placeholder:
+        return n.Placeholder(self._pos(meta), str(c[0]))
+
+    @lark.v_args(meta=True)
+    def placeholder_stmt(self, meta: Any, c: list[Any]) -> n.Placeholder:
+        return n.Placeholder(self._pos(meta), str(c[0]))
+
+    @lark.v_args(meta=True)
     def named(self, meta: Any, c: list[Any]) -> n.Arg:
         return n.Arg(self._pos(meta), "named", str(c[0]), c[1])
 
@@ -503,7 +517,9 @@ class _Builder(lark.Transformer[Any, Any]):
 
     @lark.v_args(meta=True)
     def record_def(self, meta: Any, c: list[Any]) -> n.RecordDef:
-        return n.RecordDef(self._pos(meta), str(c[0]), tuple(c[1:]))
+        fields = tuple(x for x in c if isinstance(x, tuple))
+        name = [x for x in c if not isinstance(x, tuple)][-1]  # after its scope, where it has one
+        return n.RecordDef(self._pos(meta), str(name), fields)
 
     @lark.v_args(meta=True)
     def alias_decl(self, meta: Any, c: list[Any]) -> n.Alias:

@@ -73,6 +73,8 @@ MAX_DEPTH = 32
 """Deepest routine call (recursion) one run may take."""
 MAX_LOOP_TURNS = 200_000
 """Turns one loop may take."""
+SPIN_TURNS = 1000
+"""Turns of a loop that moves nothing, on data set outside the task, before it is taken to end."""
 UNTYPED = "(declared nowhere)"
 """The type of a value declared nowhere whose role nothing fixes: it takes what it is assigned."""
 UNKNOWN_TARGET = "an unknown target"
@@ -595,9 +597,12 @@ class Interpreter:
                 if isinstance(v, n.Name):
                     out.add(v.name.lower())
             if isinstance(s, n.Call) and s.name.lower() in ("movejdo", "moveldo", "movecdo"):
-                for a in s.args:
-                    if isinstance(a.value, n.Name) and a.value.name.lower() not in self.globals:
-                        out.add(a.value.name.lower())
+                # MoveLDO ToPoint, Speed, Zone, Tool, Signal, Value (MoveCDO: CirPoint first)
+                positional = [a for a in s.args if a.kind == "pos"]
+                k = 5 if s.name.lower() == "movecdo" else 4
+                v = positional[k].value if len(positional) > k else None
+                if isinstance(v, n.Name) and v.name.lower() not in self.globals:
+                    out.add(v.name.lower())
         for m in self.task.modules:
             for node in _expressions(m):
                 first = (
@@ -813,7 +818,29 @@ class Interpreter:
         return Cell(decl.name, type_, decl.storage, value, taint, decl.pos)
 
     # ---- expressions
+    def _unfinished(self, p: n.Placeholder) -> RapidError:
+        return RapidError(
+            f"{p.pos}: {p.text} is a placeholder of unfinished code, and the cycle runs it; write it "
+            "(or give --routine NAME to run another routine)"
+        )
+
+    def _conditionals(self, args: tuple[n.Arg, ...]) -> tuple[n.Arg, ...]:
+        """``\\Arg?Par`` resolved: passed as ``\\Arg:=Par`` where the caller's optional ``Par`` is
+        present, else left out (RAPID's conditional argument)."""
+        if not any(a.kind == "cond" for a in args):
+            return args
+        present = self.stack[-1].present if self.stack else set()
+        out = []
+        for a in args:
+            if a.kind != "cond":
+                out.append(a)
+            elif isinstance(a.value, n.Name) and a.value.name.lower() in present:
+                out.append(n.Arg(a.pos, "opt", a.name, a.value))
+        return tuple(out)
+
     def ev(self, e: n.Expr) -> tuple[Value, Taint]:
+        if isinstance(e, n.Placeholder):
+            raise self._unfinished(e)
         if isinstance(e, n.Num):
             return e.value, CLEAN
         if isinstance(e, n.Str):
@@ -977,6 +1004,7 @@ class Interpreter:
         return pos, opt
 
     def call_function(self, e: n.FuncCall) -> tuple[Value, Taint]:
+        e = replace(e, args=self._conditionals(e.args))
         found = self.routine(e.name, e.pos)
         if found is not None:
             r, m = found
@@ -1360,7 +1388,19 @@ class Interpreter:
             k += 1
 
     def exec(self, s: n.Stmt) -> None:
+        """Run one statement; an error of a value's type or geometry is refused in one line there."""
+        try:
+            self._exec(s)
+        except RapidError:
+            raise
+        except (ValueError, TypeErrorRapid, ZeroDivisionError, IndexError, OverflowError) as err:
+            text = " ".join(str(err).split())[:160]
+            raise RapidError(f"{s.pos}: {text}; correct the statement") from None
+
+    def _exec(self, s: n.Stmt) -> None:
         self._tick(s.pos)
+        if isinstance(s, n.Placeholder):
+            raise self._unfinished(s)
         if isinstance(s, n.Call):
             self.call(s)
         elif isinstance(s, n.Assign):
@@ -1385,7 +1425,11 @@ class Interpreter:
                 elif isinstance(cur, str):
                     value = self.types.coerce(value, "string")
             except TypeErrorRapid as err:
-                raise RapidError(f"{s.pos}: {err}; correct the assignment") from None
+                if not taint:
+                    raise RapidError(f"{s.pos}: {err}; correct the assignment") from None
+                # a stand-in of run-time data that cannot take the datum's type: it keeps its value, marked
+                value = cur
+                self.note(f"{s.pos}: {' '.join(sorted(taint))[:120]}: its stand-in does not fit; value kept")
             r.set(value, taint | self.ctx_taint | self._index_taint(s.target))
             self.events.append(Action(s, _lvalue_text(s.target), self._context()))
         elif isinstance(s, n.If):
@@ -1475,6 +1519,26 @@ class Interpreter:
                     return True
         return False
 
+    def _shared(self, e: object) -> Taint:
+        """Why a condition may turn at run time though the task decides none of it: the ``PERS``
+        ``bool``, ``num`` and ``string`` data it reads that this task never sets (another task, a PLC
+        through a PC interface or the HMI sets them). Empty where it reads none."""
+        out: set[str] = set()
+        for node in _expressions(e):
+            if not isinstance(node, n.Name):
+                continue
+            key = node.name.lower()
+            found = self.globals.get(key)
+            if found is None or key in self.assigned:
+                continue
+            decl = found[0]
+            if decl.storage == "PERS" and self.types.resolve(decl.type) in ("bool", "num", "dnum", "string"):
+                out.add(
+                    f"{decl.pos}: {decl.name} is PERS data this task never sets (another task or the HMI "
+                    "sets it)"
+                )
+        return frozenset(out)
+
     def exec_if(self, s: n.If) -> None:
         taint: Taint = CLEAN
         chosen: tuple[n.Stmt, ...] = s.orelse
@@ -1485,6 +1549,8 @@ class Interpreter:
             if v:
                 chosen, label = body, "THEN" if k == 0 else f"ELSEIF at line {cond.pos.line}"
                 break
+        if not taint and not self._has_motion(chosen, 0) and self._has_motion((s,), 0):
+            taint = frozenset().union(*(self._shared(c) for c, _ in s.branches))
         if taint and not self._has_motion(chosen, 0):
             # decided at run time: the stand-in's branch does not move; assume the first that does
             options = [
@@ -1520,6 +1586,8 @@ class Interpreter:
             else:
                 continue
             break
+        if not t and not self._has_motion(chosen, 0) and self._has_motion((s,), 0):
+            t = self._shared(s.expr)
         if t and not self._has_motion(chosen, 0):
             options = [(b, f"CASE at line {vs[0].pos.line}") for vs, b in s.cases] + [
                 (s.default or (), "DEFAULT")
@@ -1600,8 +1668,17 @@ class Interpreter:
             self.exec_body(s.body)
             raise _Stop(f"{s.pos}: an endless loop inside the cycle")
         turns = 0
+        moving = self._has_motion(s.body, 0)
         while True:
             v, t = self._condition(s.cond)
+            if v and not t and not moving and turns >= SPIN_TURNS:
+                shared = self._shared(s.cond)
+                if shared:  # it spins, moving nothing, until another task or the HMI sets its data
+                    self.note(
+                        f"{s.pos}: WHILE waits on data set outside this task ({'; '.join(sorted(shared))}): "
+                        f"assumed to end after {turns} turns"
+                    )
+                    return
             if not v and t and turns == 0 and self._has_motion(s.body, 0):
                 v = True  # decided at run time and the stand-in skips it: assume one turn that moves
             if not v:
@@ -1641,6 +1718,7 @@ class Interpreter:
 
     # ---- instructions
     def call(self, s: n.Call) -> None:
+        s = replace(s, args=self._conditionals(s.args))
         key = s.name.lower()
         found = self.routine(s.name, s.pos)
         if found is not None:
@@ -1830,16 +1908,17 @@ class Interpreter:
         elif key == "singarea":
             mode = next((k for k in ("wrist", "lockaxis4", "off") if k in opt), "off")
             st = replace(st, sing_area=mode.capitalize())
-        elif key == "pathacclim":
-            st = replace(
-                st,
-                path_acc_lim=(
-                    float(num(opt["accmax"])) if "accmax" in opt else None,
-                    float(num(opt["decelmax"])) if "decelmax" in opt else None,
-                ),
-            )
+        elif key == "pathacclim":  # PathAccLim AccLim [\AccMax], DecelLim [\DecelMax]: each on when TRUE
+            lims = [v is True for v in vals[:2]] + [False, False]
+            acc_max = self._num(opt["accmax"][0], s.pos) if lims[0] and "accmax" in opt else None
+            dec_max = self._num(opt["decelmax"][0], s.pos) if lims[1] and "decelmax" in opt else None
+            for what, lim in (("AccMax", acc_max), ("DecelMax", dec_max)):
+                if lim is not None and not lim > 0:
+                    raise RapidError(f"{s.pos}: PathAccLim \\{what}:={lim:g}: give a positive m/s²")
+            st = replace(st, path_acc_lim=(acc_max, dec_max))
         elif key == "worldacclim":
-            st = replace(st, world_acc_lim=float(num(opt["acc"])) if "acc" in opt else None)
+            world = self._num(opt["acc"][0], s.pos) if "acc" in opt else None
+            st = replace(st, world_acc_lim=world if world is not None and world > 0 else None)
         self.settings = st
         self.events.append(Action(s, s.name, self._context()))
 
@@ -2071,7 +2150,7 @@ class Interpreter:
             for m in self.task.modules:
                 found = self.local_routines[m.name.lower()].get(name.lower()) or found
         if found is None:
-            movers = sorted({r.name for r, _ in self.routines.values() if r.kind == "PROC" and _moves_in(r)})
+            movers = sorted({r.name for r, _ in self.routines.values() if r.kind == "PROC" and moves_in(r)})
             where = f"{self.task.modules[0].path}:{self.task.modules[0].pos.line}"
             if routine is None:
                 raise RapidError(
@@ -2275,7 +2354,7 @@ def _lvalue_text(e: n.Expr) -> str:
     return "(assignment)"
 
 
-def _moves_in(r: n.Routine) -> bool:
+def moves_in(r: n.Routine) -> bool:
     motion = set(JOINT_MOTIONS) | set(LINEAR_MOTIONS) | set(CIRCULAR_MOTIONS) | set(ABSJ_MOTIONS)
 
     def walk(body: tuple[n.Stmt, ...]) -> bool:
@@ -2295,7 +2374,7 @@ def _moves_in(r: n.Routine) -> bool:
     return walk(r.body)
 
 
-def _expressions(m: n.Module) -> Iterator[object]:
+def _expressions(m: object) -> Iterator[object]:
     """Every node of a module (depth first), for scans by kind."""
     stack: list[object] = [m]
     while stack:

@@ -119,7 +119,16 @@ class Neg:
     a: Expr
 
 
-Expr = Num | Str | Bool | Aggregate | Name | Index | Field | FuncCall | BinOp | Not | Neg
+@dataclass(frozen=True, slots=True)
+class Placeholder:
+    """RobotStudio's placeholder of unfinished code (``<SMT>``, ``<EXP>`` ...): a statement or an
+    expression that is read, and refused only where the program runs it."""
+
+    pos: Pos
+    text: str
+
+
+Expr = Num | Str | Bool | Aggregate | Name | Index | Field | FuncCall | BinOp | Not | Neg | Placeholder
 
 
 # ------------------------------------------------------------------ statements
@@ -253,7 +262,8 @@ class Empty:
 
 
 Stmt = (
-    DataDecl
+    Placeholder
+    | DataDecl
     | Assign
     | Call
     | LateCall
