@@ -850,8 +850,9 @@ def _source_text(spec: CycleSpec) -> tuple[str, str]:
             "the levers"
         )
     raw = p.read_bytes()
-    try:
-        return raw.decode("utf-8"), "utf-8"
+    try:  # a byte-order mark (as Windows editors save) is read, and written back, as it was
+        encoding = "utf-8-sig" if raw.startswith(b"\xef\xbb\xbf") else "utf-8"
+        return raw.decode(encoding), encoding
     except UnicodeDecodeError:
         return raw.decode("latin-1"), "latin-1"
 

@@ -106,7 +106,7 @@ def _syntax_message(err: lark.exceptions.UnexpectedInput, text: str, path: str) 
             )
         expected = sorted(e.lstrip("_") for e in err.expected)[:6]
         return (
-            f"{path}:{line}: syntax error at {str(tok)!r}: RAPID expects {', '.join(expected)} here; "
+            f"{path}:{line}: syntax error at {quoted(str(tok))!r}: RAPID expects {', '.join(expected)} here; "
             "correct the statement"
         )
     if isinstance(err, lark.exceptions.UnexpectedCharacters):
@@ -173,10 +173,18 @@ def _check_nesting(text: str, path: str) -> None:
                 blocks = max(0, blocks - 1)
 
 
+def quoted(text: str, most: int = 60) -> str:
+    """``text`` as an error line quotes input: at most ``most`` characters, the rest counted."""
+    return text if len(text) <= most else f"{text[: most - 1]}… ({len(text)} characters)"
+
+
 def _number(text: str) -> float:
-    value = float(int(text, 16)) if text[:2].lower() == "0x" else float(text)
+    try:
+        value = float(int(text, 16)) if text[:2].lower() == "0x" else float(text)
+    except (ValueError, OverflowError):
+        value = math.inf
     if not math.isfinite(value):
-        raise RapidError(f"{text} is not a finite number")
+        raise RapidError(f"{quoted(text)} is not a finite number")
     return value
 
 

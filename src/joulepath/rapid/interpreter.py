@@ -1990,6 +1990,7 @@ class Interpreter:
             fine = self.predefined["fine"].value
             assert isinstance(fine, Record)
             zone = fine
+        self._check_motion_data(speed, zone, s)
         if kind == "circular" and len(targets) < 2:
             raise RapidError(f"{s.pos}: {s.name} needs a circle point and a target; correct the instruction")
         wobj = self.predefined["wobj0"].value
@@ -2109,6 +2110,18 @@ class Interpreter:
             self.current_taint = self.current_taint | frozenset({unknown})
         if self.progress is not None and len(self.events) % 50 == 0:
             self.progress(f"reading the program: {self._moves()} moves")
+
+    def _check_motion_data(self, speed: Record, zone: Record, s: n.Call) -> None:
+        """A move's speed data positive and its zone sizes not negative, as the controller checks them."""
+        for k, v in enumerate(speed.values[:2]):
+            if isinstance(v, float) and not v > 0:
+                what = ("v_tcp", "v_ori")[k]
+                raise RapidError(f"{s.pos}: {s.name}: its speed data's {what} is {v:g}; a speed is positive")
+        for name, v in zip(zone.names, zone.values, strict=True):
+            if isinstance(v, float) and v < 0:
+                raise RapidError(
+                    f"{s.pos}: {s.name}: its zone data's {name} is {v:g}; a zone's size is 0 or more"
+                )
 
     def _where_the_arm_is(self) -> FloatArray | None:
         """The arm's joints now: the last move's end, else every joint at 0 (the calibration position)."""
