@@ -171,8 +171,8 @@ INDEPENDENT_ROWS: tuple[Row, ...] = (
     ("IndAMove", r"MecUnit:mecunit Axis:num [\ToAbsPos:robtarget|\ToAbsNum:num] Speed:num [\Ramp:num]", "move independent"),
     ("IndCMove", r"MecUnit:mecunit Axis:num Speed:num [\Ramp:num]", "move independent"),
     ("IndDMove", r"MecUnit:mecunit Axis:num Delta:num Speed:num [\Ramp:num]", "move independent"),
-    ("IndRMove", r"MecUnit:mecunit Axis:num [\ToRelPos:robtarget|\ToRelNum:num|\Short|\Fwd|\Bwd] Speed:num [\Ramp:num]", "move independent"),
-    ("IndReset", r"MecUnit:mecunit Axis:num [\RefPos:robtarget|\RefNum:num|\Short|\Fwd|\Bwd|\Old]", "setting"),
+    ("IndRMove", r"MecUnit:mecunit Axis:num [\ToRelPos:robtarget|\ToRelNum:num] [\Short|\Fwd|\Bwd] Speed:num [\Ramp:num]", "move independent"),
+    ("IndReset", r"MecUnit:mecunit Axis:num [\RefPos:robtarget|\RefNum:num] [\Short|\Fwd|\Bwd|\Old]", "setting"),
 )  # fmt: skip
 
 INDEPENDENT_FUNCTIONS: tuple[Row, ...] = (

@@ -28,9 +28,8 @@ Examples
 >>> b = lookup("movel")
 >>> b.name, b.kind.value, b.effect.value, b.motion.kind.value if b.motion else None
 ('MoveL', 'instruction', 'move', 'linear')
->>> sorted(match_arguments(b, [(None, "p10"), (None, "v500"), (None, "z10"), (None, "tool1"),
-...                            ("WObj", "wobj1")]).items())
-[('Speed', 'v500'), ('Tool', 'tool1'), ('ToPoint', 'p10'), ('WObj', 'wobj1'), ('Zone', 'z10')]
+>>> match_arguments(b, [(None, "p10"), (None, "v500"), (None, "z10"), (None, "tool1"), ("WObj", "wobj1")])
+{'ToPoint': 'p10', 'Speed': 'v500', 'Zone': 'z10', 'Tool': 'tool1', 'WObj': 'wobj1'}
 >>> [c for c, _ in data_type("robtarget").components]
 ['trans', 'rot', 'robconf', 'extax']
 """
