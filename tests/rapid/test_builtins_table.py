@@ -586,6 +586,8 @@ def _calls(text: str) -> list[tuple[str, str]]:
     out = []
     for line in text.strip().splitlines():
         line = line.strip()
+        if not line:
+            continue
         m = re.fullmatch(r"([A-Za-z_]\w*)\s*(.*)", line)
         assert m, line
         out.append((m.group(1), m.group(2)))
@@ -605,7 +607,9 @@ def test_match_arguments_call_as_written(name, args):
 
 
 def test_calls_cover_most_of_the_table():
-    written = {n.lower() for n, _ in _calls(CALLS) + _calls(FUNCTION_CALLS)}
+    written = {
+        n.lower() for n, _ in _calls(CALLS + MORE_CALLS) + _calls(FUNCTION_CALLS + MORE_FUNCTION_CALLS)
+    }
     table = {b.name.lower() for b in bi.all_builtins()}
     assert written <= table
     assert len(written) / len(table) > 0.85, sorted(table - written)
@@ -915,3 +919,62 @@ def test_parse_signature_kinds_and_groups():
 def test_parse_signature_refuses_bad_text(bad):
     with pytest.raises(ValueError, match="signature"):
         parse_signature(bad)
+
+
+MORE_CALLS = r"""
+WaitDI di1, 1\Visualize\Header:="Waiting"\MsgArray:=["a", "b"]\Icon:=iconInfo;
+WaitUntil ready = TRUE\PollRate:=0.1\Visualize\Header:="Waiting"\Message:="Buffer full";
+SpeedLimAxis STN_1, 1, 10;
+SpeedLimCheckPoint 400;
+ReadCfgData "/MOC/MOTOR_CALIB/rob1_1", "cal_offset", offset1;
+WriteCfgData "/MOC/MOTOR_CALIB/rob1_1", "cal_offset", offset1;
+WZBoxDef \Inside, volume, corner1, corner2;
+WZCylDef \Outside, volume, centre, 100, 200;
+WZSphDef \Inside, volume, centre, 50;
+WZHomeJointDef \Inside, joint_space, home_pos, delta_pos;
+WZLimJointDef \Outside, joint_space, low_pos, high_pos;
+WZDOSet \Temp, service \Inside, volume, do_service, 1;
+WZDOSet \Stat, service \Before, volume, do_service, 0;
+WZLimSup \Stat, max_workarea, volume;
+WZEnable wz_temp;
+WZDisable wz_temp;
+WZFree wz_temp;
+EGMGetId egm_id;
+EGMReset egm_id;
+EGMSetupUC ROB_1, egm_id, "default", "UCdevice"\Joint;
+EGMSetupUC ROB_1, egm_id, "default", "UCdevice"\Pose\CommTimeout:=0.1;
+EGMActJoint egm_id\Tool:=tool0\WObj:=wobj0\J1:=limits\J2:=limits\LpFilter:=20\SampleRate:=4;
+EGMActPose egm_id\Tool:=tool1\WObj:=wobj1, corr_frame, EGM_FRAME_WOBJ, sens_frame, EGM_FRAME_WOBJ\x:=limits\y:=limits;
+EGMRunJoint egm_id, EGM_STOP_HOLD\J1\J2\J3\J4\J5\J6\CondTime:=20\RampInTime:=0.05;
+EGMRunPose egm_id, EGM_STOP_RAMP_DOWN\x\y\z\CondTime:=10\RampOutTime:=0.5;
+EGMStop egm_id, EGM_STOP_HOLD\RampOutTime:=0.5;
+EGMStreamStart egm_id\SampleRate:=4;
+EGMStreamStop egm_id;
+EGMMoveL egm_id, p20, v10, z5, tEGM\WObj:=wobj0;
+EGMMoveC egm_id, c1, p20, v10, z5, tEGM;
+ArcMoveAbsJ jStart, v800, z10, tWeldGun;
+ArcMoveExtJ jTrack, vrot20, fine;
+CSSAct CSS_XYZ\Stiffness:=50\AllowMove;
+CSSDeact;
+SetDataSearch "tooldata"\Object:="tool.*";
+SetDataSearch "robtarget"\PersSym\VarSym\InMod:="mymod";
+"""
+
+MORE_FUNCTION_CALLS = r"""
+MaxRobSpeed()
+GetMotorTorque(4)
+IsStopMoveAct(\FromMoveTask)
+GetSysInfo(\LanIp)
+EGMGetState(egm_id)
+"""
+
+
+@pytest.mark.parametrize(("name", "args"), _calls(MORE_CALLS) + _calls(MORE_FUNCTION_CALLS))
+def test_match_arguments_more_calls_as_written(name, args):
+    test_match_arguments_call_as_written(name, args)
+
+
+def test_egm_run_is_a_guided_move():
+    m = lookup("EGMRunPose").motion
+    assert m.kind is MotionKind.GUIDED and m.target is None
+    assert lookup("EGMMoveL").motion.kind is MotionKind.LINEAR

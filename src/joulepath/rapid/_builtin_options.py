@@ -22,7 +22,12 @@ CONVEYOR = "Conveyor Tracking"
 INDEPENDENT = "Independent Axes"
 PATH_OFFSET = "Path Offset"
 RMQ = "RAPID Message Queue"
+WORLDZONES = "World Zones"
+EGM = "Externally Guided Motion"
+CSS = "Cartesian Soft Servo"
 
+_SRC_EGM = "ABB, Application manual: Externally Guided Motion; its use in published programs"
+_SRC_CSS = "ABB, Application manual: Cartesian Soft Servo; its use in published programs"
 _SRC_MT = "ABB, Application manual: Multitasking; " + STD
 _SRC_SOCKET = "ABB, Application manual: Controller software IRC5 (Socket Messaging); " + STD
 _SRC_VISION = "ABB, Application manual: Integrated Vision; its use in published programs"
@@ -133,6 +138,8 @@ ARC_ROWS: tuple[Row, ...] = (
     ("ArcC", rf"[\On|\Off] CirPoint:robtarget ToPoint:robtarget [\ID:identno] Speed:speeddata [\T:num] Seam:seamdata Weld:welddata {_ARC_TAIL}", "move circular process"),
     ("ArcCStart", rf"CirPoint:robtarget ToPoint:robtarget [\ID:identno] Speed:speeddata [\T:num] Seam:seamdata Weld:welddata {_ARC_TAIL}", "move circular process"),
     ("ArcCEnd", rf"CirPoint:robtarget ToPoint:robtarget [\ID:identno] Speed:speeddata [\T:num] Seam:seamdata Weld:welddata {_ARC_TAIL}", "move circular process"),
+    ("ArcMoveAbsJ", r"[\Conc] ToJointPos:jointtarget [\ID:identno] [\NoEOffs] Speed:speeddata [\T:num] Zone:zonedata [\Inpos:stoppointdata] Tool:tooldata [\WObj:wobjdata] [\TLoad:loaddata]", "move absjoint"),
+    ("ArcMoveExtJ", r"ToJointPos:jointtarget Speed:speeddata Zone:zonedata", "move external"),
     ("ArcRefresh", r"", "none"),
     ("ArcKill", r"", "none"),
 )  # fmt: skip
@@ -180,6 +187,45 @@ INDEPENDENT_FUNCTIONS: tuple[Row, ...] = (
     ("IndSpeed", r"MecUnit:mecunit Axis:num <\InSpeed|\ZeroSpeed>", "bool runtime"),
 )  # fmt: skip
 
+_ZONE = r"[\Inside|\Outside] Shape:shapedata&"
+_WZ = r"<\Temp|\Stat> WorldZone:wztemporary/wzstationary&"
+WORLDZONE_ROWS: tuple[Row, ...] = (
+    ("WZBoxDef", rf"{_ZONE} LowPoint:pos HighPoint:pos", "none"),
+    ("WZCylDef", rf"{_ZONE} CentrePoint:pos Radius:num Height:num", "none"),
+    ("WZSphDef", rf"{_ZONE} CentrePoint:pos Radius:num", "none"),
+    ("WZHomeJointDef", rf"{_ZONE} MiddleJointVal:jointtarget DeltaJointVal:jointtarget", "none"),
+    ("WZLimJointDef", rf"{_ZONE} LowJointVal:jointtarget HighJointVal:jointtarget", "none"),
+    ("WZDOSet", rf"{_WZ} [\Inside|\Before] Shape:shapedata Signal:signaldo SetValue:dionum", "none"),
+    ("WZLimSup", rf"{_WZ} Shape:shapedata", "none"),
+    ("WZEnable", r"WorldZone:wztemporary&", "none"),
+    ("WZDisable", r"WorldZone:wztemporary&", "none"),
+    ("WZFree", r"WorldZone:wztemporary&", "none"),
+)  # fmt: skip
+
+EGM_ROWS: tuple[Row, ...] = (
+    ("EGMGetId", r"EGMid:egmident&", "none"),
+    ("EGMReset", r"EGMid:egmident&", "none"),
+    ("EGMSetupUC", r"MecUnit:mecunit EGMid:egmident& ExtConfig:string UCDevice:string <\Pose|\Joint|\PathCorr> [\CommTimeout:num]", "none"),
+    ("EGMActJoint", r"EGMid:egmident [\Tool:tooldata] [\WObj:wobjdata] [\TLoad:loaddata] [\J1:egm_minmax] [\J2:egm_minmax] [\J3:egm_minmax] [\J4:egm_minmax] [\J5:egm_minmax] [\J6:egm_minmax] [\J7:egm_minmax] [\LpFilter:num] [\SampleRate:num] [\MaxPosDeviation:num] [\MaxSpeedDeviation:num]", "setting"),
+    ("EGMActPose", r"EGMid:egmident [\StreamStart] [\Tool:tooldata] [\WObj:wobjdata] [\TLoad:loaddata] CorrFrame:pose CorrFrType:egmframetype SensorFrame:pose SensFrType:egmframetype [\x:egm_minmax] [\y:egm_minmax] [\z:egm_minmax] [\rx:egm_minmax] [\ry:egm_minmax] [\rz:egm_minmax] [\LpFilter:num] [\SampleRate:num] [\MaxPosDeviation:num] [\MaxSpeedDeviation:num]", "setting"),
+    ("EGMRunJoint", r"EGMid:egmident Mode:egmstopmode [\NoWaitCond] [\J1] [\J2] [\J3] [\J4] [\J5] [\J6] [\J7] [\CondTime:num] [\RampInTime:num] [\RampOutTime:num] [\PosCorrGain:num]", "move guided"),
+    ("EGMRunPose", r"EGMid:egmident Mode:egmstopmode [\NoWaitCond] [\x] [\y] [\z] [\rx] [\ry] [\rz] [\CondTime:num] [\RampInTime:num] [\RampOutTime:num] [\PosCorrGain:num]", "move guided"),
+    ("EGMStop", r"EGMid:egmident Mode:egmstopmode [\RampOutTime:num]", "none"),
+    ("EGMStreamStart", r"EGMid:egmident [\SampleRate:num]", "none"),
+    ("EGMStreamStop", r"EGMid:egmident", "none"),
+    ("EGMMoveL", r"EGMid:egmident ToPoint:robtarget Speed:speeddata Zone:zonedata Tool:tooldata [\WObj:wobjdata] [\TLoad:loaddata]", "move linear"),
+    ("EGMMoveC", r"EGMid:egmident CirPoint:robtarget ToPoint:robtarget Speed:speeddata Zone:zonedata Tool:tooldata [\WObj:wobjdata] [\TLoad:loaddata]", "move circular"),
+)  # fmt: skip
+
+EGM_FUNCTIONS: tuple[Row, ...] = (
+    ("EGMGetState", r"EGMid:egmident", "egmstate runtime"),
+)  # fmt: skip
+
+CSS_ROWS: tuple[Row, ...] = (
+    ("CSSAct", r"", "setting"),
+    ("CSSDeact", r"", "setting"),
+)  # fmt: skip
+
 OPTION_TYPES: tuple[tuple[str | None, str, tuple[Row, ...]], ...] = (
     (SOCKET, _SRC_SOCKET, (("socketdev", "atomic nonvalue"), ("socketstatus", "alias num"))),
     (RMQ, STD, (("rmqslot", "atomic nonvalue"), ("rmqmessage", "atomic nonvalue"), ("rmqheader", "record:", "partial"))),
@@ -189,6 +235,8 @@ OPTION_TYPES: tuple[tuple[str | None, str, tuple[Row, ...]], ...] = (
     )),
     (ARC, _SRC_ARC, (("seamdata", "record:", "partial"), ("welddata", "record:", "partial"), ("weavedata", "record:", "partial"), ("trackdata", "record:", "partial"))),
     (DISPENSE, _SRC_DISPENSE, (("beaddata", "record:", "partial"),)),
+    (WORLDZONES, STD, (("shapedata", "atomic nonvalue"), ("wztemporary", "record: wz num"), ("wzstationary", "record: wz num"))),
+    (EGM, _SRC_EGM, (("egmident", "atomic nonvalue"), ("egmstopmode", "alias num"), ("egmframetype", "alias num"), ("egmstate", "alias num"), ("egm_minmax", "record: min num, max num"))),
     (FORCE, _SRC_FORCE, (("fcforcevector", "record: xforce num, yforce num, zforce num, xtorque num, ytorque num, ztorque num"),)),
 )  # fmt: skip
 
@@ -207,6 +255,10 @@ BLOCKS: tuple[Block, ...] = (
     ("instruction partial", FORCE, _SRC_FORCE, FORCE_ROWS),
     ("function partial", FORCE, _SRC_FORCE, FORCE_FUNCTIONS),
     ("instruction", CONVEYOR, _SRC_CONVEYOR, CONVEYOR_ROWS),
+    ("instruction partial", WORLDZONES, STD, WORLDZONE_ROWS),
+    ("instruction partial", EGM, _SRC_EGM, EGM_ROWS),
+    ("function partial", EGM, _SRC_EGM, EGM_FUNCTIONS),
+    ("instruction partial", CSS, _SRC_CSS, CSS_ROWS),
     ("instruction", INDEPENDENT, STD, INDEPENDENT_ROWS),
     ("function", INDEPENDENT, STD, INDEPENDENT_FUNCTIONS),
     *(("type", option, source, rows) for option, source, rows in OPTION_TYPES),

@@ -57,6 +57,7 @@ __all__ = [
     "MotionKind",
     "Param",
     "ParamKind",
+    "ROBOT_MOTIONS",
     "all_builtins",
     "all_data_types",
     "data_type",
@@ -104,6 +105,8 @@ class MotionKind(StrEnum):
     """External axes only, no TCP (``MoveExtJ``)."""
     INDEPENDENT = "independent"
     """One axis in independent mode (``IndAMove``, ...)."""
+    GUIDED = "guided"
+    """Guided by an external sensor's stream (``EGMRunPose``): no target in the program."""
 
 
 ROBOT_MOTIONS = frozenset({MotionKind.JOINT, MotionKind.LINEAR, MotionKind.CIRCULAR, MotionKind.ABSJOINT})
