@@ -978,3 +978,36 @@ def test_egm_run_is_a_guided_move():
     m = lookup("EGMRunPose").motion
     assert m.kind is MotionKind.GUIDED and m.target is None
     assert lookup("EGMMoveL").motion.kind is MotionKind.LINEAR
+
+
+DNUM_AND_SYSTEM_CALLS = r"""
+TriggCheckIO checkgrip, 100, airok, EQ, 1\StopMove, gateclosed;
+PathResol 150;
+ActEventBuffer;
+DeactEventBuffer;
+ResetPPMoved;
+SpyStart "HOME:/spy.log";
+SpyStop;
+TryInt reg1;
+SqrtDnum(dval)
+PowDnum(dval, 2)
+ATan2Dnum(dy, dx)
+RoundDnum(dval\Dec:=2)
+BitAndDnum(d1, d2)
+BitLShDnum(d1, 3)
+BitCheckDnum(d1, 5)
+StrDigCalc(s1, OpAdd, s2)
+StrDigCmp(s1, LT, s2)
+RobName()
+TaskIsActive("T_ROB1")
+ExecHandler()
+ExecLevel()
+RemainingRetries()
+PPMovedInManMode()
+FileTime("HOME:/f.txt"\ModifyTime)
+"""
+
+
+@pytest.mark.parametrize(("name", "args"), _calls(DNUM_AND_SYSTEM_CALLS))
+def test_match_arguments_dnum_and_system_calls(name, args):
+    test_match_arguments_call_as_written(name, args)
