@@ -197,7 +197,7 @@ class Builtin:
     source: str = ""
     signature: str = ""
 
-    required_groups_ids: frozenset[int] = frozenset()
+    required_group_ids: frozenset[int] = frozenset()
     """The exclusive groups of which one member must be given (``<\\On|\\Off>``)."""
 
     def param(self, name: str) -> Param | None:
@@ -218,7 +218,7 @@ class Builtin:
     @property
     def required_groups(self) -> tuple[tuple[Param, ...], ...]:
         """Groups of which one member must be given (``<\\On|\\Off>``)."""
-        return tuple(g for k, g in enumerate(self.groups) if k in self.required_groups_ids)
+        return tuple(g for k, g in enumerate(self.groups) if k in self.required_group_ids)
 
     @property
     def writes(self) -> tuple[Param, ...]:
@@ -400,7 +400,7 @@ def _builtin(row: Sequence[str], kind: Kind, option: str | None, source: str, co
         complete=complete and (len(row) < 4 or row[3] != "partial"),
         source=source,
         signature=signature,
-        required_groups_ids=frozenset(_required_group_ids(signature)),
+        required_group_ids=frozenset(_required_group_ids(signature)),
     )
 
 
@@ -554,7 +554,7 @@ def match_arguments(builtin: Builtin, args: Iterable[tuple[str | None, V]]) -> d
             raise ArgumentError(
                 f"{what}: {' and '.join(chr(92) + g for g in given)} exclude each other; give one"
             )
-        if not given and k in builtin.required_groups_ids:
+        if not given and k in builtin.required_group_ids:
             choices = " or ".join("\\" + p.name for p in group)
             raise ArgumentError(f"{what} needs one of {choices}")
     ordered = {p.name: out[p.name] for p in builtin.params if p.name in out}
