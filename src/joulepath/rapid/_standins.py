@@ -17,6 +17,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass
 
+from joulepath.rapid import builtins
 from joulepath.rapid import nodes as n
 
 ROBTARGET, JOINTTARGET = "robtarget", "jointtarget"
@@ -89,10 +90,43 @@ def layout(
     return None
 
 
+ROLE_TYPES = frozenset({"tooldata", "wobjdata", "loaddata", "speeddata", "zonedata", ROBTARGET, JOINTTARGET})
+"""The data types a stand-in is chosen for by its place in a built-in's call
+(:mod:`joulepath.rapid.builtins`)."""
+
+
+def table_types(call: n.Call | n.FuncCall) -> list[tuple[n.Arg, str]] | None:
+    """Each argument of a built-in's call whose type its documented signature fixes (one of
+    :data:`ROLE_TYPES`), with that type; None where the table does not know the routine, or the
+    call does not match its signature."""
+    b = builtins.lookup(call.name)
+    if b is None:
+        return None
+    pairs = [(None if a.kind == "pos" else a.name, a) for a in call.args if a.kind in ("pos", "opt", "named")]
+    try:
+        matched = builtins.match_arguments(b, pairs)
+    except builtins.ArgumentError:
+        return None
+    out = []
+    for name, a in matched.items():
+        param = b.param(name)
+        if param is None or a is None or a.value is None:
+            continue
+        types = [t for t in param.types if t in ROLE_TYPES]
+        if len(types) == 1:
+            out.append((a, types[0]))
+    return out
+
+
 def argument_types(
     call: n.Call, process_linear: set[str], process_circular: set[str]
 ) -> Iterator[tuple[n.Arg, str]]:
-    """Each argument of ``call`` whose type the instruction fixes, with that type."""
+    """Each argument of ``call`` whose type the instruction fixes, with that type: from the table of
+    RAPID's built-ins where it knows the instruction, else from :data:`MOVE_LAYOUTS`."""
+    found_in_table = table_types(call)
+    if found_in_table is not None:
+        yield from found_in_table
+        return
     key = call.name.lower()
     found = layout(key, process_linear, process_circular)
     positional = [a for a in call.args if a.kind == "pos" and a.value is not None]
@@ -118,13 +152,36 @@ def name_roles(
     A name used as two types (a name declared in one module for one thing, used elsewhere for
     another) keeps the first; the interpreter's own type checks still hold."""
     out: dict[str, str] = {}
+    declared = {r.name.lower() for m in modules for r in m.routines}
     for m in modules:
         for r in m.routines:
             for s in _calls(r.body):
+                if s.name.lower() in declared:
+                    continue
                 for a, type_ in argument_types(s, process_linear, process_circular):
                     if isinstance(a.value, (n.Name, n.FuncCall)):  # a datum, or a function's value
                         out.setdefault(a.value.name.lower(), type_)
+            for node in _nodes(r.body):  # the built-in functions' arguments (CalcJointT(p, tool ...))
+                if isinstance(node, n.FuncCall) and node.name.lower() not in declared:
+                    for a, type_ in table_types(node) or ():
+                        if isinstance(a.value, (n.Name, n.FuncCall)):
+                            out.setdefault(a.value.name.lower(), type_)
     return out
+
+
+def _nodes(root: object) -> Iterator[object]:
+    stack: list[object] = [root]
+    while stack:
+        node = stack.pop()
+        yield node
+        if isinstance(node, tuple):
+            stack.extend(node)
+        elif hasattr(node, "__dataclass_fields__") and not isinstance(node, n.Pos):
+            for name in node.__dataclass_fields__:
+                if name not in ("pos", "text", "path"):
+                    v = getattr(node, name)
+                    if isinstance(v, tuple) or hasattr(v, "__dataclass_fields__"):
+                        stack.append(v)
 
 
 def _calls(body: tuple[n.Stmt, ...]) -> Iterator[n.Call]:

@@ -43,8 +43,8 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import TypeVar
 
+from joulepath.errors import RapidError
 from joulepath.rapid import _builtin_options, _builtin_table
-from joulepath.rapid._parse import RapidError
 
 __all__ = [
     "ArgumentError",

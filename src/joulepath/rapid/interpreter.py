@@ -43,6 +43,7 @@ from joulepath._typing import FloatArray
 from joulepath.errors import RapidError
 from joulepath.rapid import _geometry as geo
 from joulepath.rapid import _standins as standins
+from joulepath.rapid import builtins
 from joulepath.rapid import nodes as n
 from joulepath.rapid.task import Task
 from joulepath.rapid.values import (
@@ -1168,6 +1169,18 @@ class Interpreter:
             return KNOWN_FUNCTIONS_UNKNOWN_RESULT[key], frozenset({why})
         if key in _STRING_FUNCS:
             return _STRING_FUNCS[key](a, opt), CLEAN
+        documented = builtins.lookup(key)
+        if documented is not None and documented.kind is builtins.Kind.FUNCTION:
+            why = f"{pos}: {e.name}() " + (
+                "is known only while the program runs"
+                if documented.runtime
+                else "is a RAPID function joulepath does not evaluate: its value is taken as unknown"
+            )
+            type_ = self.types.resolve(documented.returns or "num")
+            try:
+                return self.types.default(type_), frozenset({why})
+            except (TypeErrorRapid, KeyError):
+                return 0.0, frozenset({why})
         role = self.roles.get(key, "value")
         if key not in self._assumed_routines:
             self._assumed_routines.add(key)
@@ -1282,9 +1295,8 @@ class Interpreter:
         far = float(np.linalg.norm(flange[:3, 3]))
         if reach is not None and far > reach:
             return (
-                f"the target at {where} mm (in its work object) puts the flange {1000 * far:.0f} mm from the "
-                f"robot's base, {1000 * (far - reach):.0f} mm beyond its reach of {1000 * reach:.0f} mm: the "
-                "program is probably for a larger arm; give it with --robot (or move the target)"
+                f"{1000 * far:.0f} mm from the robot's base, {1000 * (far - reach):.0f} mm beyond its reach "
+                f"({1000 * reach:.0f} mm): probably a program for a larger arm; give it with --robot"
             )
         return (
             f"the target at {where} mm (in its work object) is out of the robot's reach with this "
@@ -1520,9 +1532,9 @@ class Interpreter:
         return False
 
     def _shared(self, e: object) -> Taint:
-        """Why a condition may turn at run time though the task decides none of it: the ``PERS``
-        ``bool``, ``num`` and ``string`` data it reads that this task never sets (another task, a PLC
-        through a PC interface or the HMI sets them). Empty where it reads none."""
+        """Why a condition may turn at run time though the task decides none of it: the ``PERS`` and
+        ``VAR`` ``bool``, ``num`` and ``string`` data it reads that this task never sets (another task,
+        a PC through the robot's interfaces or the HMI sets them). Empty where it reads none."""
         out: set[str] = set()
         for node in _expressions(e):
             if not isinstance(node, n.Name):
@@ -1532,9 +1544,9 @@ class Interpreter:
             if found is None or key in self.assigned:
                 continue
             decl = found[0]
-            if decl.storage == "PERS" and self.types.resolve(decl.type) in ("bool", "num", "dnum", "string"):
+            if decl.storage != "CONST" and self.types.resolve(decl.type) in ("bool", "num", "dnum", "string"):
                 out.add(
-                    f"{decl.pos}: {decl.name} is PERS data this task never sets (another task or the HMI "
+                    f"{decl.pos}: {decl.name} is data this task never sets (another task, a PC or the HMI "
                     "sets it)"
                 )
         return frozenset(out)
@@ -1745,6 +1757,10 @@ class Interpreter:
             return
         if not s.name.strip():
             raise RapidError(f"{s.pos}: a call with no procedure name; give the procedure's name")
+        documented = builtins.lookup(key)
+        if documented is not None and documented.kind is builtins.Kind.INSTRUCTION:
+            self.documented_instruction(s, documented)
+            return
         if key not in self._assumed_routines:
             self._assumed_routines.add(key)
             said = (
@@ -1754,6 +1770,51 @@ class Interpreter:
             self.assumed.append(standins.Assumption(s.name, "routine", said, s.pos))
         self.write_inputs(s, key)
         self.events.append(Action(s, s.name, self._context()))
+
+    def documented_instruction(self, s: n.Call, b: builtins.Builtin) -> None:
+        """An instruction of RAPID or of an option (:mod:`joulepath.rapid.builtins`) that the cycle's
+        model does not run: its arguments checked against its documented signature, what it writes
+        from the outside world marked; one that moves the arm makes the next move's start unknown."""
+        pairs = [(None if a.kind == "pos" else a.name, a) for a in s.args]
+        try:
+            builtins.match_arguments(b, pairs)
+        except builtins.ArgumentError as err:
+            raise RapidError(f"{s.pos}: {s.name}: {err}; correct its arguments ({b.signature})") from None
+        whose = f"the {b.option} option's" if b.option else "a RAPID"
+        if b.effect is builtins.Effect.MOVE:
+            why = f"{s.pos}: {s.name} ({whose} instruction) moves the arm in a way joulepath does not model"
+            self.note(f"{why}: the move after it starts from where it leaves the arm")
+            self.after_branch = self.after_branch | frozenset({why})
+        elif b.name.lower() not in self._assumed_routines:
+            self._assumed_routines.add(b.name.lower())
+            self.note(f"{s.pos}: {s.name}: {whose} instruction, run as no motion and no time")
+        written = {p.name.lower() for p in b.writes}
+        if written:
+            self._mark_written(s, written, b)
+        self.events.append(Action(s, s.name, self._context()))
+
+    def _mark_written(self, s: n.Call, written: set[str], b: builtins.Builtin) -> None:
+        """Mark the arguments a documented instruction writes (with data known only at run time)."""
+        pairs = [(None if a.kind == "pos" else a.name, a) for a in s.args]
+        matched = builtins.match_arguments(b, pairs)
+        why = frozenset({f"{s.pos}: {s.name} writes data known only at run time"})
+        for name, a in matched.items():
+            if (
+                name.lower() not in written
+                or a is None
+                or not isinstance(a.value, (n.Name, n.Index, n.Field))
+            ):
+                continue
+            try:
+                target = self.ref(a.value)
+            except RapidError:
+                continue
+            r = target if isinstance(target, _Ref) else _Ref(target)
+            if r.cell.storage in ("CONST", "IO"):
+                continue
+            if not r.path and self._give(r):
+                continue
+            r.set(r.get(), r.cell.taint | why)
 
     def instruction(self, s: n.Call, key: str) -> None:
         ctx = self._context()
@@ -2070,7 +2131,8 @@ class Interpreter:
                 if bad is not None:
                     raise RapidError(
                         f"{s.pos}: {target_text}: joint {bad + 1} = {math.degrees(joints[bad]):.2f} deg is "
-                        "outside its range; correct the jointtarget"
+                        "outside this robot's range: correct the jointtarget, or give the robot it was "
+                        "taught on with --robot"
                     )
             else:
                 linear = kind in ("linear", "circular")
