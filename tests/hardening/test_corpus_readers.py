@@ -175,7 +175,7 @@ CASES = [
     # ---- work bounded before it starts (each names its limit and the variable that changes it)
     C("rapid-tiny-v", CYC, 2, "JOULEPATH_MAX_MOTION_S", {"p.mod": mod(AB[0], "MoveAbsJ jB, v1000\\V:=0.0001, fine, tool0;")}),
     C("rapid-speeddata-1e-9", CYC, 2, "JOULEPATH_MAX_MOTION_S", {"p.mod": mod(AB[0], "MoveAbsJ jB, vs, fine, tool0;", decl=DECL + "    CONST speeddata vs := [1e-9, 1e-9, 1e-9, 1e-9];\n")}),
-    C("rapid-T600", CYC, 2, "JOULEPATH_MAX_MOTION_S", {"p.mod": mod(AB[0], "MoveAbsJ jB, v1000\\T:=600, fine, tool0;")}),
+    C("rapid-T900", CYC, 2, "JOULEPATH_MAX_MOTION_S", {"p.mod": mod(AB[0], "MoveAbsJ jB, v1000\\T:=900, fine, tool0;")}),
     C("rapid-T60", CYC, 2, "JOULEPATH_MAX_MOVE_S", {"p.mod": mod(AB[0], "MoveAbsJ jB, v1000\\T:=60, fine, tool0;")}),
     C("cycle-toml-duration-60", CYT, 2, "JOULEPATH_MAX_MOVE_S", {"c.toml": step("[10, 0, 0, 0, 30, 0]", "60") + CYCLE_TOML}),
     C("cell-mesh-900k-triangles", CELLCMD, 2, "JOULEPATH_MAX_TRIANGLES", {"p.mod": mod(*AB), "c.toml": '[[mesh]]\nname = "m"\nfile = "m.stl"\ncenter_mm = [0, 0, 0]\n', "m.stl": STL900K}),

@@ -489,6 +489,12 @@ class Interpreter:
         self.outputs: dict[str, Value] = {}
         self._define_types()
         self.predefined = _predefined(self.types)
+        self.base = np.eye(4)  # the robot's base frame in the world (MOC.cfg), m
+        if task.moc is not None:
+            x, y, z = (1000.0 * v for v in task.moc.base_pos_m)
+            self.base = geo.frame((x, y, z), task.moc.base_quat)
+            for line in task.moc.lines():
+                self.note(line)
         self.globals: dict[str, tuple[n.DataDecl, n.Module]] = {}
         self.locals_of: dict[str, dict[str, tuple[n.DataDecl, n.Module]]] = {}
         self.cells: dict[tuple[str, str], Cell] = {}
@@ -1240,7 +1246,7 @@ class Interpreter:
 
     def _robtarget_at(self, q: FloatArray, tool: Record, wobj: Record) -> Record:
         assert self.kin is not None
-        flange = self.kin.flange(q)
+        flange = self.base @ self.kin.flange(q)
         tcp = flange @ geo.pose_matrix(_as_record(tool.get("tframe")))
         obj = _wobj_matrix(wobj)
         in_obj = np.linalg.inv(obj) @ tcp
@@ -1267,7 +1273,7 @@ class Interpreter:
         the target lies beyond the robot's reach (a program for a larger arm).
         """
         assert self.kin is not None
-        flange = target_flange(rt, tool, wobj, self.pdisp)
+        flange = np.linalg.inv(self.base) @ target_flange(rt, tool, wobj, self.pdisp)
         conf = _conf(rt) if (self.settings.conf_l if linear else self.settings.conf_j) else None
         q = self.kin.joints(flange, conf, self.current_q)
         if q is None:

@@ -9,6 +9,7 @@ then found across all the modules, as the controller finds them in one task.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -27,6 +28,87 @@ MAX_MODULES = 200
 
 
 @dataclass(frozen=True, slots=True)
+class MotionConfig:
+    """What a backup's ``MOC.cfg`` says of the robot (its ``ROBOT:`` section): the robot type as ABB
+    names it (``ROB1_4600_2.55_40``: an IRB 4600 of 2.55 m reach and 40 kg payload), the base frame
+    in the world (position m, quaternion w x y z) and ``gravity_beta`` (rad: 0 floor, pi/2 wall, pi
+    ceiling)."""
+
+    path: str
+    robot_type: str | None = None
+    base_pos_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    base_quat: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    gravity_beta: float = 0.0
+
+    @property
+    def family(self) -> tuple[str, float | None, float | None] | None:
+        """``(IRB family, reach m, payload kg)`` read from :attr:`robot_type`, or None."""
+        if self.robot_type is None:
+            return None
+        m = re.match(r"ROB\d*_([0-9]+[A-Za-z]*)_([0-9.]+)_([0-9.]+)", self.robot_type)
+        if m is None:
+            return None
+        return m.group(1), float(m.group(2)), float(m.group(3))
+
+    @property
+    def mounting(self) -> str:
+        beta = abs(self.gravity_beta) % (2 * math.pi)
+        if beta < 0.1 or beta > 2 * math.pi - 0.1:
+            return "floor"
+        return "ceiling" if abs(beta - math.pi) < 0.1 else f"tilted ({math.degrees(beta):.0f} deg)"
+
+    def lines(self) -> list[str]:
+        """What was read, a line each, for the run's notes."""
+        out = []
+        fam = self.family
+        if self.robot_type is not None:
+            what = (
+                f" (an IRB {fam[0]}, {fam[1]:g} m reach, {fam[2]:g} kg)" if fam and fam[1] and fam[2] else ""
+            )
+            out.append(f"{self.path}: the robot type is {self.robot_type}{what}")
+        if self.base_pos_m != (0.0, 0.0, 0.0) or self.base_quat != (1.0, 0.0, 0.0, 0.0):
+            pos = ", ".join(f"{1000 * v:.0f}" for v in self.base_pos_m)
+            quat = ", ".join(f"{v:.4g}" for v in self.base_quat)
+            out.append(
+                f"{self.path}: the base frame is at [{pos}] mm, [{quat}] in the world (targets go by it)"
+            )
+        if self.mounting != "floor":
+            out.append(
+                f"{self.path}: the arm is {self.mounting}-mounted (gravity_beta {self.gravity_beta:g} rad); "
+                "joulepath's dynamics take it floor-mounted, so the energies are those of a floor-mounted arm"
+            )
+        return out
+
+
+def read_moc(path: Path) -> MotionConfig:
+    """The robot's type, base frame and mounting from a ``MOC.cfg`` (other sections are ignored)."""
+    data = read_capped(path, max_bytes=MAX_BYTES, what="a motion configuration (MOC.cfg)", error=RapidError)
+    text, _, _ = decode(data)
+    text = text.replace("\\\n", " ")
+    section = re.search(r"^ROBOT:\s*$(.*?)(?=^[A-Z_]+:\s*$|\Z)", text, re.M | re.S)
+    body = section.group(1) if section else ""
+
+    def num(key: str, default: float) -> float:
+        m = re.search(rf"-{key}\s+(-?[0-9.]+(?:[eE][-+]?[0-9]+)?)", body)
+        try:
+            value = float(m.group(1)) if m else default
+        except ValueError:
+            value = default
+        return value if math.isfinite(value) else default
+
+    kind = re.search(r'-use_robot_type\s+"([^"]{1,80})"', body)
+    quat = tuple(num(f"base_frame_orient_u{k}", 1.0 if k == 0 else 0.0) for k in range(4))
+    norm = math.sqrt(sum(v * v for v in quat))
+    return MotionConfig(
+        str(path),
+        kind.group(1) if kind else None,
+        (num("base_frame_pos_x", 0.0), num("base_frame_pos_y", 0.0), num("base_frame_pos_z", 0.0)),
+        tuple(v / norm for v in quat) if norm > 0.5 else (1.0, 0.0, 0.0, 0.0),  # type: ignore[arg-type]
+        num("gravity_beta", 0.0),
+    )
+
+
+@dataclass(frozen=True, slots=True)
 class Task:
     """The modules of one task, the signals the I/O configuration declares, and where they came from."""
 
@@ -34,6 +116,7 @@ class Task:
     signals: frozenset[str]
     source: str
     eio: str | None = None
+    moc: MotionConfig | None = None
 
     def module_of(self, path: str) -> n.Module | None:
         return next((m for m in self.modules if m.path == path), None)
@@ -50,6 +133,7 @@ def load_task(paths: Sequence[str | Path]) -> Task:
     """Parse a task's modules from files and folders; :class:`RapidError` with one line otherwise."""
     files: list[Path] = []
     eio: list[Path] = []
+    moc: list[Path] = []
     if not paths:
         raise RapidError("no program given: name a module file (.mod, .sys) or a task's folder")
     for raw in paths:
@@ -57,11 +141,12 @@ def load_task(paths: Sequence[str | Path]) -> Task:
         if p.is_dir():
             found = sorted(f for f in p.rglob("*") if f.is_file() and f.suffix.lower() in MODULE_SUFFIXES)
             eio.extend(sorted(f for f in p.rglob("*") if f.is_file() and f.name.lower() == "eio.cfg"))
+            moc.extend(sorted(f for f in p.rglob("*") if f.is_file() and f.name.lower() == "moc.cfg"))
             if not found:
                 raise RapidError(f"{p}: the folder holds no RAPID module (.mod, .sys); give a task's folder")
             files.extend(found)
         elif p.suffix.lower() == ".cfg" and p.is_file():
-            eio.append(p)
+            (moc if p.name.lower() == "moc.cfg" else eio).append(p)
         elif p.exists() or p.is_symlink():
             files.append(p)  # a regular file, or refused by name when read (a device, a FIFO ...)
         else:
@@ -95,4 +180,6 @@ def load_task(paths: Sequence[str | Path]) -> Task:
     for f in eio:
         signals |= _signals_of_eio(f)
     source = ", ".join(str(Path(p)) for p in paths)
-    return Task(tuple(modules), signals, source, str(eio[0]) if eio else None)
+    return Task(
+        tuple(modules), signals, source, str(eio[0]) if eio else None, read_moc(moc[0]) if moc else None
+    )
