@@ -585,6 +585,14 @@ def check_moves_arm(spec: CycleSpec) -> None:
             if np.abs(step.q - q).max() > 1e-9:
                 return
             q = step.q
+    unknown = [a for a in spec.assumed if a.role in ("robtarget", "jointtarget", "wobjdata", "tooldata")]
+    if unknown and all(st.kept for st in spec.steps if st.kind == "move"):
+        names = ", ".join(sorted({a.name for a in unknown})[:6])
+        raise InvalidInput(
+            f"{spec.source}: no move of the cycle can be planned: its targets are unknown (they come from "
+            f"{names}, declared nowhere in what was given); give the module that declares them, or their "
+            "values in the scenario file ([targets], [wobj.NAME], [tool.NAME])"
+        )
     raise InvalidInput(
         f"{spec.source}: the cycle does not move the arm (every move goes where the arm already is); "
         "nothing to optimize: give targets that differ"

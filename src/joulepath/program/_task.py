@@ -218,7 +218,13 @@ def read_task_cycle(
         given=given,
         rated_payload_kg=robot.rated_payload_kg,
     )
-    trace = interp.run(routine)
+    try:
+        trace = interp.run(routine)
+    except RapidError as err:
+        fam = task.moc.family if task.moc is not None else None
+        if fam is not None and "--robot" in str(err) and f"irb{fam[0]}".lower() not in robot.name.lower():
+            raise RapidError(f"{err} (its MOC.cfg names an IRB {fam[0]})") from None
+        raise
     moves = [e for e in trace.cycle if isinstance(e, Motion)]
     if not moves:
         if trace.loop is not None:

@@ -2118,7 +2118,7 @@ class Interpreter:
         if conc:
             kept.add(f"{s.pos}: \\Conc: the instructions after it run while it moves")
         joints = circle_joints = None
-        unknown = self._unknown_target(targets, tool, wobj, s, kind)
+        unknown = self._unknown_target(targets, tool, wobj, s, kind, tool_name, wobj_name)
         if unknown is not None:
             kept.add(unknown)
             joints = self._where_the_arm_is()
@@ -2201,7 +2201,14 @@ class Interpreter:
         return q if self.kin.in_range(q) is None else None
 
     def _unknown_target(
-        self, targets: list[tuple[Record, Taint, str]], tool: Record, wobj: Record, s: n.Call, kind: str
+        self,
+        targets: list[tuple[Record, Taint, str]],
+        tool: Record,
+        wobj: Record,
+        s: n.Call,
+        kind: str,
+        tool_name: str = "",
+        wobj_name: str = "",
     ) -> str | None:
         """Why the move's target is unknown (None: it is known): declared nowhere, or known only at run
         time and its stand-in out of reach. Such a move is placed where the arm is and kept as taught."""
@@ -2211,8 +2218,28 @@ class Interpreter:
                 return f"{marked}; the move to it and the one after it are kept as taught"
         if self.kin is None or kind == "absjoint":
             return None
+        stand_in = next(
+            (
+                a
+                for a in self.assumed
+                if a.role in ("wobjdata", "tooldata") and a.name in (tool_name, wobj_name)
+            ),
+            None,
+        )
         for rec, t, text in targets:
-            if not t or rec.type != "robtarget":
+            if rec.type != "robtarget":
+                continue
+            if not t and stand_in is not None:  # placed by a stand-in frame: where it lies is not known
+                try:
+                    self.solve(rec, tool, wobj, s.pos, f"{s.name} {text}")
+                except (RapidError, ValueError):
+                    return (
+                        f"{s.pos}: {text} is {UNKNOWN_TARGET}: it lies in {stand_in.name}, declared nowhere "
+                        f"in what was given ({stand_in.role}, give it in the scenario file); the move to it "
+                        "and the one after it are kept as taught"
+                    )
+                continue
+            if not t:
                 continue
             try:
                 self.solve(rec, tool, wobj, s.pos, f"{s.name} {text}")
