@@ -68,8 +68,9 @@ CLEAN: Taint = frozenset()
 
 MAX_STEPS = 200_000
 """Statements and expression calls one run may take before it is stopped as never ending."""
-MAX_SECONDS = 60.0
-"""Wall time one run may take (s)."""
+MAX_SECONDS: float | None = None
+"""Wall time one run may take (s; None: none, the default: a run is bounded by its statements, so the
+same program is read the same on any machine)."""
 MAX_DEPTH = 32
 """Deepest routine call (recursion) one run may take."""
 MAX_LOOP_TURNS = 200_000
@@ -452,7 +453,7 @@ class Interpreter:
         seed: int = 0,
         kinematics: Kinematics | None = None,
         max_steps: int = MAX_STEPS,
-        max_seconds: float = MAX_SECONDS,
+        max_seconds: float | None = MAX_SECONDS,
         progress: Callable[[str], None] | None = None,
         given: Mapping[str, Value] | None = None,
         rated_payload_kg: float | None = None,
@@ -627,7 +628,9 @@ class Interpreter:
     def _tick(self, pos: n.Pos) -> None:
         self.steps += 1
         if self.steps > self.max_steps or (
-            self.steps % 4096 == 0 and time.perf_counter() - self.t0 > self.max_seconds
+            self.max_seconds is not None
+            and self.steps % 4096 == 0
+            and time.perf_counter() - self.t0 > self.max_seconds
         ):
             raise RapidError(
                 f"{pos}: the program runs more than {self.max_steps} statements without finishing a cycle "
