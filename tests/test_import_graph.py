@@ -154,3 +154,32 @@ def test_import_cycles_accepts_a_layered_package_and_finds_a_self_import(tmp_pat
     assert import_cycles(import_graph(pkg)) == []
     (pkg / "a.py").write_text("def f():\n    import pkg.a\n")
     assert import_cycles(import_graph(pkg)) == [["pkg.a"]]
+
+
+def private_imports(root: Path) -> list[str]:
+    """``file:line: module`` for every import of another package's private module (issue 46):
+    ``joulepath.a._b`` (or ``from joulepath.a import _b``) in a module outside ``joulepath.a``. A
+    package is used through its ``__init__``'s names; the root's own modules (``joulepath._io`` ...)
+    are the foundation every package shares."""
+    out = []
+    for path in sorted(root.rglob("*.py")):
+        parts = path.relative_to(root).parts
+        own = parts[0] if len(parts) > 1 else ""
+        for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+            names: list[str] = []
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+                names = [node.module]
+                if node.module.count(".") == 1:  # from joulepath.a import _b
+                    names += [f"{node.module}.{alias.name}" for alias in node.names]
+            for name in names:
+                bits = name.split(".")
+                if len(bits) >= 3 and bits[0] == "joulepath" and bits[1] != own and bits[2].startswith("_"):
+                    out.append(f"{path.relative_to(root.parent)}:{node.lineno}: {name}")
+    return sorted(set(out))
+
+
+def test_packages_use_each_other_through_their_public_names():
+    found = private_imports(SRC)
+    assert not found, "imports of another package's private module:\n" + "\n".join(found)

@@ -21,7 +21,7 @@ from joulepath.dynamics._friction import (
 )
 from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le
 from joulepath.dynamics._rnea import PinocchioRnea
-from joulepath.dynamics._robot import DEFAULT_ROBOT, METHODS, Robot, load_robot
+from joulepath.dynamics._robot import DEFAULT_ROBOT, FALLBACK_RANGE_SETS, METHODS, Robot, load_robot
 
 __all__ = [
     "Calibration",
@@ -29,6 +29,7 @@ __all__ = [
     "DEFAULT_ROBOT",
     "DynamicsDerivatives",
     "ElastoPlasticFriction",
+    "FALLBACK_RANGE_SETS",
     "FRICTION_SUFFIX",
     "Friction",
     "FrictionSum",

@@ -520,7 +520,7 @@ def _check_stages(exp: Experiment, robot: Any, source: str) -> None:
                 f"{source}: [identify] needs a robot described in IRML (the twin is written as IRML); "
                 f"robot = {exp.robot!r} comes from a URDF: use an .irml robot, or drop [identify]"
             )
-        from joulepath.dynamics._robot import FALLBACK_RANGE_SETS
+        from joulepath.dynamics import FALLBACK_RANGE_SETS
 
         if st.range_set not in (*robot.range_set_names, *FALLBACK_RANGE_SETS):
             raise InvalidInput(
@@ -529,9 +529,7 @@ def _check_stages(exp: Experiment, robot: Any, source: str) -> None:
             )
     c = exp.cycle
     if c.program:
-        from joulepath.program import CycleSettings, read_cycle_program
-        from joulepath.program._cell import read_cell
-        from joulepath.program._cycle import check_cycle
+        from joulepath.program import CycleSettings, check_cycle, read_cell, read_cycle_program
 
         program, cell = (
             resolve_logs(exp, (c.program,))[0],
@@ -583,8 +581,7 @@ def _check_extras(exp: Experiment, source: str) -> None:
 
 
 def _check_robot(exp: Experiment, source: str) -> Any:
-    from joulepath.dynamics import load_robot
-    from joulepath.dynamics._robot import FALLBACK_RANGE_SETS
+    from joulepath.dynamics import FALLBACK_RANGE_SETS, load_robot
     from joulepath.errors import JoulepathError
 
     try:

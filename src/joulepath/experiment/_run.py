@@ -798,8 +798,7 @@ def _optimum(robot: Any, res: Any) -> dict[str, Any]:
     reference starts from the minimum-jerk move (``benchmarks/optimizer_peers.py`` also
     starts it from the optimized path and keeps the better of the two).
     """
-    from joulepath.optimize import acceleration_limit, jerk_limit
-    from joulepath.optimize._reference import reference_optimum
+    from joulepath.optimize import acceleration_limit, jerk_limit, reference_optimum
 
     s = res.summary
     amax = acceleration_limit(robot, s.config["accel_time"])

@@ -10,6 +10,7 @@ from joulepath.optimize._bench import (
 from joulepath.optimize._cycle_reference import CycleLeg, CycleOptimum, cycle_optimum
 from joulepath.optimize._execute import EXECUTION_TOLERANCES, Execution, rapid_execution
 from joulepath.optimize._features import path_features
+from joulepath.optimize._figures import CYCLE_DEPRECATED, EnergyPair, figures_json, headline_keys, lab_pair
 from joulepath.optimize._gradient import (
     GRID_SEARCH,
     MOVE_SEARCH,
@@ -34,6 +35,7 @@ from joulepath.optimize._problem import (
     physics_energy,
     register_fitness,
 )
+from joulepath.optimize._reference import reference_optimum
 from joulepath.optimize._retime import (
     Retimed,
     controller_profile,
@@ -80,10 +82,12 @@ __all__ = [
     "ALGORITHMS",
     "AUTO",
     "AlgorithmSpec",
+    "CYCLE_DEPRECATED",
     "CycleLeg",
     "CycleOptimum",
     "CycleSegment",
     "EXECUTION_TOLERANCES",
+    "EnergyPair",
     "Execution",
     "FINE_FACTOR",
     "FITNESS",
@@ -106,8 +110,8 @@ __all__ = [
     "PENALTY",
     "PlanSegment",
     "RUN_FILES",
-    "SEARCH_BEFORE_HULL",
     "Retimed",
+    "SEARCH_BEFORE_HULL",
     "SearchOutcome",
     "SegmentMove",
     "SegmentOptimum",
@@ -121,8 +125,11 @@ __all__ = [
     "controller_profile",
     "cycle_optimum",
     "default_configuration",
+    "figures_json",
     "fitness_kind",
+    "headline_keys",
     "jerk_limit",
+    "lab_pair",
     "limit_violation",
     "measure_summaries",
     "optimize_move",
@@ -134,6 +141,7 @@ __all__ = [
     "random_tasks",
     "rank_joints_by_energy",
     "rapid_execution",
+    "reference_optimum",
     "register_fitness",
     "resolve_algorithm",
     "retime_on_path",

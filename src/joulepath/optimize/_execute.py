@@ -101,8 +101,7 @@ def rapid_execution(
     measurement and the via points as a (non-uniform) trajectory: its samples are what the
     RAPID exporter writes, the first the start.
     """
-    from joulepath.sim import make_plant
-    from joulepath.sim._via import follow_path, timed_move
+    from joulepath.sim import follow_path, make_plant, timed_move
 
     duration = float(planned.t[-1])
     followed = follow_path(robot, planned)
@@ -200,6 +199,6 @@ def tracked(plant: Any, path: Trajectory) -> Trajectory:
 
 
 def _at(path: Trajectory, t: np.ndarray) -> np.ndarray:
-    from joulepath.sim._via import _interpolate
+    from joulepath.sim import interpolate_via as _interpolate
 
     return _interpolate(path, t)

@@ -31,8 +31,7 @@ from joulepath.dynamics import Robot
 from joulepath.energy import DEFAULT_MEASURE, measure_power, path_energy
 from joulepath.errors import InvalidInput
 from joulepath.optimize._features import path_features
-from joulepath.trajectory import GRID_HIGH, GRID_LOW, Trajectory, rest_to_rest, thesis_quintic
-from joulepath.trajectory._polynomial import N_COEFFICIENTS
+from joulepath.trajectory import GRID_HIGH, GRID_LOW, N_COEFFICIENTS, Trajectory, rest_to_rest, thesis_quintic
 
 PARAMETRIZATIONS = ("rest_to_rest", "thesis")
 

@@ -55,7 +55,7 @@ from joulepath.dynamics import NOMINAL_FRICTION, Friction, Robot, friction_deriv
 from joulepath.energy import DEFAULT_MEASURE, Drivetrain, SmoothPower, check_measure, measure_power
 from joulepath.errors import InvalidInput
 from joulepath.optimize._verify import check_limits, energy_on_samples
-from joulepath.sim._profile import Profile, evaluate_profile, plan_profile
+from joulepath.sim import Profile, evaluate_profile, plan_profile
 from joulepath.trajectory import Trajectory
 
 FINE_DT = 0.0025

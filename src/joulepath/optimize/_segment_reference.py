@@ -846,7 +846,7 @@ class PlanSegment:
 def _zone_box(step: Any, zone_mm: float) -> FloatArray:
     """The joint box (rad) whose every point keeps the TCP within ``zone_mm`` of the step's
     target, to first order with a margin of 1/4 (as the cycle optimizer's zones)."""
-    from joulepath.sim._timing import _tcp
+    from joulepath.sim import tcp_path as _tcp
 
     n = step.q.size
     if zone_mm <= 0.0:
@@ -879,7 +879,7 @@ def plan_segments(plan: PlannedCycle) -> list[PlanSegment]:
     list of PlanSegment
         In the cycle's order; the segments' taught motions add up to the cycle's motion.
     """
-    from joulepath.sim._timing import evaluate_cycle
+    from joulepath.sim import evaluate_cycle
 
     out: list[PlanSegment] = []
     run: list[Any] = []

@@ -384,7 +384,7 @@ def _cell_file(raw: Any, base: Path, say: Any) -> Path | None:
     if not p.is_file():
         say(f"cell {raw}: no such file (looked at {p}); fix the path, relative to the plant file")
         return None
-    from joulepath.program._cell import read_cell
+    from joulepath.program import read_cell
 
     try:
         read_cell(p)

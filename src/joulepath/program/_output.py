@@ -226,13 +226,7 @@ def _energy_figures(result: CycleResult, check: dict[str, Any] | None) -> dict[s
     The cycle's motion (no standby) at every stage: planned on the model, the same motion on
     the emulated lab robot, and the written module as the controller emulation runs it.
     """
-    from joulepath.optimize._figures import (
-        CYCLE_DEPRECATED,
-        EnergyPair,
-        figures_json,
-        headline_keys,
-        lab_pair,
-    )
+    from joulepath.optimize import CYCLE_DEPRECATED, EnergyPair, figures_json, headline_keys, lab_pair
 
     m = result.energy_measure
     pairs = [
@@ -407,7 +401,7 @@ def cycle_path_csv(result: CycleResult) -> str:
 
 def egm_cycle_files(result: CycleResult) -> dict[str, str]:
     """``egm.mod`` and ``EGM_SETUP.md`` streaming the planned cycle (checked against the limits)."""
-    from joulepath.export._egm import render_egm
+    from joulepath.export import render_egm
 
     traj = result.planned
     assert traj is not None

@@ -669,7 +669,7 @@ def _restored(paths: Sequence[Path]) -> Path | None:
     if len(paths) != 1 or not paths[0].is_file():
         return None
     from joulepath.program._rapid_write import restore_program
-    from joulepath.rapid._parse import decode
+    from joulepath.rapid import decode
 
     raw = read_capped(paths[0], max_bytes=MAX_MODULE_BYTES, what="a RAPID module", error=RapidError)
     text, _, _ = decode(raw)

@@ -49,7 +49,7 @@ from joulepath import __version__
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, JoulepathError, LimitViolation
-from joulepath.optimize._retime import tcp_velocity
+from joulepath.optimize import tcp_velocity
 from joulepath.program._levers import LeverResult, _Evaluator, cycle_motion, levers_module
 from joulepath.program._line_speed import SPEED_TOL, LineSpeed, fastest_on_lines, line_speeds
 from joulepath.program._parse import parse_module

@@ -40,9 +40,15 @@ from joulepath._typing import FloatArray
 from joulepath.program._levers import _Evaluator
 from joulepath.program._line_speed import LineSpeed, blends, chord_floor
 from joulepath.program._resolve import CycleSpec
-from joulepath.sim import ControllerConfig, PlannedCycle, tcp_pose
-from joulepath.sim._limits import acceleration_limit
-from joulepath.sim._timing import ChainProfile, acc_share, stops_after
+from joulepath.sim import (
+    ChainProfile,
+    ControllerConfig,
+    PlannedCycle,
+    acc_share,
+    acceleration_limit,
+    stops_after,
+    tcp_pose,
+)
 
 VIA_SPACING_S = 0.05
 """s between the via points of a chain, on average (equal TCP arc length inside each move)."""
@@ -378,7 +384,7 @@ def dense_vias(
     blend's time away (:func:`_clear_of_blends`); nearer, the blend shrinks and the kept move runs
     almost to its target first, which costs the cycle the rest of the blend. ``room``: that many
     times the taught blend's time (0: none dropped)."""
-    from joulepath.sim._via import _leg_indices
+    from joulepath.sim import leg_indices as _leg_indices
 
     steps = plan.spec.steps
     # per move: the taught blends into it and out of it (s)

@@ -411,7 +411,7 @@ def _predefined(types: Types) -> dict[str, Cell]:
     out: dict[str, Cell] = {}
 
     def put(name: str, type_: str, value: Value, storage: str = "CONST") -> None:
-        out[name] = Cell(name, type_, storage, types.coerce(value, type_), CLEAN, None)
+        out[name.lower()] = Cell(name, type_, storage, types.coerce(value, type_), CLEAN, None)
 
     for v in SPEEDS:
         put(f"v{v}", "speeddata", (float(v), 500.0, 5000.0, 1000.0))
@@ -435,6 +435,9 @@ def _predefined(types: Types) -> dict[str, Cell]:
         )
     for name, value in (("pi", math.pi),):
         put(name, "num", value)
+    put("WAIT_MAX", "num", 8388608.0)  # RAPID's "wait forever" for \\MaxTime, \\Time
+    for k, state in enumerate(("CREATED", "CONNECTED", "BOUND", "LISTENING", "CLOSED"), start=1):
+        put(f"SOCKET_{state}", "num", float(k))  # socketstatus (Socket Messaging: SocketGetStatus)
     return out
 
 
@@ -505,6 +508,7 @@ class Interpreter:
         self.assigned = self._assigned_names()
         self.signals_used = self._signal_names()
         self.roles = standins.name_roles(self.task.modules, PROCESS_LINEAR, PROCESS_CIRCULAR)
+        self.set_names = self._set_names()
         self._initialising: set[tuple[str, str]] = set()
 
     # ---- setup
@@ -592,6 +596,36 @@ class Interpreter:
                 for a in s.args:
                     if isinstance(a.value, n.Name):
                         out.add(a.value.name.lower())
+        return out
+
+    def _set_names(self) -> set[str]:
+        """Data the task's statements set: assigned, passed to a routine of the task, or written by an
+        instruction that writes its argument (``Incr``, ``TPReadNum``, ``SocketReceive`` ...)."""
+        out: set[str] = set()
+        for s in self._walk_stmts():
+            if isinstance(s, n.Assign):
+                base = s.target
+                while isinstance(base, (n.Index, n.Field)):
+                    base = base.base
+                if isinstance(base, n.Name):
+                    out.add(base.name.lower())
+            elif isinstance(s, n.Call):
+                key = s.name.lower()
+                documented = builtins.lookup(key) if key not in self.routines else None
+                if documented is None:  # a routine of the task (or declared nowhere): it may write any
+                    args = [a.value for a in s.args]
+                else:
+                    written = {p.name.lower() for p in documented.params if p.writes}
+                    try:
+                        matched = builtins.match_arguments(documented, _pairs(s.args))
+                    except builtins.ArgumentError:
+                        matched = {}
+                    args = [v for k, v in matched.items() if k.lower() in written]
+                for v in args:
+                    while isinstance(v, (n.Index, n.Field)):
+                        v = v.base
+                    if isinstance(v, n.Name):
+                        out.add(v.name.lower())
         return out
 
     def _signal_names(self) -> set[str]:
@@ -1550,7 +1584,7 @@ class Interpreter:
                 continue
             key = node.name.lower()
             found = self.globals.get(key)
-            if found is None or key in self.assigned:
+            if found is None or key in self.set_names:
                 continue
             decl = found[0]
             if decl.storage != "CONST" and self.types.resolve(decl.type) in ("bool", "num", "dnum", "string"):
@@ -1559,6 +1593,75 @@ class Interpreter:
                     "sets it)"
                 )
         return frozenset(out)
+
+    def _outside(self, e: object, but: set[str] | frozenset[str] = frozenset()) -> Taint:
+        """What in a condition the world outside the task may change: the task's ``VAR`` and ``PERS``
+        data and its signals (another task, a PC, the HMI or the PLC sets them). A condition that a
+        loop or a wait spins on, moving nothing, ends when they change."""
+        out: set[str] = set()
+        for node in _expressions(e):
+            if not isinstance(node, n.Name) or node.name.lower() in but:
+                continue
+            key = node.name.lower()
+            found = self.globals.get(key)
+            if found is not None and found[0].storage != "CONST":
+                out.add(
+                    f"{found[0].pos}: {found[0].name} may be set outside this task (another task, a PC, "
+                    "the HMI)"
+                )
+            elif key in self.signals_used:
+                out.add(f"{node.pos}: the signal {node.name} is set outside the task")
+        return frozenset(out)
+
+    def _motion_weight(self, body: tuple[n.Stmt, ...], depth: int = 0) -> int:
+        """How many move statements a statement list runs once through (calls followed 8 deep)."""
+        if depth > 8:
+            return 1
+        total = 0
+        for s in body:
+            if isinstance(s, n.Call):
+                key = s.name.lower()
+                found = self.routines.get(key)
+                total += (
+                    1
+                    if key in _ALL_MOTIONS
+                    else self._motion_weight(found[0].body, depth + 1)
+                    if found
+                    else 0
+                )
+            elif isinstance(s, n.If):
+                total += max(
+                    [self._motion_weight(b, depth) for _, b in s.branches]
+                    + [self._motion_weight(s.orelse, depth)]
+                )
+            elif isinstance(s, (n.For, n.While)):
+                total += self._motion_weight(s.body, depth)
+            elif isinstance(s, n.Test):
+                total += max(
+                    [self._motion_weight(b, depth) for _, b in s.cases]
+                    + [self._motion_weight(s.default or (), depth)]
+                )
+        return total
+
+    def _most_moving(
+        self, options: list[tuple[tuple[n.Stmt, ...], str]], why: str
+    ) -> tuple[tuple[n.Stmt, ...], str]:
+        """The branch that runs the most moves (the first of equals), labelled with ``why``."""
+        body, label = max(options, key=lambda o: self._motion_weight(o[0]))
+        return body, f"{label} ({why}: the branch that moves most)"
+
+    def _production_turn(
+        self, pos: n.Pos, what: str, options: list[tuple[tuple[n.Stmt, ...], str]], shared: Taint
+    ) -> tuple[tuple[n.Stmt, ...], str]:
+        """A branch decided by data set outside the task, whose value now runs no move: the production
+        turn is taken to be the branch that moves most; said, with how to name another."""
+        body, label = self._most_moving(options, "assumed")
+        names = "; ".join(sorted(shared))
+        self.note(
+            f"{pos}: {what} on data set outside the task ({names[:160]}) -> {label}; give the data's value "
+            "(--io NAME=VALUE) to optimize another turn"
+        )
+        return body, label
 
     def exec_if(self, s: n.If) -> None:
         taint: Taint = CLEAN
@@ -1570,21 +1673,25 @@ class Interpreter:
             if v:
                 chosen, label = body, "THEN" if k == 0 else f"ELSEIF at line {cond.pos.line}"
                 break
+        options = [
+            (b, "THEN" if k == 0 else f"ELSEIF at line {c.pos.line}") for k, (c, b) in enumerate(s.branches)
+        ] + [(s.orelse, "ELSE")]
         if not taint and not self._has_motion(chosen, 0) and self._has_motion((s,), 0):
-            taint = frozenset().union(*(self._shared(c) for c, _ in s.branches))
+            shared = frozenset().union(*(self._shared(c) for c, _ in s.branches))
+            if shared:  # the production turn of data the HMI, a PC or another task sets: stated, then known
+                chosen, label = self._production_turn(s.pos, "IF", options, shared)
         if taint and not self._has_motion(chosen, 0):
-            # decided at run time: the stand-in's branch does not move; assume the first that does
-            options = [
-                (b, "THEN" if k == 0 else f"ELSEIF at line {c.pos.line}")
-                for k, (c, b) in enumerate(s.branches)
-            ]
-            options.append((s.orelse, "ELSE"))
-            moving = next(((b, lab) for b, lab in options if self._has_motion(b, 0)), None)
-            if moving is not None:
-                chosen, label = moving[0], moving[1] + " (assumed: the first branch that moves)"
+            # decided at run time: the stand-in's branch does not move; assume the one that moves most
+            chosen, label = self._most_moving(options, "assumed")
         if taint and not self.ctx_taint:
             self.note(f"{s.pos}: IF decided at run time: {'; '.join(sorted(taint))} -> {label} taken")
-        elif not taint and not self.ctx_taint and not s.compact and self._has_motion((s,), 0):
+        elif (
+            not taint
+            and not self.ctx_taint
+            and not s.compact
+            and self._has_motion((s,), 0)
+            and "assumed" not in label
+        ):
             cond = s.branches[0][0]
             v, _ = self._condition(cond)
             self.note(
@@ -1607,18 +1714,18 @@ class Interpreter:
             else:
                 continue
             break
+        options = [(b, f"CASE at line {vs[0].pos.line}") for vs, b in s.cases] + [
+            (s.default or (), "DEFAULT")
+        ]
         if not t and not self._has_motion(chosen, 0) and self._has_motion((s,), 0):
-            t = self._shared(s.expr)
+            shared = self._shared(s.expr)
+            if shared:
+                chosen, label = self._production_turn(s.pos, "TEST", options, shared)
         if t and not self._has_motion(chosen, 0):
-            options = [(b, f"CASE at line {vs[0].pos.line}") for vs, b in s.cases] + [
-                (s.default or (), "DEFAULT")
-            ]
-            moving = next(((b, lab) for b, lab in options if self._has_motion(b, 0)), None)
-            if moving is not None:
-                chosen, label = moving[0], moving[1] + " (assumed: the first branch that moves)"
+            chosen, label = self._most_moving(options, "assumed")
         if t and not self.ctx_taint:
             self.note(f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken")
-        elif not t and not self.ctx_taint and self._has_motion((s,), 0):
+        elif not t and not self.ctx_taint and self._has_motion((s,), 0) and "assumed" not in label:
             self.note(f"{s.pos}: TEST {self.source_of(s.expr.pos)} ({_show(v)}) -> {label} branch")
         self._under(t, lambda: self.exec_body(chosen), s)
 
@@ -1693,7 +1800,9 @@ class Interpreter:
         while True:
             v, t = self._condition(s.cond)
             if v and not t and not moving and turns >= SPIN_TURNS:
-                shared = self._shared(s.cond)
+                shared = self._outside(
+                    s.cond, but=_set_in(s.body)
+                )  # what the loop's own statements set ends it
                 if shared:  # it spins, moving nothing, until another task or the HMI sets its data
                     self.note(
                         f"{s.pos}: WHILE waits on data set outside this task ({'; '.join(sorted(shared))}): "
@@ -1784,7 +1893,7 @@ class Interpreter:
         """An instruction of RAPID or of an option (:mod:`joulepath.rapid.builtins`) that the cycle's
         model does not run: its arguments checked against its documented signature, what it writes
         from the outside world marked; one that moves the arm makes the next move's start unknown."""
-        pairs = [(None if a.kind == "pos" else a.name, a) for a in s.args]
+        pairs = _pairs(s.args)
         try:
             builtins.match_arguments(b, pairs)
         except builtins.ArgumentError as err:
@@ -1804,18 +1913,13 @@ class Interpreter:
 
     def _mark_written(self, s: n.Call, written: set[str], b: builtins.Builtin) -> None:
         """Mark the arguments a documented instruction writes (with data known only at run time)."""
-        pairs = [(None if a.kind == "pos" else a.name, a) for a in s.args]
-        matched = builtins.match_arguments(b, pairs)
+        matched = builtins.match_arguments(b, _pairs(s.args))
         why = frozenset({f"{s.pos}: {s.name} writes data known only at run time"})
         for name, a in matched.items():
-            if (
-                name.lower() not in written
-                or a is None
-                or not isinstance(a.value, (n.Name, n.Index, n.Field))
-            ):
+            if name.lower() not in written or not isinstance(a, (n.Name, n.Index, n.Field)):
                 continue
             try:
-                target = self.ref(a.value)
+                target = self.ref(a)
             except RapidError:
                 continue
             r = target if isinstance(target, _Ref) else _Ref(target)
@@ -1933,6 +2037,11 @@ class Interpreter:
             known = not t
             met = equal(v, want)
         note = ""
+        outside = (
+            self._outside(s.args[0].value) if key == "waituntil" and s.args and known and not met else CLEAN
+        )
+        if outside:  # a wait on data the task's own statements never met: the outside world ends it
+            known, t = False, outside
         if known and not met and "maxtime" not in opt:
             raise RapidError(
                 f"{s.pos}: {s.name} never ends: the scenario keeps its condition false; give the input's "
@@ -2381,6 +2490,33 @@ def _as_record(v: Value) -> Record:
 def _robax(jt: Record) -> FloatArray:
     rob = _as_record(jt.get("robax"))
     return np.array([num(v) for v in rob.values], dtype=float)
+
+
+def _set_in(body: tuple[n.Stmt, ...]) -> set[str]:
+    """Names (lower case) a statement list assigns or passes to a call, nested blocks included."""
+    out: set[str] = set()
+    for s in _expressions(body):
+        target: object = None
+        if isinstance(s, n.Assign):
+            target = s.target
+        elif isinstance(s, n.Call):
+            for a in s.args:
+                v: object = a.value
+                while isinstance(v, (n.Index, n.Field)):
+                    v = v.base
+                if isinstance(v, n.Name):
+                    out.add(v.name.lower())
+        while isinstance(target, (n.Index, n.Field)):
+            target = target.base
+        if isinstance(target, n.Name):
+            out.add(target.name.lower())
+    return out
+
+
+def _pairs(args: tuple[n.Arg, ...]) -> list[tuple[str | None, n.Expr | None]]:
+    """A call's arguments as :func:`joulepath.rapid.builtins.match_arguments` takes them: a switch's
+    value None, every other argument its expression."""
+    return [(None if a.kind == "pos" else a.name, a.value) for a in args if a.kind in ("pos", "opt", "named")]
 
 
 def _jointtarget(types: Types, q: FloatArray) -> Record:

@@ -147,6 +147,13 @@ class Types:
     def __init__(self) -> None:
         self.records: dict[str, tuple[tuple[str, str], ...]] = dict(BUILTIN_RECORDS)
         self.aliases: dict[str, str] = {}
+        from joulepath.rapid.builtins import all_data_types  # the options' records (cameratarget ...)
+
+        for dt in all_data_types():
+            if dt.kind == "record" and dt.components and dt.name.lower() not in self.records:
+                self.records[dt.name.lower()] = tuple((c.lower(), ty.lower()) for c, ty in dt.components)
+            elif dt.kind == "alias" and dt.alias_of:  # socketstatus, errnum-like aliases of num ...
+                self.aliases.setdefault(dt.name.lower(), dt.alias_of.lower())
 
     def resolve(self, type_: str) -> str:
         t = type_.lower()

@@ -17,6 +17,7 @@ from joulepath.sim._controller import (
 )
 from joulepath.sim._limits import ACCEL_TIME, JERK_TIME, acceleration_limit, jerk_limit
 from joulepath.sim._plants import PLANTS, LabFriction, Measured, Plant, make_plant, run_plant
+from joulepath.sim._profile import Profile, evaluate_profile, plan_profile
 from joulepath.sim._run import (
     THESIS_PLAN,
     SimulatedLog,
@@ -29,20 +30,26 @@ from joulepath.sim._run import (
 from joulepath.sim._steps import SpeedData, Step, StepSequence
 from joulepath.sim._timing import (
     FINE_DT,
+    ChainProfile,
     PathCache,
     PlannedCycle,
     PlannedMove,
+    acc_share,
     check_motion_time,
     evaluate_cycle,
     plan_cycle,
     stops_after,
     tcp_pose,
 )
+from joulepath.sim._timing import _tcp as tcp_path
 from joulepath.sim._via import RAPID_ACCEL_SHARE, FollowedPath, follow_path, timed_move
+from joulepath.sim._via import _interpolate as interpolate_via
+from joulepath.sim._via import _leg_indices as leg_indices
 from joulepath.sim._via import layout as via_layout
 
 __all__ = [
     "ACCEL_TIME",
+    "ChainProfile",
     "ControllerConfig",
     "FINE_DT",
     "FollowedPath",
@@ -55,6 +62,7 @@ __all__ = [
     "PlannedCycle",
     "PlannedMove",
     "Plant",
+    "Profile",
     "RAPID_ACCEL_SHARE",
     "Segment",
     "SimulatedLog",
@@ -62,12 +70,16 @@ __all__ = [
     "Step",
     "StepSequence",
     "THESIS_PLAN",
+    "acc_share",
     "acceleration_limit",
     "check_motion_time",
     "evaluate_cycle",
     "evaluate_plan",
+    "evaluate_profile",
     "follow_path",
+    "interpolate_via",
     "jerk_limit",
+    "leg_indices",
     "log_text",
     "log_times",
     "make_plant",
@@ -75,10 +87,12 @@ __all__ = [
     "moves_text",
     "plan_cycle",
     "plan_moves",
+    "plan_profile",
     "run_plant",
     "simulate",
     "simulate_plan",
     "stops_after",
+    "tcp_path",
     "tcp_pose",
     "timed_move",
     "via_layout",

@@ -12,6 +12,7 @@ import numpy as np
 
 from joulepath._io import atomic_write_text, check_replaceable, expect_outputs, make_folder
 from joulepath.data import (
+    MOVES_SIDECAR_COLUMNS,
     controller_log_text,
     generic_log_text,
     ingest,
@@ -19,7 +20,6 @@ from joulepath.data import (
     save_table,
     write_controller_log,
 )
-from joulepath.data._schema import MOVES_SIDECAR_COLUMNS
 from joulepath.description import DEFAULT_ROBOT
 from joulepath.dynamics import Robot, load_robot
 from joulepath.export import Move, draw_moves
