@@ -84,7 +84,6 @@ def _prog(*body: str, decl: str = "") -> str:
 
 # (name, program text, line of the error)
 CORPUS = [
-    ("unknown target", _prog("MoveJ pB, v100, fine, tool0;"), 5),
     ("missing semicolon", _prog("MoveJ pA, v100, fine, tool0", "WaitTime 1;"), 5),
     (
         "unreachable pose",
@@ -121,13 +120,6 @@ CORPUS = [
         ),
         6,
     ),
-    ("unknown speeddata", _prog("MoveAbsJ jA, v123, fine, tool0;"), 5),
-    (
-        "undeclared in a condition",
-        _prog("IF nParts > 3 THEN", "    MoveJ pA, v100, fine, tool0;", "ENDIF"),
-        5,
-    ),
-    ("other work object", _prog("MoveJ pA, v100, fine, tool0 \\WObj:=wobjTable;"), 5),
     ("WaitTime InPos without a time", _prog("MoveJ pA, v100, fine, tool0;", "WaitTime \\InPos;"), 6),
     (
         "declared twice",
@@ -136,11 +128,6 @@ CORPUS = [
         + "    PROC main()\n        MoveJ pA, v100, fine, tool0;\n    ENDPROC\n"
         + TAIL,
         4,
-    ),
-    (
-        "robtarget without value",
-        _prog("MoveJ pNone, v100, fine, tool0;", decl="    VAR robtarget pNone;\n"),
-        6,
     ),
     (
         "recursion",
@@ -200,3 +187,56 @@ def test_what_the_subset_reader_refused_is_now_read(tmp_path):
 
 def test_corpus_is_large_enough():
     assert len(CORPUS) >= 15
+
+
+# what the subset reader refused as declared nowhere is a partial task now (issue 47): read with a
+# stand-in by role, or refused only where no move can be planned
+PARTIAL = [
+    (
+        "unknown speeddata",
+        _prog("MoveJ pA, v100, fine, tool0;", "MoveAbsJ jA, v123, fine, tool0;"),
+        {"v123": "speeddata"},
+    ),
+    (
+        "other work object",
+        _prog("MoveAbsJ jA, v100, fine, tool0;", "MoveJ pA, v100, fine, tool0 \\WObj:=wobjTable;"),
+        {"wobjTable": "wobjdata"},
+    ),
+    (
+        "undeclared in a condition",
+        _prog(
+            "MoveAbsJ jA, v100, fine, tool0;",
+            "IF nParts > 3 THEN",
+            "    MoveJ pA, v100, fine, tool0;",
+            "ENDIF",
+        ),
+        {"nParts": "value"},
+    ),
+]
+
+
+@pytest.mark.parametrize(("name", "text", "roles"), PARTIAL, ids=[c[0] for c in PARTIAL])
+def test_a_name_declared_nowhere_gets_a_stand_in_by_its_role(tmp_path, name, text, roles):
+    prog = tmp_path / "partial.mod"
+    prog.write_text(text)
+    spec, _ = read_cycle_program(prog, joulepath.load_robot("irb120"))
+    assert {a.name: a.role for a in spec.assumed} == roles
+    assert all(a.pos.file == str(prog) and a.value for a in spec.assumed)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        _prog("MoveJ pB, v100, fine, tool0;"),
+        _prog("MoveJ pNone, v100, fine, tool0;", decl="    VAR robtarget pNone;\n"),
+    ],
+    ids=["target declared nowhere", "robtarget without value"],
+)
+def test_a_cycle_of_unknown_targets_is_refused_saying_where_they_come_from(tmp_path, capsys, text):
+    prog = tmp_path / "bad.mod"
+    prog.write_text(text)
+    assert main(["cycle", str(prog), "--out", str(tmp_path / "run")]) == 2
+    err = [ln for ln in capsys.readouterr().err.strip().splitlines() if not ln.startswith("[")]
+    assert len(err) == 1 and "Traceback" not in err[0]
+    assert "no move of the cycle can be planned" in err[0] or "an unknown target" in err[0], err
+    assert not (tmp_path / "run").exists()

@@ -586,7 +586,11 @@ def check_moves_arm(spec: CycleSpec) -> None:
                 return
             q = step.q
     unknown = [a for a in spec.assumed if a.role in ("robtarget", "jointtarget", "wobjdata", "tooldata")]
-    if unknown and all(st.kept for st in spec.steps if st.kind == "move"):
+    moves = [st for st in spec.steps if st.kind == "move"]
+    why = next((w for st in moves for w in st.kept if "an unknown target" in w), None)
+    if not unknown and why is not None and all(st.kept for st in moves):
+        raise InvalidInput(f"no move of the cycle can be planned: its targets are unknown ({why[:200]})")
+    if unknown and all(st.kept for st in moves):
         names = ", ".join(sorted({a.name for a in unknown})[:6])
         raise InvalidInput(
             f"{spec.source}: no move of the cycle can be planned: its targets are unknown (they come from "
