@@ -53,6 +53,11 @@ RESULTS = Path("/work/public_programs_results")
 CLASSES: list[tuple[str, str, re.Pattern[str]]] = [
     ("traceback", "a Python traceback", re.compile(r"Traceback \(most recent call last\)")),
     (
+        "no-plannable-move",
+        "no move of the cycle can be planned: its targets are unknown (declared nowhere, or from outside)",
+        re.compile(r"no move of the cycle can be planned"),
+    ),
+    (
         "runtime-targets",
         "targets or routine names that arrive at run time (taken as zeros, or an empty name)",
         re.compile(
@@ -96,7 +101,10 @@ CLASSES: list[tuple[str, str, re.Pattern[str]]] = [
     (
         "out-of-reach",
         "out of the IRB 120's reach or joint range (probably a program for another robot)",
-        re.compile(r"out of (the robot's )?reach|unreachable|cannot reach|outside its range|joint limit"),
+        re.compile(
+            r"out of (the robot's )?reach|unreachable|cannot reach|outside (its|this robot's) range|joint limit|"
+            r"beyond its reach|a larger arm"
+        ),
     ),
     (
         "duplicate",

@@ -43,7 +43,7 @@ import numpy as np
 from scipy.interpolate import BPoly
 
 from joulepath._typing import FloatArray
-from joulepath._work import check_work
+from joulepath._work import check_work, work_limit
 from joulepath.dynamics import NOMINAL_FRICTION, Robot
 from joulepath.energy import DEFAULT_MEASURE, MEASURES, energy_measure, measure_energy, measure_power
 from joulepath.errors import InvalidInput, LimitViolation
@@ -1713,6 +1713,9 @@ class CycleOptimizer:
             return out  # after its solves: solve_on_taught)
         for n_move, i in enumerate(self.optimizable, start=1):
             hi = budget - (sum(floor.values()) - floor[i])
+            # a unit is solved at most as long as the move_s limit (or its own taught duration): idle
+            # time beyond what the moves can use stays a wait (a long wait with --use-waits)
+            hi = min(hi, max(self.span[i], work_limit("move_s")))
             if hi < self.t_lo[i] - 1e-9:
                 continue  # the optimizer's shortest does not fit: taught only
             self.progress(f"unit {n_move}/{len(self.optimizable)}: solving at up to {k + 1} durations")
