@@ -96,4 +96,19 @@ def chain_from_description(
         velocity=_nan_if_none([j.velocity for j in desc.joints]),
         effort=_nan_if_none([j.effort for j in desc.joints]),
         gravity=np.array([0.0, 0.0, -gravity]),
+        notes=description_notes(desc),
     )
+
+
+def description_notes(desc: RobotDescription) -> tuple[tuple[str, str], ...]:
+    """What every result computed on this description must say: an estimated model (the IRML
+    ``<model>`` entry when it is not published or identified), and the family name that stands for
+    this variant (``<family-default>``)."""
+    notes = []
+    model = desc.info_value("model")
+    if model and not model.startswith(("published", "identified")):
+        notes.append(("model", model))
+    family = desc.info_value("family-default")
+    if family:
+        notes.append(("robot", f"is the variant that the family name {family!r} stands for (--robot {family})"))
+    return tuple(notes)
