@@ -31,6 +31,7 @@ from joulepath.description._presets import (
     preset_path,
     preset_variant,
 )
+from joulepath.description._sample import sample_chains
 from joulepath.description._provenance import (
     KINDS,
     PROVENANCE_SUFFIX,
@@ -78,6 +79,7 @@ __all__ = [
     "provenance_path",
     "read_irml",
     "read_provenance",
+    "sample_chains",
     "transform_inertial",
     "write_irml",
 ]

@@ -56,6 +56,7 @@ from joulepath.optimize._run import (
     verify_move,
     write_run,
 )
+from joulepath.optimize._robust import MC_SAMPLES, SavingStatement, saving_over_uncertainty
 from joulepath.optimize._search import ALGORITHMS, AUTO, AlgorithmSpec, SearchOutcome, resolve_algorithm
 from joulepath.optimize._segment_reference import (
     CycleSegment,
@@ -97,6 +98,7 @@ __all__ = [
     "LimitExcess",
     "LimitReport",
     "MAX_DURATION",
+    "MC_SAMPLES",
     "MOVE_SEARCH",
     "MeasureSummary",
     "MoveResult",
@@ -107,6 +109,7 @@ __all__ = [
     "PlanSegment",
     "RUN_FILES",
     "SEARCH_BEFORE_HULL",
+    "SavingStatement",
     "Retimed",
     "SearchOutcome",
     "SegmentMove",
@@ -137,6 +140,7 @@ __all__ = [
     "register_fitness",
     "resolve_algorithm",
     "retime_on_path",
+    "saving_over_uncertainty",
     "segment_optimum",
     "shortest_feasible_duration",
     "shortest_on_path",
