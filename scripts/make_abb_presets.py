@@ -134,7 +134,9 @@ def git_show(repo: Path, path: str) -> bytes:
 
 
 def git_head(repo: Path) -> str:
-    out = subprocess.run(["git", "--git-dir", str(repo), "rev-parse", "HEAD"], capture_output=True, check=True)
+    out = subprocess.run(
+        ["git", "--git-dir", str(repo), "rev-parse", "HEAD"], capture_output=True, check=True
+    )
     return out.stdout.decode().strip()
 
 
@@ -154,7 +156,9 @@ def _num(text: str) -> float:
     return sign * float(eval(inner, {"__builtins__": {}, "pi": math.pi}))  # noqa: S307
 
 
-def read_xacro(text: str) -> tuple[list[tuple[float, float, float]], list[tuple[float, float, float]], dict[str, str]]:
+def read_xacro(
+    text: str,
+) -> tuple[list[tuple[float, float, float]], list[tuple[float, float, float]], dict[str, str]]:
     """Joint origins, (lower, upper, velocity) of joint_1..6 and each link's collision mesh."""
     origins, limits = [], []
     for i in range(1, 7):
@@ -165,7 +169,9 @@ def read_xacro(text: str) -> tuple[list[tuple[float, float, float]], list[tuple[
             r'<origin[^>]*rpy="([^"]+)"[^>]*xyz="([^"]+)"', body
         )
         assert o
-        xyz, rpy = (o.group(1), o.group(2)) if "xyz" in o.group(0).split("rpy")[0] else (o.group(2), o.group(1))
+        xyz, rpy = (
+            (o.group(1), o.group(2)) if "xyz" in o.group(0).split("rpy")[0] else (o.group(2), o.group(1))
+        )
         assert all(float(v) == 0.0 for v in rpy.split()), rpy
         origins.append(tuple(float(v) for v in xyz.split()))
         axis = re.search(r'<axis xyz="([^"]+)"', body)
@@ -177,7 +183,9 @@ def read_xacro(text: str) -> tuple[list[tuple[float, float, float]], list[tuple[
     meshes = {}
     for link in LINKS:
         m = re.search(
-            rf'<link name="\$\{{prefix\}}{link}">.*?<collision.*?<mesh filename="package://([^"]+)"', text, re.S
+            rf'<link name="\$\{{prefix\}}{link}">.*?<collision.*?<mesh filename="package://([^"]+)"',
+            text,
+            re.S,
         )
         assert m, link
         pkg, _, rest = m.group(1).partition("/")
@@ -262,8 +270,8 @@ def urdf_text(name: str, origins, limits, inertials: dict[str, Inertial], header
             i = b.inertia_array
             lines += [
                 "    <inertial>",
-                f"      <mass value=\"{fmt(b.mass)}\"/>",
-                f"      <origin xyz=\"{' '.join(fmt(v) for v in b.com)}\" rpy=\"0 0 0\"/>",
+                f'      <mass value="{fmt(b.mass)}"/>',
+                f'      <origin xyz="{" ".join(fmt(v) for v in b.com)}" rpy="0 0 0"/>',
                 f'      <inertia ixx="{fmt(i[0, 0])}" ixy="{fmt(i[0, 1])}" ixz="{fmt(i[0, 2])}" '
                 f'iyy="{fmt(i[1, 1])}" iyz="{fmt(i[1, 2])}" izz="{fmt(i[2, 2])}"/>',
                 "    </inertial>",
@@ -273,9 +281,9 @@ def urdf_text(name: str, origins, limits, inertials: dict[str, Inertial], header
         lo, hi, vel = limits[i]
         lines += [
             f'  <joint name="joint_{i + 1}" type="revolute">',
-            f"    <parent link=\"{LINKS[i]}\"/>",
-            f"    <child link=\"{LINKS[i + 1]}\"/>",
-            f"    <origin xyz=\"{' '.join(fmt(v) for v in origins[i])}\" rpy=\"0 0 0\"/>",
+            f'    <parent link="{LINKS[i]}"/>',
+            f'    <child link="{LINKS[i + 1]}"/>',
+            f'    <origin xyz="{" ".join(fmt(v) for v in origins[i])}" rpy="0 0 0"/>',
             f'    <axis xyz="{AXES[i]}"/>',
             f'    <limit effort="0" lower="{fmt(lo)}" upper="{fmt(hi)}" velocity="{fmt(vel)}"/>',
             "  </joint>",
@@ -291,7 +299,9 @@ def urdf_text(name: str, origins, limits, inertials: dict[str, Inertial], header
     return "\n".join(lines) + "\n"
 
 
-def mesh_inertials(repo: Path, meshes: dict[str, str], total_mass: float) -> tuple[dict[str, Inertial], float]:
+def mesh_inertials(
+    repo: Path, meshes: dict[str, str], total_mass: float
+) -> tuple[dict[str, Inertial], float]:
     props = {link: volume_properties(read_stl(git_show(repo, path))) for link, path in meshes.items()}
     for link, (vol, _, _) in props.items():
         assert vol > 0, (link, vol)
@@ -369,7 +379,9 @@ def main() -> None:
     heads = {k: git_head(v) for k, v in repos.items()}
     check = validate_on_irb120(repos["abb_experimental"])
     mass_bound = round(math.ceil(check["max_link_mass_error"] * 20) / 20 + 0.05, 2)
-    print(f"mesh method on the IRB 120, link 1-5 mass errors: {np.round(check['errors'], 3)}; bound {mass_bound}")
+    print(
+        f"mesh method on the IRB 120, link 1-5 mass errors: {np.round(check['errors'], 3)}; bound {mass_bound}"
+    )
     for v in VARIANTS:
         if v.repo:
             text = git_show(repos[v.repo], v.xacro).decode()
@@ -490,8 +502,8 @@ def main() -> None:
             '  "the axis-2 balancing device (spring or hydraulic cylinder) of the large arms is not modelled: '
             'the axis-2 torque and energy are overstated where it carries the arm",',
             f'  "mesh method checked on the IRB 120 (CAD inertials known): link 1-5 masses off by '
-            f'{", ".join(f"{e:+.0%}" for e in check["errors"])}, hence the bound; centres of mass off by at most '
-            f'{check["max_com_error"]:.0%} of the arm length, hence a bound of 10 % of the longer arm; link 6 (the '
+            f"{', '.join(f'{e:+.0%}' for e in check['errors'])}, hence the bound; centres of mass off by at most "
+            f"{check['max_com_error']:.0%} of the arm length, hence a bound of 10 % of the longer arm; link 6 (the "
             'flange, under 1 % of the mass) is not estimated well by its collision mesh",',
             "]",
             "",

@@ -152,8 +152,14 @@ def _branch_in_quadrants(qs: np.ndarray, cfx: np.ndarray, conf: np.ndarray, chai
         low = conf[:, col] * QUADRANT
         turns = np.ceil((low - 1e-9 - q[:, j]) / (2 * np.pi))
         q[:, j] += 2 * np.pi * turns
-    for j in (1, 2, 4):  # a range wider than a half turn (IRB 140 axis 3: -230..50 deg): the one turn within it
-        q[:, j] += 2 * np.pi * ((q[:, j] < chain.lower[j] - 1e-9).astype(float) - (q[:, j] > chain.upper[j] + 1e-9))
+    for j in (
+        1,
+        2,
+        4,
+    ):  # a range wider than a half turn (IRB 140 axis 3: -230..50 deg): the one turn within it
+        q[:, j] += (
+            2 * np.pi * ((q[:, j] < chain.lower[j] - 1e-9).astype(float) - (q[:, j] > chain.upper[j] + 1e-9))
+        )
     return q
 
 

@@ -31,7 +31,9 @@ def test_optimize_move_on_a_large_arm_stays_within_every_limit(big_move):
 
 def test_saving_over_uncertainty_zero_width_gives_the_nominal_saving(big_move):
     robot, result = big_move
-    stated = saving_over_uncertainty(robot, result.default, result.optimized, Uncertainty(), n_samples=5, seed=3)
+    stated = saving_over_uncertainty(
+        robot, result.default, result.optimized, Uncertainty(), n_samples=5, seed=3
+    )
     assert stated.nominal_pct == pytest.approx(result.summary.saved_pct, rel=1e-9)
     assert stated.median_pct == pytest.approx(stated.nominal_pct, rel=1e-12)
     assert stated.p5_pct == pytest.approx(stated.nominal_pct, rel=1e-12)
@@ -41,9 +43,15 @@ def test_saving_over_uncertainty_is_seeded_and_spreads_with_the_bounds(big_move)
     robot, result = big_move
     prov = provenance_beside(robot.source)
     assert prov is not None and prov.is_estimate
-    a = saving_over_uncertainty(robot, result.default, result.optimized, prov.uncertainty, n_samples=16, seed=5)
-    b = saving_over_uncertainty(robot, result.default, result.optimized, prov.uncertainty, n_samples=16, seed=5)
-    c = saving_over_uncertainty(robot, result.default, result.optimized, prov.uncertainty, n_samples=16, seed=6)
+    a = saving_over_uncertainty(
+        robot, result.default, result.optimized, prov.uncertainty, n_samples=16, seed=5
+    )
+    b = saving_over_uncertainty(
+        robot, result.default, result.optimized, prov.uncertainty, n_samples=16, seed=5
+    )
+    c = saving_over_uncertainty(
+        robot, result.default, result.optimized, prov.uncertainty, n_samples=16, seed=6
+    )
     assert a == b
     assert a.median_pct != c.median_pct
     assert a.p5_pct <= a.median_pct

@@ -6,6 +6,7 @@ import sys
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import typer
@@ -13,6 +14,10 @@ import typer
 from joulepath.cli._common import check_out_folder, console, parse_joints, robot_inputs
 from joulepath.cli._robot import load_robot_for_cli, lock_option, unchecked_option
 from joulepath.description import DEFAULT_ROBOT
+
+if TYPE_CHECKING:
+    from joulepath.dynamics import Robot
+    from joulepath.optimize import MoveResult
 
 
 def _models(
@@ -218,6 +223,7 @@ def optimize(
         console.print(f"the plan: {plan}")
     else:
         console.print(plan)
+    _state_over_uncertainty(r, result, seed=seed, measure=energy)
     if r.friction is None:
         console.print(f"physics: no friction modelled for {r.name}; friction: {r.friction_note}")
     lab, vs = figures["lab"], figures["planned_vs_lab"]
@@ -300,3 +306,18 @@ def bench_optimizers(
         console.print(f"{kind}-objective, fitness {fitness}:")
         console.print(frame.to_string(index=False, float_format=lambda v: f"{v:.2f}"), markup=False)
     return 0
+
+
+def _state_over_uncertainty(r: Robot, result: MoveResult, *, seed: int, measure: str) -> None:
+    """For a model of estimates, one line: the planned saving over the model's stated uncertainty."""
+    from joulepath.description import provenance_beside
+    from joulepath.optimize import saving_over_uncertainty
+
+    provenance = provenance_beside(r.source)
+    if provenance is None or not provenance.is_estimate:
+        return
+    stated = saving_over_uncertainty(
+        r, result.default, result.optimized, provenance.uncertainty, seed=seed, measure=measure
+    )
+    console.print(stated.line(), markup=False)
+    console.print(provenance.headline(), markup=False)

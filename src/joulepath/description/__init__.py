@@ -31,7 +31,6 @@ from joulepath.description._presets import (
     preset_path,
     preset_variant,
 )
-from joulepath.description._sample import sample_chains
 from joulepath.description._provenance import (
     KINDS,
     PROVENANCE_SUFFIX,
@@ -42,6 +41,7 @@ from joulepath.description._provenance import (
     provenance_path,
     read_provenance,
 )
+from joulepath.description._sample import sample_chains
 
 __all__ = [
     "ABB_RANGE",

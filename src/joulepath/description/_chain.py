@@ -110,5 +110,7 @@ def description_notes(desc: RobotDescription) -> tuple[tuple[str, str], ...]:
         notes.append(("model", model))
     family = desc.info_value("family-default")
     if family:
-        notes.append(("robot", f"is the variant that the family name {family!r} stands for (--robot {family})"))
+        notes.append(
+            ("robot", f"is the variant that the family name {family!r} stands for (--robot {family})")
+        )
     return tuple(notes)

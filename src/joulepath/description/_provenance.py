@@ -80,7 +80,8 @@ class Uncertainty:
         for key in ("link_mass_rel", "link_inertia_rel"):
             if getattr(self, key) >= 1.0:
                 raise InvalidRobotDescription(
-                    f"uncertainty {key} = {getattr(self, key)!r}: expected < 1 (a mass or inertia stays positive)"
+                    f"uncertainty {key} = {getattr(self, key)!r}: expected < 1 "
+                    "(a mass or inertia stays positive)"
                 )
 
     @property
@@ -113,8 +114,8 @@ class ModelProvenance:
             return f"model {self.name}: {self.status}"
         u = self.uncertainty
         return (
-            f"model {self.name} is {self.status.upper()}: link masses ±{u.link_mass_rel:.0%}, centres of mass "
-            f"±{u.link_com_m * 1000:.0f} mm, inertias ±{u.link_inertia_rel:.0%} "
+            f"model {self.name} is {self.status.upper()}: link masses ±{u.link_mass_rel:.0%}, "
+            f"centres of mass ±{u.link_com_m * 1000:.0f} mm, inertias ±{u.link_inertia_rel:.0%} "
             "(joulepath robot show lists every source; identify a twin from the arm's log to replace them)"
         )
 
@@ -163,7 +164,9 @@ def read_provenance(path: str | os.PathLike[str]) -> ModelProvenance:
     known = {"link_mass_rel", "link_com_m", "link_inertia_rel", "catalogue_mass_rel"}
     unknown = sorted(set(unc) - known)
     if unknown:
-        raise _fail(f"{p} [uncertainty]", f"unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+        raise _fail(
+            f"{p} [uncertainty]", f"unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}"
+        )
     try:
         uncertainty = Uncertainty(**{k: float(v) for k, v in unc.items()})
     except (TypeError, ValueError) as err:

@@ -10,7 +10,9 @@ from joulepath.description._model import Chain
 from joulepath.description._provenance import Uncertainty
 
 
-def sample_chains(chain: Chain, uncertainty: Uncertainty, n_samples: int, *, rng: np.random.Generator) -> list[Chain]:
+def sample_chains(
+    chain: Chain, uncertainty: Uncertainty, n_samples: int, *, rng: np.random.Generator
+) -> list[Chain]:
     """``n_samples`` chains whose link dynamics are drawn uniformly within ``uncertainty``.
 
     Per moving link, independently: the mass times a factor in ``1 ± link_mass_rel``, the
@@ -35,7 +37,9 @@ def sample_chains(chain: Chain, uncertainty: Uncertainty, n_samples: int, *, rng
     masses = np.asarray(chain.masses, dtype=float)
     coms = np.asarray(chain.coms, dtype=float)
     inertias = np.asarray(chain.inertias, dtype=float)
-    f_mass = rng.uniform(1.0 - uncertainty.link_mass_rel, 1.0 + uncertainty.link_mass_rel, size=(n_samples, n))
+    f_mass = rng.uniform(
+        1.0 - uncertainty.link_mass_rel, 1.0 + uncertainty.link_mass_rel, size=(n_samples, n)
+    )
     f_inertia = rng.uniform(
         1.0 - uncertainty.link_inertia_rel, 1.0 + uncertainty.link_inertia_rel, size=(n_samples, n)
     )

@@ -97,7 +97,9 @@ def check_layout(chain: Chain) -> Layout:
     expected = bool(np.all(np.abs(got - _LAYOUT) <= _LAYOUT_TOL))
     if not expected:
         raise InvalidInput(f"{how}: this chain's joint frames differ")
-    return Layout(d1=float(tr[1][2]), a2=float(tr[2][0]), g=(float(tr[3][0]), float(tr[4][2])), a1=float(tr[1][0]))
+    return Layout(
+        d1=float(tr[1][2]), a2=float(tr[2][0]), g=(float(tr[3][0]), float(tr[4][2])), a1=float(tr[1][0])
+    )
 
 
 def _wrap(a: FloatArray) -> FloatArray:

@@ -41,6 +41,7 @@ from joulepath.optimize._retime import (
     shortest_on_path,
     tcp_velocity,
 )
+from joulepath.optimize._robust import MC_SAMPLES, SavingStatement, saving_over_uncertainty
 from joulepath.optimize._run import (
     FOLLOW,
     MAX_DURATION,
@@ -56,7 +57,6 @@ from joulepath.optimize._run import (
     verify_move,
     write_run,
 )
-from joulepath.optimize._robust import MC_SAMPLES, SavingStatement, saving_over_uncertainty
 from joulepath.optimize._search import ALGORITHMS, AUTO, AlgorithmSpec, SearchOutcome, resolve_algorithm
 from joulepath.optimize._segment_reference import (
     CycleSegment,

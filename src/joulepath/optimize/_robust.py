@@ -27,7 +27,7 @@ MC_SAMPLES = 64
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class SavingStatement:
-    """A planned saving on the nominal model and over the model's uncertainty (percent of the default's energy).
+    """A planned saving on the nominal model and over the model's uncertainty (% of the default's energy).
 
     ``holds`` is False when the 5th percentile is below zero: the saving is then not headlined.
     """
@@ -48,20 +48,23 @@ class SavingStatement:
         u = self.uncertainty
         over = (
             f"over the model's uncertainty (masses ±{u.link_mass_rel:.0%}, centres of mass "
-            f"±{u.link_com_m * 1000:.0f} mm, inertias ±{u.link_inertia_rel:.0%}; {self.n_samples} sampled models, "
+            f"±{u.link_com_m * 1000:.0f} mm, inertias ±{u.link_inertia_rel:.0%}; "
+            f"{self.n_samples} sampled models, "
             f"seed {self.seed}, {self.measure} energy): median {self.median_pct:.1f} %, 5th percentile "
             f"{self.p5_pct:.1f} % (nominal {self.nominal_pct:.1f} %)"
         )
         if self.holds:
-            return f"saving {over}"
-        return f"saving NOT headlined: its 5th percentile is below zero {over}"
+            return f"planned saving {over}"
+        return f"planned saving NOT headlined: its 5th percentile is below zero {over}"
 
 
 def _energies(robot: Robot, chain_robot: Robot, paths: tuple[Trajectory, ...], measure: str) -> list[float]:
     out = []
     for path in paths:
         tau = chain_robot.inverse_dynamics(path.q, path.qd, path.qdd, friction=robot.friction)
-        e = measure_energy(measure, tau, path.qd, path.dt, robot.drivetrain, duration=float(path.t[-1] - path.t[0]))
+        e = measure_energy(
+            measure, tau, path.qd, path.dt, robot.drivetrain, duration=float(path.t[-1] - path.t[0])
+        )
         out.append(float(e.total_J))
     return out
 
@@ -109,7 +112,8 @@ def saving_over_uncertainty(
     for name, path in (("default", default), ("optimized", optimized)):
         if path.q.ndim != 2 or path.q.shape[1] != robot.n_joints:
             raise InvalidInput(
-                f"{name} path has shape {path.q.shape}; expected one path of shape (n_steps, {robot.n_joints})"
+                f"{name} path has shape {path.q.shape}; "
+                f"expected one path of shape (n_steps, {robot.n_joints})"
             )
     rng = check_rng(seed)
     paths = (default, optimized)
