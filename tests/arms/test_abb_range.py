@@ -193,3 +193,26 @@ def test_solve_ik_with_confdata_returns_the_same_joints(arm: Robot) -> None:
         got = solve_ik(chain, pose[k], tuple(int(c) for c in conf[k]), lower=chain.lower, upper=chain.upper)
         assert got is not None
         np.testing.assert_allclose(got, q[k], atol=1e-7)
+
+
+# --------------------------------------------------------------------------- command line
+
+
+def test_robot_show_prints_provenance_and_the_variant_a_family_name_takes(capsys) -> None:
+    from joulepath.cli import main
+
+    assert main(["robot", "show", "irb4600"]) == 0
+    out = capsys.readouterr().out
+    assert "IRB 4600-40/2.55" in out
+    assert "family name 'irb4600'" in out
+    assert "is ESTIMATED" in out
+    assert "link masses: estimated" in out
+    assert "kinematics: published" in out and "Apache-2.0" in out
+
+
+def test_robot_show_unknown_abb_variant_is_one_line_and_exit_2(capsys) -> None:
+    from joulepath.cli import main
+
+    assert main(["robot", "show", "irb4600-99-9.99"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "irb4600-40-2.55" in err[0]

@@ -80,3 +80,15 @@ def test_sample_chains_stay_within_the_bounds_and_physical():
         np.testing.assert_array_equal(s.placements, chain.placements)
     same = sample_chains(chain, Uncertainty(), 2, rng=np.random.default_rng(0))
     np.testing.assert_array_equal(same[0].masses, chain.masses)
+
+
+def test_optimize_command_states_the_saving_over_the_uncertainty(tmp_path, capsys):
+    from joulepath.cli import main
+
+    args = ["optimize", "--robot", "irb4600", "--start=-60,10,-20,30,40,0", "--end=60,40,-50,-30,60,90"]
+    assert main([*args, "--degrees", "--duration", "2.5", "--out", str(tmp_path / "run")]) == 0
+    captured = capsys.readouterr()
+    assert "planned saving" in captured.out and "5th percentile" in captured.out
+    assert "is ESTIMATED" in captured.out
+    assert "model estimated" in captured.err  # the warning every command prints for a model of estimates
+    assert (tmp_path / "run" / "path.mod").is_file()

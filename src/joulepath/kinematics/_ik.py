@@ -79,8 +79,8 @@ the expected value (``np.allclose``'s)."""
 def check_layout(chain: Chain) -> Layout:
     """The chain's lengths when it has the ABB layout; ``InvalidInput`` otherwise."""
     how = (
-        "closed-form inverse kinematics (robtargets, MoveL) supports the ABB layout only "
-        "(6 revolute joints, joint 2 on or offset from axis 1 in the arm plane, parallel joints 2 and 3, "
+        "closed-form inverse kinematics (robtargets, MoveL) supports the IRB 120 layout only, with or "
+        "without a shoulder offset (ABB's serial arms: 6 revolute joints, parallel joints 2 and 3, "
         "spherical wrist); use jointtargets (MoveAbsJ)"
     )
     if chain.n_joints != 6 or not np.all(np.abs(np.asarray(chain.axes) - _Z_AXES) <= 1e-8 + 1e-5 * _Z_AXES):
