@@ -33,7 +33,7 @@ import re
 import struct
 import subprocess
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -50,7 +50,7 @@ from joulepath.description import (  # noqa: E402
     irml_string,
     preset_description,
 )
-from joulepath.description._chain import dh_transform  # noqa: E402
+from joulepath.description._chain import dh_transform, dynamics_fingerprint  # noqa: E402
 
 DEG = math.pi / 180
 CATALOGUE_BOUND = 0.05
@@ -471,6 +471,7 @@ def main() -> None:
             joints=tuple(joints),
             base=link_inertials["base_link"],
         )
+        desc = replace(desc, info=(*desc.info, ("model-fingerprint", dynamics_fingerprint(desc))))
         (PRESETS / f"{v.id}.irml").write_text(irml_string(desc))
         params = [
             ("kinematics", "published", src, "DH lengths d1, a1, a2, a3, d4, d6 read from the joint origins", "0.5 mm"),

@@ -125,6 +125,24 @@ def test_provenance_every_parameter_has_a_kind_a_source_and_a_bound(arm: Robot) 
     assert any(where == "model" and "estimated" in message for where, message in arm.chain.notes)
 
 
+def test_estimate_note_goes_when_the_masses_are_not_the_estimate_any_more() -> None:
+    """A twin (identified) or an edited copy keeps the IRML's general information but not its
+    masses: it is not called an estimate (the ``<model-fingerprint>`` no longer matches)."""
+    from dataclasses import replace
+
+    from joulepath.description import Inertial, chain_from_description, irml_string, parse_irml
+
+    desc = preset_description("irb2600")
+    assert any(where == "model" for where, _ in chain_from_description(desc).notes)
+    again = parse_irml(irml_string(desc))  # written and read back: still the estimate
+    assert any(where == "model" for where, _ in chain_from_description(again).notes)
+    joints = list(desc.joints)
+    b = joints[1].inertial
+    joints[1] = replace(joints[1], inertial=Inertial.from_arrays(b.mass * 1.2, b.com, b.inertia))
+    identified = replace(desc, joints=tuple(joints))
+    assert all(where != "model" for where, _ in chain_from_description(identified).notes)
+
+
 def test_irb120_has_no_estimate_note() -> None:
     assert load_robot("irb120").chain.notes == ()
 
