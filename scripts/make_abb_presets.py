@@ -394,7 +394,11 @@ def main() -> None:
                 for (lo, hi), sp in zip(IRB140["ranges_deg"], IRB140["speeds_deg_s"], strict=True)
             ]
             meshes = {}
-            src = "ABB data sheet IRB 140 (dimension drawing, axis working range, axis max speed)"
+            src = (
+                "ABB data sheet IRB 140 (dimension drawing, axis working range, axis max speed), values as "
+                "written in scripts/make_abb_presets.py, not re-read from ABB's document there; the lengths "
+                "agree with FreddyMartinez/abb_irb140_support's URDF (no licence stated: numbers compared only)"
+            )
         k = dh_params(origins)
         rows = dh_rows(k)
         com_bound = round(0.1 * max(k["a2"], k["d4"]), 3)
@@ -506,6 +510,14 @@ def main() -> None:
             f"{', '.join(f'{e:+.0%}' for e in check['errors'])}, hence the bound; centres of mass off by at most "
             f"{check['max_com_error']:.0%} of the arm length, hence a bound of 10 % of the longer arm; link 6 (the "
             'flange, under 1 % of the mass) is not estimated well by its collision mesh",',
+            *(
+                ()
+                if meshes
+                else (
+                    '  "the IRB 140 has no licensed public mesh: its link dynamics are the IRB 120\'s scaled, a '
+                    "method not checked against a known arm; the bound is the mesh method's\",",
+                )
+            ),
             "]",
             "",
             "[uncertainty]",
