@@ -45,6 +45,7 @@ sys.path.insert(0, str(ROOT / "src"))
 from joulepath.description import (  # noqa: E402
     Inertial,
     JointDescription,
+    RangeSet,
     RobotDescription,
     chain_from_urdf,
     irml_string,
@@ -363,6 +364,20 @@ def validate_on_irb120(repo: Path) -> dict[str, float]:
     }
 
 
+def collection_ranges(limits) -> RangeSet:
+    """The ``collection`` range set (what ``simulate``/``rapid collect`` excite within): ASSUMED, the
+    nominal ranges 10 deg inside each end, axes 4 and 6 within ±180 deg (cables), for a free cell."""
+    margin = 10 * DEG
+    lower, upper = [], []
+    for i, (lo, hi, _) in enumerate(limits):
+        lo, hi = lo + margin, hi - margin
+        if i in (3, 5):
+            lo, hi = max(lo, -math.pi), min(hi, math.pi)
+        lower.append(float(np.round(lo, 12)))
+        upper.append(float(np.round(hi, 12)))
+    return RangeSet(name="collection", lower=tuple(lower), upper=tuple(upper))
+
+
 # ---------------------------------------------------------------------------- writers
 
 
@@ -474,6 +489,7 @@ def main() -> None:
             ),
             joints=tuple(joints),
             base=link_inertials["base_link"],
+            range_sets=(collection_ranges(limits),),
         )
         desc = replace(desc, info=(*desc.info, ("model-fingerprint", dynamics_fingerprint(desc))))
         (PRESETS / f"{v.id}.irml").write_text(irml_string(desc))
@@ -492,6 +508,14 @@ def main() -> None:
             ("link masses", "estimated", "scripts/make_abb_presets.py", how, f"±{mass_bound:.0%} each"),
             ("centres of mass", "estimated", "scripts/make_abb_presets.py", how, f"±{com_bound} m per axis"),
             ("inertias", "estimated", "scripts/make_abb_presets.py", how + "; scaled with the link's mass", f"±{mass_bound:.0%}"),
+            (
+                "collection range set",
+                "assumed",
+                "scripts/make_abb_presets.py",
+                "the nominal ranges 10 deg inside each end, axes 4 and 6 within ±180 deg: an excitation "
+                "envelope for a free cell; narrow it to your cell",
+                "a choice, not a fact",
+            ),
             ("torque limits", "assumed", "none public", "not given: the torque check is skipped", "unknown"),
             ("friction", "assumed", "none public", "rigid body only (no friction) until identified", "unknown"),
         ]  # fmt: skip
@@ -514,7 +538,7 @@ def main() -> None:
                 ()
                 if meshes
                 else (
-                    '  "the IRB 140 has no licensed public mesh: its link dynamics are the IRB 120\'s scaled, a '
+                    "  \"the IRB 140 has no licensed public mesh: its link dynamics are the IRB 120's scaled, a "
                     "method not checked against a known arm; the bound is the mesh method's\",",
                 )
             ),

@@ -125,7 +125,7 @@ def description_notes(desc: RobotDescription) -> tuple[tuple[str, str], ...]:
     if model and same and not model.startswith(("published", "identified")):
         notes.append(("model", model))
     family = desc.info_value("family-default")
-    if family:
+    if family and same:
         notes.append(
             ("robot", f"is the variant that the family name {family!r} stands for (--robot {family})")
         )
