@@ -92,3 +92,45 @@ def test_optimize_command_states_the_saving_over_the_uncertainty(tmp_path, capsy
     assert "is ESTIMATED" in captured.out
     assert "model estimated" in captured.err  # the warning every command prints for a model of estimates
     assert (tmp_path / "run" / "path.mod").is_file()
+
+
+def test_expected_energy_zero_width_is_the_nominal_physics_energy(big_move):
+    """The robust objective over zero-width samples sums, path by path, to the nominal energy."""
+    from joulepath.optimize import ExpectedEnergy, physics_energy
+    from joulepath.optimize._features import path_features
+    from joulepath.trajectory import Trajectory
+
+    robot, result = big_move
+    paths = Trajectory(
+        t=result.default.t,
+        q=np.stack([result.default.q, result.optimized.q]),
+        qd=np.stack([result.default.qd, result.optimized.qd]),
+        qdd=np.stack([result.default.qdd, result.optimized.qdd]),
+    )
+    model = ExpectedEnergy(robot, Uncertainty(), rng=0, n_samples=3)
+    rows = path_features(robot, paths, model.input_columns)
+    expected = model.predict_rows(rows).reshape(2, -1).sum(axis=1)
+    nominal, _ = physics_energy(robot, paths)
+    np.testing.assert_allclose(expected, nominal, rtol=1e-12)
+    wide = ExpectedEnergy(robot, provenance_beside(robot.source).uncertainty, rng=0, n_samples=3)
+    assert not np.allclose(wide.predict_rows(rows).reshape(2, -1).sum(axis=1), nominal)
+
+
+def test_optimize_robust_needs_a_model_with_a_stated_uncertainty(tmp_path, capsys):
+    from joulepath.cli import main
+
+    args = ["optimize", "--robot", "irb120", "--start=0,0,0,0,0,0", "--end=0.5,0.2,0.1,0,0.3,0"]
+    assert main([*args, "--duration", "1.5", "--robust", "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "states no uncertainty" in err[0]
+    assert not (tmp_path / "r").exists()
+
+
+def test_optimize_robust_on_a_large_arm_is_within_limits_and_stated(tmp_path, capsys):
+    from joulepath.cli import main
+
+    args = ["optimize", "--robot", "irb1200", "--start=-60,10,-20,30,40,0", "--end=60,40,-50,-30,60,90"]
+    assert main([*args, "--degrees", "--duration", "1.175", "--robust", "--out", str(tmp_path / "r")]) == 0
+    out = capsys.readouterr().out
+    assert "robust objective: expected energy over 16 models" in out
+    assert "within every limit" in out and "5th percentile" in out

@@ -41,7 +41,13 @@ from joulepath.optimize._retime import (
     shortest_on_path,
     tcp_velocity,
 )
-from joulepath.optimize._robust import MC_SAMPLES, SavingStatement, saving_over_uncertainty
+from joulepath.optimize._robust import (
+    MC_SAMPLES,
+    ROBUST_SAMPLES,
+    ExpectedEnergy,
+    SavingStatement,
+    saving_over_uncertainty,
+)
 from joulepath.optimize._run import (
     FOLLOW,
     MAX_DURATION,
@@ -85,6 +91,7 @@ __all__ = [
     "CycleOptimum",
     "CycleSegment",
     "EXECUTION_TOLERANCES",
+    "ExpectedEnergy",
     "Execution",
     "FINE_FACTOR",
     "FITNESS",
@@ -106,6 +113,7 @@ __all__ = [
     "OptimizeConfig",
     "PARAMETRIZATIONS",
     "PENALTY",
+    "ROBUST_SAMPLES",
     "PlanSegment",
     "RUN_FILES",
     "SEARCH_BEFORE_HULL",

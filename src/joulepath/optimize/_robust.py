@@ -15,14 +15,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from joulepath._rng import check_rng
+from joulepath._typing import FloatArray
 from joulepath.description import Uncertainty, sample_chains
 from joulepath.dynamics import Robot
-from joulepath.energy import DEFAULT_MEASURE, measure_energy
+from joulepath.energy import DEFAULT_MEASURE, measure_energy, measure_power
 from joulepath.errors import InvalidInput
 from joulepath.trajectory import Trajectory
 
 MC_SAMPLES = 64
 """Models sampled by default (the 5th percentile of 64 draws: between the 3rd and 4th lowest)."""
+ROBUST_SAMPLES = 16
+"""Models the robust objective averages over (:class:`ExpectedEnergy`)."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -133,3 +136,63 @@ def saving_over_uncertainty(
         measure=measure,
         uncertainty=uncertainty,
     )
+
+
+class ExpectedEnergy:
+    """The robust objective: a path's energy averaged over models sampled within an uncertainty.
+
+    It plugs into the optimizer as a model of the path energy (``fitness="surrogate"``, the
+    ``models`` of :func:`joulepath.optimize.optimize_move`): per sample (row) of a path it returns the
+    power of ``measure`` times the sample period, averaged over ``n_samples`` robots whose link
+    dynamics are drawn within ``uncertainty`` (:func:`joulepath.description.sample_chains`); the rows
+    of a path sum to its expected energy. Its samples are drawn once, from ``rng``: state the result
+    with :func:`saving_over_uncertainty` on another stream, so that the statement is not made on the
+    models the path was fitted to.
+
+    Parameters
+    ----------
+    robot : Robot
+    uncertainty : Uncertainty
+    n_samples : int, default 16
+    rng : int or numpy.random.Generator
+        Seed or generator of the sampled models.
+    measure : str
+    """
+
+    target = "E"
+    family = "expected-physics"
+
+    def __init__(
+        self,
+        robot: Robot,
+        uncertainty: Uncertainty,
+        *,
+        rng: int | np.random.Generator,
+        n_samples: int = ROBUST_SAMPLES,
+        measure: str = DEFAULT_MEASURE,
+    ) -> None:
+        if not (isinstance(n_samples, int) and n_samples >= 1):
+            raise InvalidInput(f"n_samples must be an integer ≥ 1, got {n_samples!r}")
+        self.robot = robot
+        self.measure = measure
+        self.n_samples = n_samples
+        chains = sample_chains(robot.chain, uncertainty, n_samples, rng=check_rng(rng))
+        self._robots = [Robot(c, payload=robot.payload) for c in chains]
+        n = robot.n_joints
+        self.input_columns = (
+            *(f"q{i + 1}" for i in range(n)),
+            *(f"dq{i + 1}" for i in range(n)),
+            *(f"ddq{i + 1}" for i in range(n)),
+            "dt",
+        )
+
+    def predict_rows(self, rows: FloatArray) -> FloatArray:
+        """Expected energy (J) of each row ``(q, qd, qdd, dt)``: shape (n_rows,)."""
+        n = self.robot.n_joints
+        q, qd, qdd, dt = rows[:, :n], rows[:, n : 2 * n], rows[:, 2 * n : 3 * n], rows[:, 3 * n]
+        total = np.zeros(rows.shape[0])
+        for r in self._robots:
+            tau = r.inverse_dynamics(q, qd, qdd, friction=self.robot.friction)
+            total += measure_power(self.measure, tau, qd, self.robot.drivetrain).value
+        out: FloatArray = total / self.n_samples * dt
+        return out
