@@ -43,7 +43,7 @@ MOVES = {
 
 def main() -> None:
     rows = []
-    for family, variant in FAMILY_DEFAULTS.items():
+    for variant in FAMILY_DEFAULTS.values():
         robot = load_robot(variant)
         prov = provenance_beside(robot.source)
         assert prov is not None
@@ -63,7 +63,13 @@ def main() -> None:
                 "cmaes": (OptimizeConfig(seed=1, algorithm="cmaes"), ()),
                 "robust": (
                     OptimizeConfig(seed=1, algorithm="cmaes", fitness="surrogate"),
-                    (ExpectedEnergy(robot, prov.uncertainty, rng=np.random.SeedSequence(1).spawn(1)[0]),),
+                    (
+                        ExpectedEnergy(
+                            robot,
+                            prov.uncertainty,
+                            rng=np.random.default_rng(np.random.SeedSequence(1).spawn(1)[0]),
+                        ),
+                    ),
                 ),
             }
             for search, (config, models) in searches.items():
