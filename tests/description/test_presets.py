@@ -75,6 +75,6 @@ def test_irb120_inertias_are_the_published_ones_rotated():
 
 
 def test_preset_path_unknown_name():
-    assert PRESETS == ("irb120",)
-    with pytest.raises(InvalidRobotDescription, match="unknown robot 'irb999'; bundled robots: irb120"):
+    assert PRESETS[0] == "irb120"
+    with pytest.raises(InvalidRobotDescription, match="unknown robot 'irb999'; bundled robots: irb120, irb1"):
         preset_path("irb999")

@@ -6,6 +6,7 @@ import sys
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import typer
@@ -13,6 +14,10 @@ import typer
 from joulepath.cli._common import check_out_folder, console, parse_joints, robot_inputs
 from joulepath.cli._robot import load_robot_for_cli, lock_option, unchecked_option
 from joulepath.description import DEFAULT_ROBOT
+
+if TYPE_CHECKING:
+    from joulepath.dynamics import Robot
+    from joulepath.optimize import MoveResult
 
 
 def _models(
@@ -122,6 +127,13 @@ def optimize(
     ),
     lock: list[str] = lock_option(),
     unchecked: bool = unchecked_option(),
+    robust: bool = typer.Option(
+        False,
+        "--robust",
+        help="For a model of estimates (a .provenance.toml beside it, e.g. irb4600): minimize the expected "
+        "energy over 16 models drawn within its stated uncertainty (CMA-ES; thesis energy), not the nominal "
+        "model's.",
+    ),
     out: Path = typer.Option(..., "--out", help="Run folder."),
 ) -> int:
     """Find the least-energy path between two configurations in a fixed time; verify; export the program.
@@ -165,11 +177,18 @@ def optimize(
         energy=energy,
     )
     check_measure(energy, r.drivetrain)  # refused before any model is loaded: one line, what to provide
+    robust_models = (
+        _robust_models(r, seed=seed, fitness=fitness, model=model, energy=energy) if robust else ()
+    )
+    if robust:
+        config = replace(config, fitness="surrogate")
     if jerk_time is not None:  # else the controller's default (OptimizeConfig's)
         config = replace(config, jerk_time=jerk_time)
     if np.isfinite(duration) and 0 < duration <= MAX_DURATION:
         sample_times(duration)  # a whole number of samples: checked before any model is loaded
-    models, joints = _models(model, fitness, family, r.name, r.n_joints, robot)
+    models, joints = (
+        (robust_models, None) if robust else _models(model, fitness, family, r.name, r.n_joints, robot)
+    )
     with console.status(f"optimizing with {config.search.name} on the {fitness} fitness..."):
         result = optimize_move(
             r, np.array(q0), np.array(qf), duration, config, models=models, joints_ranked=joints
@@ -218,6 +237,7 @@ def optimize(
         console.print(f"the plan: {plan}")
     else:
         console.print(plan)
+    _state_over_uncertainty(r, result, seed=seed, measure=energy)
     if r.friction is None:
         console.print(f"physics: no friction modelled for {r.name}; friction: {r.friction_note}")
     lab, vs = figures["lab"], figures["planned_vs_lab"]
@@ -300,3 +320,49 @@ def bench_optimizers(
         console.print(f"{kind}-objective, fitness {fitness}:")
         console.print(frame.to_string(index=False, float_format=lambda v: f"{v:.2f}"), markup=False)
     return 0
+
+
+def _state_over_uncertainty(r: Robot, result: MoveResult, *, seed: int, measure: str) -> None:
+    """For a model of estimates, one line: the planned saving over the model's stated uncertainty."""
+    from joulepath.description import provenance_beside
+    from joulepath.optimize import saving_over_uncertainty
+
+    provenance = provenance_beside(r.source)
+    if provenance is None or not provenance.is_estimate:
+        return
+    stated = saving_over_uncertainty(
+        r, result.default, result.optimized, provenance.uncertainty, seed=seed, measure=measure
+    )
+    console.print(stated.line(), markup=False)
+    console.print(provenance.headline(), markup=False)
+
+
+def _robust_models(
+    r: Robot, *, seed: int, fitness: str, model: Path | None, energy: str
+) -> tuple[object, ...]:
+    """``--robust``: the expected-energy objective over models within the robot's stated uncertainty."""
+    import numpy as np
+
+    from joulepath.description import provenance_beside
+    from joulepath.optimize import ROBUST_SAMPLES, ExpectedEnergy
+
+    if fitness != "physics" or model is not None or energy != "thesis":
+        raise typer.BadParameter(
+            "--robust is its own objective on the thesis energy; drop --fitness, --model and --energy",
+            param_hint="--robust",
+        )
+    provenance = provenance_beside(r.source)
+    if provenance is None or provenance.uncertainty.is_zero:
+        raise typer.BadParameter(
+            f"robot {r.name!r} states no uncertainty (no .provenance.toml beside {r.source}); "
+            "--robust needs one, e.g. --robot irb4600",
+            param_hint="--robust",
+        )
+    # its own stream, apart from the statement's (seeded by --seed): the saving is then stated on
+    # models the path was not fitted to
+    stream = np.random.default_rng(np.random.SeedSequence(seed).spawn(1)[0])
+    console.print(
+        f"robust objective: expected energy over {ROBUST_SAMPLES} models within the stated uncertainty",
+        markup=False,
+    )
+    return (ExpectedEnergy(r, provenance.uncertainty, rng=stream),)

@@ -89,7 +89,9 @@ def load_robot_for_cli(name_or_path: str, *, unchecked: bool = False, lock: list
 
 @robot_app.command("show")
 def show(
-    robot: str = typer.Argument(..., help="Robot name (irb120, ur5, panda, ...) or an .irml/.urdf path."),
+    robot: str = typer.Argument(
+        ..., help="Robot name (irb120, irb4600-40-2.55, irb4600, ur5, panda, ...) or an .irml/.urdf path."
+    ),
     strict: bool = typer.Option(False, help="Exit with code 1 when the physical check finds errors."),
     lock: list[str] = lock_option(),
 ) -> int:
@@ -106,6 +108,16 @@ def show(
     console.print(
         f"tool0 at home: ({x:.1f}, {y:.1f}, {z:.1f}) mm, quaternion ({w:.5f}, {qx:.5f}, {qy:.5f}, {qz:.5f})"
     )
+    from joulepath.description import provenance_beside
+
+    provenance = provenance_beside(r.source)
+    for where, message in r.chain.notes:
+        if where != "model" or provenance is None:
+            console.print(f"note: {r.name}: {where} {message}", markup=False)
+    if provenance is not None:
+        console.print(provenance.headline(), markup=False)
+        for line in provenance.lines():
+            console.print(line, markup=False)
     findings = r.check_physical()
     errors = [f for f in findings if f.severity == "error"]
     if not findings:
@@ -123,7 +135,9 @@ def show(
 
 @robot_app.command("fk")
 def fk(
-    robot: str = typer.Argument(..., help="Robot name (irb120, ur5, panda, ...) or an .irml/.urdf path."),
+    robot: str = typer.Argument(
+        ..., help="Robot name (irb120, irb4600-40-2.55, irb4600, ur5, panda, ...) or an .irml/.urdf path."
+    ),
     q: str = typer.Option(..., "--q", help="Joint positions, comma separated."),
     degrees: bool = typer.Option(False, "--degrees", help="--q is in degrees (default rad)."),
     lock: list[str] = lock_option(),

@@ -21,20 +21,47 @@ from joulepath.description._model import (
 )
 from joulepath.description._named import NAMED_ARMS, NamedArm, named_arm_path
 from joulepath.description._pinocchio import chain_from_urdf, pinocchio_model
-from joulepath.description._presets import DEFAULT_ROBOT, HOME, PRESETS, preset_description, preset_path
+from joulepath.description._presets import (
+    ABB_RANGE,
+    DEFAULT_ROBOT,
+    FAMILY_DEFAULTS,
+    HOME,
+    PRESETS,
+    preset_description,
+    preset_path,
+    preset_variant,
+)
+from joulepath.description._provenance import (
+    KINDS,
+    PROVENANCE_SUFFIX,
+    ModelProvenance,
+    ParameterSource,
+    Uncertainty,
+    provenance_beside,
+    provenance_path,
+    read_provenance,
+)
+from joulepath.description._sample import sample_chains
 
 __all__ = [
+    "ABB_RANGE",
     "Chain",
     "DEFAULT_ROBOT",
+    "FAMILY_DEFAULTS",
     "Finding",
     "HOME",
     "Inertial",
     "JointDescription",
+    "KINDS",
+    "ModelProvenance",
     "NAMED_ARMS",
     "NamedArm",
     "PRESETS",
+    "PROVENANCE_SUFFIX",
+    "ParameterSource",
     "RangeSet",
     "RobotDescription",
+    "Uncertainty",
     "chain_from_description",
     "chain_from_urdf",
     "check_inertial",
@@ -47,7 +74,12 @@ __all__ = [
     "pinocchio_model",
     "preset_description",
     "preset_path",
+    "preset_variant",
+    "provenance_beside",
+    "provenance_path",
     "read_irml",
+    "read_provenance",
+    "sample_chains",
     "transform_inertial",
     "write_irml",
 ]

@@ -96,4 +96,37 @@ def chain_from_description(
         velocity=_nan_if_none([j.velocity for j in desc.joints]),
         effort=_nan_if_none([j.effort for j in desc.joints]),
         gravity=np.array([0.0, 0.0, -gravity]),
+        notes=description_notes(desc),
     )
+
+
+def dynamics_fingerprint(desc: RobotDescription) -> str:
+    """A short hash of the links' mass properties (9 significant digits), so that a statement
+    about them (``<model>estimated ...``) is known to be about these values and not others."""
+    import hashlib
+
+    values = []
+    for j in desc.joints:
+        b = j.inertial
+        values += [b.mass, *b.com, *(v for row in b.inertia for v in row)]
+    text = " ".join(f"{v:.9g}" for v in values)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def description_notes(desc: RobotDescription) -> tuple[tuple[str, str], ...]:
+    """What every result computed on this description must say: an estimated model (the IRML
+    ``<model>`` entry when it is not published or identified, while ``<model-fingerprint>`` still
+    matches the links' mass properties: a twin or an edited copy with other values is not that
+    estimate), and the family name that stands for this variant (``<family-default>``)."""
+    notes = []
+    model = desc.info_value("model")
+    fingerprint = desc.info_value("model-fingerprint")
+    same = fingerprint is None or fingerprint == dynamics_fingerprint(desc)
+    if model and same and not model.startswith(("published", "identified")):
+        notes.append(("model", model))
+    family = desc.info_value("family-default")
+    if family and same:
+        notes.append(
+            ("robot", f"is the variant that the family name {family!r} stands for (--robot {family})")
+        )
+    return tuple(notes)

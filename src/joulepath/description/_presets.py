@@ -1,4 +1,11 @@
-"""Ready-made robots shipped with joulepath (data only)."""
+"""Ready-made robots shipped with joulepath (data only): the IRB 120 and the ABB range.
+
+The ABB range (``irb140-6-0.8`` ... ``irb6700-235-2.65``) is named as ABB names its variants,
+payload and reach (``IRB 4600-40/2.55`` -> ``irb4600-40-2.55``); a family's name alone
+(``irb4600``) is its default variant (:data:`FAMILY_DEFAULTS`). Each of them has a
+``.provenance.toml`` beside its ``.irml``: its masses and inertias are estimates
+(:func:`joulepath.description.read_provenance`). ``scripts/make_abb_presets.py`` writes them.
+"""
 
 from __future__ import annotations
 
@@ -12,21 +19,51 @@ from joulepath.errors import InvalidRobotDescription
 DEFAULT_ROBOT = "irb120"
 """The robot every command and config uses when none is named (the thesis' ABB IRB 120)."""
 
-PRESETS = ("irb120",)
-"""Names accepted by :func:`preset_path` and :func:`joulepath.load_robot`."""
+ABB_RANGE = (
+    "irb140-6-0.8",
+    "irb1200-7-0.7",
+    "irb1200-5-0.9",
+    "irb1600-6-1.2",
+    "irb1600-8-1.45",
+    "irb2600-12-1.65",
+    "irb4600-20-2.50",
+    "irb4600-40-2.55",
+    "irb4600-60-2.05",
+    "irb6700-200-2.60",
+    "irb6700-235-2.65",
+)
+"""The bundled ABB variants beyond the IRB 120 (estimated dynamics; see each one's provenance)."""
 
-HOME = {"irb120": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}
+FAMILY_DEFAULTS = {
+    "irb140": "irb140-6-0.8",
+    "irb1200": "irb1200-7-0.7",
+    "irb1600": "irb1600-8-1.45",
+    "irb2600": "irb2600-12-1.65",
+    "irb4600": "irb4600-40-2.55",
+    "irb6700": "irb6700-200-2.60",
+}
+"""A family's name -> the variant it stands for (the family's headline variant among those bundled)."""
+
+PRESETS = ("irb120", *ABB_RANGE, *FAMILY_DEFAULTS)
+"""Names accepted by :func:`preset_path` and :func:`joulepath.load_robot` (variants, then family names)."""
+
+HOME = {name: (0.0, 0.0, 0.0, 0.0, 0.0, 0.0) for name in PRESETS}
 """Named configurations (rad): ABB's home pose is q = 0."""
 
 
+def preset_variant(name: str) -> str:
+    """The bundled file a name stands for: a family's name gives its default variant."""
+    return FAMILY_DEFAULTS.get(name, name)
+
+
 def preset_path(name: str, *, fmt: str = "irml") -> Path:
-    """Path of a bundled robot file (``fmt`` is ``"irml"`` or ``"urdf"``)."""
+    """Path of a bundled robot file (``fmt`` is ``"irml"``, ``"urdf"`` or ``"provenance.toml"``)."""
     if name not in PRESETS:
         raise InvalidRobotDescription(
             f"unknown robot {name!r}; bundled robots: {', '.join(PRESETS)} "
             "(or give a path to an .irml or .urdf file)"
         )
-    ref = resources.files("joulepath.description") / "presets" / f"{name}.{fmt}"
+    ref = resources.files("joulepath.description") / "presets" / f"{preset_variant(name)}.{fmt}"
     return Path(str(ref))
 
 

@@ -1,10 +1,11 @@
-"""Closed-form inverse kinematics of the IRB 120 layout and ABB's ``confdata``.
+"""Closed-form inverse kinematics of the ABB layout and ABB's ``confdata``.
 
 The layout (checked on the chain before any solve, :func:`check_layout`): six
-revolute joints about their frame's z axis; joint 1 at the base; the lower arm in
-the plane that joint 1 turns; joints 2 and 3 parallel; a spherical wrist (axes 4, 5
-and 6 meet at the wrist centre). The IRB 120 (and the other small ABB arms of the
-same build) has it. The wrist centre fixes joints 1–3 (shoulder in front of or
+revolute joints about their frame's z axis; joint 1 at the base; joint 2 on axis 1
+(the IRB 120, IRB 1200) or offset from it by ``a1`` in the arm plane (the shoulder
+offset of the IRB 140, 1600, 2600, 4600, 6700); the lower arm in the plane that
+joint 1 turns; joints 2 and 3 parallel; a spherical wrist (axes 4, 5 and 6 meet at
+the wrist centre). The wrist centre fixes joints 1–3 (shoulder in front of or
 behind axis 1, elbow up or down), the orientation fixes joints 4–6 (a ZYZ Euler
 decomposition, axis 5 positive or negative): eight branches, plus whole turns of a
 joint whose range spans more than one revolution (joint 6 of the IRB 120).
@@ -51,22 +52,23 @@ _RZ_PI = np.diag([-1.0, -1.0, 1.0])
 
 @dataclass(frozen=True, slots=True)
 class Layout:
-    """The lengths (m) of the IRB 120 layout read from a chain."""
+    """The lengths (m) of the ABB layout read from a chain."""
 
     d1: float  # base to the shoulder (joint 2), along z
     a2: float  # lower arm, joint 2 to joint 3
     g: tuple[float, float]  # joint 3 to the wrist centre in the arm plane (along, across)
+    a1: float = 0.0  # shoulder offset: axis 1 to joint 2, along the arm plane (0 for the IRB 120)
 
 
 _Z_AXES = np.tile([0.0, 0.0, 1.0], (6, 1))
 _LAYOUT = np.concatenate([
-    np.eye(4).ravel(), _PLANE.ravel(), np.zeros(2), np.eye(3).ravel(), np.zeros(2),
+    np.eye(4).ravel(), _PLANE.ravel(), np.zeros(1), np.eye(3).ravel(), np.zeros(2),
     _RX_M90.ravel(), np.zeros(2), _RX_P90.ravel(), np.zeros(2), (_RX_M90 @ _RZ_PI).ravel(), np.zeros(3),
 ])  # fmt: skip
 """The IRB 120 layout's frames as :func:`check_layout` compares them (rotations, and the parts of
 the translations that are zero)."""
 _LAYOUT_TOL = np.concatenate([
-    np.full(16, 1e-9), np.full(9, 1e-9), np.full(2, 1e-12), np.full(9, 1e-9), np.full(2, 1e-12),
+    np.full(16, 1e-9), np.full(9, 1e-9), np.full(1, 1e-12), np.full(9, 1e-9), np.full(2, 1e-12),
     np.full(9, 1e-9), np.full(2, 1e-12), np.full(9, 1e-9), np.full(2, 1e-12),
     np.full(9, 1e-9), np.full(3, 1e-12),
 ]) + 1e-5 * np.abs(_LAYOUT)  # fmt: skip
@@ -75,10 +77,11 @@ the expected value (``np.allclose``'s)."""
 
 
 def check_layout(chain: Chain) -> Layout:
-    """The chain's lengths when it has the IRB 120 layout; ``InvalidInput`` otherwise."""
+    """The chain's lengths when it has the ABB layout; ``InvalidInput`` otherwise."""
     how = (
-        "closed-form inverse kinematics (robtargets, MoveL) supports the IRB 120 layout only "
-        "(6 revolute joints, parallel joints 2 and 3, spherical wrist); use jointtargets (MoveAbsJ)"
+        "closed-form inverse kinematics (robtargets, MoveL) supports the IRB 120 layout only, with or "
+        "without a shoulder offset (ABB's serial arms: 6 revolute joints, parallel joints 2 and 3, "
+        "spherical wrist); use jointtargets (MoveAbsJ)"
     )
     if chain.n_joints != 6 or not np.all(np.abs(np.asarray(chain.axes) - _Z_AXES) <= 1e-8 + 1e-5 * _Z_AXES):
         raise InvalidInput(f"{how}: the chain has {chain.n_joints} joints or axes other than z")
@@ -88,13 +91,15 @@ def check_layout(chain: Chain) -> Layout:
     # one comparison of every frame against the layout (np.allclose per part costs more than the
     # closed form itself, and the check runs on every pose solved)
     got = np.concatenate([
-        p[0].ravel(), rot[1].ravel(), tr[1][:2], rot[2].ravel(), tr[2][1:], rot[3].ravel(), tr[3][1:],
+        p[0].ravel(), rot[1].ravel(), tr[1][1:2], rot[2].ravel(), tr[2][1:], rot[3].ravel(), tr[3][1:],
         rot[4].ravel(), tr[4][:2], rot[5].ravel(), tr[5],
     ])  # fmt: skip
     expected = bool(np.all(np.abs(got - _LAYOUT) <= _LAYOUT_TOL))
     if not expected:
         raise InvalidInput(f"{how}: this chain's joint frames differ")
-    return Layout(d1=float(tr[1][2]), a2=float(tr[2][0]), g=(float(tr[3][0]), float(tr[4][2])))
+    return Layout(
+        d1=float(tr[1][2]), a2=float(tr[2][0]), g=(float(tr[3][0]), float(tr[4][2])), a1=float(tr[1][0])
+    )
 
 
 def _wrap(a: FloatArray) -> FloatArray:
@@ -126,7 +131,7 @@ def ik_branches(chain: Chain, pose: FloatArray) -> tuple[FloatArray, FloatArray]
     rho = np.hypot(wc[..., 0], wc[..., 1])
     base = np.arctan2(wc[..., 1], wc[..., 0])
     for shoulder in (0, 1):  # 0: wrist centre in front of axis 1
-        r = rho if shoulder == 0 else -rho
+        r = (rho if shoulder == 0 else -rho) - lay.a1  # from joint 2, in the arm plane
         q1 = base if shoulder == 0 else _wrap(base + np.pi)
         x = wc[..., 2] - lay.d1
         c = (x * x + r * r - lay.a2**2 - L**2) / (2 * lay.a2 * L)
@@ -167,7 +172,7 @@ def ik_branches(chain: Chain, pose: FloatArray) -> tuple[FloatArray, FloatArray]
 
 
 def branch_cfx(chain: Chain, q: FloatArray) -> FloatArray:
-    """ABB's ``cfx`` (0..7) of joint values ``q`` (..., 6) of the IRB 120 layout (int array)."""
+    """ABB's ``cfx`` (0..7) of joint values ``q`` (..., 6) of the ABB layout (int array)."""
     lay = check_layout(chain)
     q = np.asarray(q, dtype=float)
     frames = link_frames(chain, q)
@@ -179,9 +184,9 @@ def branch_cfx(chain: Chain, q: FloatArray) -> FloatArray:
     behind_axis1 = radial < 0
     # lower arm from joint 2 to joint 3 in the (radial, height) plane
     j3 = frames[..., 2, :3, 3]
-    arm_r = (j3[..., :2] * fwd).sum(-1)
+    arm_r = (j3[..., :2] * fwd).sum(-1) - lay.a1  # joint 3 and the wrist centre seen from joint 2
     arm_h = j3[..., 2] - lay.d1
-    cross = arm_r * height - arm_h * radial  # > 0: wrist centre behind the lower arm
+    cross = arm_r * height - arm_h * (radial - lay.a1)  # > 0: wrist centre behind the lower arm
     behind_arm = cross > 0
     negative5 = q[..., 4] < 0
     out: FloatArray = 4 * behind_axis1 + 2 * behind_arm + 1 * negative5
