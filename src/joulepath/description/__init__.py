@@ -10,7 +10,7 @@ from joulepath.description._chain import (
     dh_transform,
     transform_inertial,
 )
-from joulepath.description._check import Finding, check_inertial, check_physical
+from joulepath.description._check import Finding, check_chain, check_inertial, check_physical
 from joulepath.description._irml import irml_string, parse_irml, read_irml, write_irml
 from joulepath.description._model import (
     Chain,
@@ -64,6 +64,7 @@ __all__ = [
     "Uncertainty",
     "chain_from_description",
     "chain_from_urdf",
+    "check_chain",
     "check_inertial",
     "check_physical",
     "combine_inertials",

@@ -23,6 +23,7 @@ from joulepath.description import (
     RobotDescription,
     chain_from_description,
     chain_from_urdf,
+    check_chain,
     check_inertial,
     check_physical,
     named_arm_path,
@@ -30,7 +31,6 @@ from joulepath.description import (
     preset_path,
     read_irml,
 )
-from joulepath.description._check import check_chain
 from joulepath.dynamics._calibration import Calibration, read_calibration, twin_paths
 from joulepath.dynamics._friction import FRICTION_SUFFIX, NOMINAL_FRICTION, Friction, read_friction_file
 from joulepath.dynamics._lagrange_euler import lagrange_euler, mass_matrix_le

@@ -8,7 +8,7 @@ from joulepath.kinematics._fk import (
     link_frames,
     position_and_jacobian,
 )
-from joulepath.kinematics._ik import check_layout, confdata, ik_branches, solve_ik
+from joulepath.kinematics._ik import check_layout, confdata, ik_branches, solve_ik, solve_ik_along
 from joulepath.kinematics._rotations import (
     axis_angle_matrix,
     euler_zyx_to_rotation,
@@ -33,4 +33,5 @@ __all__ = [
     "rotation_to_euler_zyx",
     "rotation_to_quaternion",
     "solve_ik",
+    "solve_ik_along",
 ]

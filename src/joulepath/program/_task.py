@@ -23,7 +23,7 @@ from joulepath._work import check_work
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, RapidError
 from joulepath.kinematics import check_layout, confdata, solve_ik
-from joulepath.rapid import _geometry as geo
+from joulepath.rapid import geometry as geo
 from joulepath.rapid.interpreter import UNKNOWN_TARGET, Action, Interpreter, Motion, Trace, Wait
 from joulepath.rapid.interpreter import moves_in as _moves
 from joulepath.rapid.task import Task, load_task

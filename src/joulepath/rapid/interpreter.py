@@ -41,9 +41,9 @@ import numpy as np
 
 from joulepath._typing import FloatArray
 from joulepath.errors import RapidError
-from joulepath.rapid import _geometry as geo
 from joulepath.rapid import _standins as standins
 from joulepath.rapid import builtins
+from joulepath.rapid import geometry as geo
 from joulepath.rapid import nodes as n
 from joulepath.rapid.task import Task
 from joulepath.rapid.values import (

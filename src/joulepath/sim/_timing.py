@@ -52,7 +52,7 @@ from joulepath._typing import FloatArray
 from joulepath._work import check_work
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
-from joulepath.kinematics._ik import solve_ik_along
+from joulepath.kinematics import solve_ik_along
 from joulepath.sim._controller import ControllerConfig
 from joulepath.sim._limits import jerk_limit
 from joulepath.sim._profile import Profile, evaluate_profile, plan_profile, time_at_fraction
