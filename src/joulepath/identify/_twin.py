@@ -13,8 +13,11 @@ and read back by :func:`joulepath.load_robot`:
   nominal URDF (with its meshes) is the one ``twin_of`` names;
 * ``friction.json`` — identified friction and gear efficiency;
 * ``card.json`` — data hash, fit and held-out scores, condition number, base parameters,
-  and ``parameters``: per joint and per parameter what the logs identified and what was
-  assumed or taken as given, with why and from where (:func:`parameter_report`);
+  ``robot_file`` (which of the two robot files the folder holds), ``kept_at_prior`` (the
+  parameters the logs left unexcited, each with its prior, where the prior comes from and
+  why: :attr:`~joulepath.identify.Identification.kept`), and ``parameters``: per joint and
+  per parameter what the logs identified and what was assumed or taken as given, with why
+  and from where (:func:`parameter_report`);
 * ``drives.toml`` — only for a twin identified from motor currents: the identified
   joint-side torque constants and gear efficiency, the other drive data as the nominal
   robot's drives file gives them (:func:`joulepath.identify.identified_drives`), in
