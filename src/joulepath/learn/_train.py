@@ -122,7 +122,7 @@ def choose_inputs(inputs: str | None, table: EnergyTable, robot: str | None = No
         joulepath does not know (KUKA KR300, a run held out) the kinematic inputs
         predicted every held-out run better than the raw ones (``benchmarks/unknown_arm.py``);
         choosing between the two by CV over two 10 s runs picked the raw inputs once
-        and lost (held-out R² -0.17 against 0.72).
+        and lost (held-out R² -0.17 against 0.73).
     table : EnergyTable
         The training table (:attr:`EnergyTable.robot` names its robot, if any).
     robot : str or None
