@@ -208,7 +208,8 @@ def test_an_unexcited_inertial_parameter_keeps_the_nominal_value(ur5, plant):
 
 
 def test_identify_and_evaluate_a_named_arm_on_the_command_line(ur5, plant, tmp_path, capsys):
-    """``identify LOG --robot ur5`` writes robot.urdf; ``evaluate --robot TWIN`` scores a held-out log."""
+    """``identify LOG --robot ur5`` writes robot.urdf; ``evaluate --robot TWIN`` scores a held-out log;
+    ``optimize --robot TWIN --energy electrical`` plans on the twin with the UR5's drive data."""
     logs = []
     for seed in (2, 41):
         q, qd, qdd = _motion(6, seed=seed)
@@ -232,3 +233,9 @@ def test_identify_and_evaluate_a_named_arm_on_the_command_line(ur5, plant, tmp_p
     out = capsys.readouterr().out
     r2 = json.loads((tmp_path / "ev" / "evaluate.json").read_text())["torque"]["r2"]
     assert min(r2) > 0.999, out
+    task = ["--start", "0,-60,60,0,40,0", "--end", "60,-80,40,20,60,30", "--degrees", "--duration", "2"]
+    quick = ["--knot-spacing", "0.1", "--energy", "electrical"]
+    assert main(["optimize", *task, *quick, "--robot", str(twin), "--out", str(tmp_path / "opt")]) == 0
+    result = json.loads((tmp_path / "opt" / "result.json").read_text())
+    assert result["energy_measure"] == "electrical" and "identified twin of ur5" in result["physics_model"]
+    assert result["limits_ok"] and result["energy_optimized_J"] <= result["energy_default_J"]

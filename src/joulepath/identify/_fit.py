@@ -583,7 +583,8 @@ def _prior_values(
                 arr = None
         if arr is None or not np.all(np.isfinite(arr)):
             values.extend([0.0] * n)
-            sources.extend([f"0: no friction known ({robot.friction_note})"] * n)
+            why = "no friction known" if friction is None else f"the robot's friction gives no {t} level"
+            sources.extend([f"0: {why} ({robot.friction_note})"] * n)
             known.extend([False] * n)
         else:
             values.extend(float(v) for v in arr)
