@@ -171,7 +171,10 @@ def test_badly_conditioned_data_is_refused_naming_a_parameter(irb120):
     sim = Plant(name="sim", robot=irb120, friction=NOMINAL_FRICTION)
     data = _exact_data(irb120, sim, 3, seed=8)
     with pytest.raises(InvalidInput, match=r"condition number .* least excited: \S+"):
-        identify(data, irb120, IdentifyOptions(gear_efficiency=1.0, max_condition=5.0))
+        identify(data, irb120, IdentifyOptions(gear_efficiency=1.0, max_condition=5.0, unexcited="refuse"))
+    # keeping parameters at their priors has a bound: more than MAX_KEPT_SHARE of them is refused
+    with pytest.raises(InvalidInput, match=r"kept at their priors, at most 25 %.* least excited"):
+        identify(data, irb120, IdentifyOptions(gear_efficiency=1.0, max_condition=1.01))
 
 
 def test_too_few_samples_and_bad_arrays_are_refused(irb120):

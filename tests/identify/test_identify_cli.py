@@ -117,9 +117,16 @@ def test_identify_refuses_without_writing(twin, lab_log, tmp_path, capsys):
     assert err.startswith("error: ") and err.count("\n") == 1
     assert not out.exists()
     # logs that cannot excite the model
-    assert main(["identify", str(lab_log), "--max-condition", "2", "--out", str(out)]) == 2
+    refuse = ["--unexcited", "refuse"]
+    assert main(["identify", str(lab_log), "--max-condition", "2", *refuse, "--out", str(out)]) == 2
     assert "least excited" in capsys.readouterr().err
     assert not out.exists()
+    # by default the least excited parameters keep their priors, but never more than a quarter of them
+    assert main(["identify", str(lab_log), "--max-condition", "2", "--out", str(out)]) == 2
+    assert "at most 25 %" in capsys.readouterr().err
+    assert not out.exists()
+    assert main(["identify", str(lab_log), "--unexcited", "sometimes", "--out", str(out)]) == 2
+    assert "unexcited must be one of" in capsys.readouterr().err
 
 
 def test_simulate_on_the_twin_plant_gives_data_that_identify_the_twin_again(twin, tmp_path):

@@ -112,7 +112,8 @@ def generic_tables(tmp_path_factory):
 
 
 def test_train_a_generic_log_with_the_defaults(generic_tables, tmp_path, capsys):
-    """No robot known: the raw inputs, one line saying so, the held-out R² on stdout and the card."""
+    """No robot known: the kinematic inputs, one line saying so, the held-out R² on stdout and on the
+    card beside the CV estimate."""
     import json
 
     import numpy as np
@@ -128,9 +129,12 @@ def test_train_a_generic_log_with_the_defaults(generic_tables, tmp_path, capsys)
     captured = capsys.readouterr()
     assert code == 0, captured.err
     assert captured.err.splitlines().count(NO_ROBOT_NOTE) == 1
-    assert "--robot" in NO_ROBOT_NOTE and "raw (thesis) inputs" in NO_ROBOT_NOTE
+    assert "--robot" in NO_ROBOT_NOTE and "kinematic inputs" in NO_ROBOT_NOTE
     card = json.loads((out / "par-E" / "card.json").read_text())
-    assert card["inputs"] == "thesis" and card["inputs_reason"] == "default: no robot known"
+    assert card["inputs"] == "kinematic" and card["inputs_reason"] == "default: no robot known"
+    assert card["cv_grouped"]["groups"] == "move"  # a table of one log
+    assert card["cv_vs_held_out"]["held_out_r2"] == card["test"]["r2"]
+    assert card["cv_vs_held_out"]["cv_r2"] == card["cv_grouped"]["r2_mean"]
     header = next(line for line in captured.out.splitlines() if "test_r2" in line).split()
     row = next(line for line in captured.out.splitlines() if line.split()[:2] == ["par", "E"]).split()
     held_out = float(row[header.index("test_r2")])

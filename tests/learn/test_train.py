@@ -35,7 +35,8 @@ def test_reports_and_files(trained):
         card = json.loads((out / f"{family}-E" / "card.json").read_text())
         assert card["input_columns"][:2] == ["q1", "dq1"] and card["target"] == "E"
         assert len(card["training_data_sha256"]) == 64
-        assert set(card["cv_grouped"]) == {"r2_mean", "r2_std", "mae_mean", "mae_std", "folds"}
+        assert set(card["cv_grouped"]) == {"r2_mean", "r2_std", "mae_mean", "mae_std", "folds", "groups"}
+        assert card["cv_grouped"]["groups"] == "move"  # one log: its moves are the groups
         assert "scikit-learn" in card["versions"]
 
 
@@ -164,8 +165,9 @@ def test_train_refuses_a_table_without_robot_for_physics_inputs(seven_joint_tabl
     assert not (tmp_path / "m").exists()
 
 
-def test_train_without_robot_defaults_to_the_raw_inputs(seven_joint_tables, tmp_path):
-    """No robot known: the thesis inputs, said in one progress line and recorded on the card."""
+def test_train_without_robot_defaults_to_the_kinematic_inputs(seven_joint_tables, tmp_path):
+    """No robot known: the raw inputs and robot-free energy bases, said in one progress line and
+    recorded on the card."""
     from dataclasses import replace
 
     from joulepath.learn import NO_ROBOT_NOTE, train
@@ -177,6 +179,6 @@ def test_train_without_robot_defaults_to_the_raw_inputs(seven_joint_tables, tmp_
     report = train(bare, bare_test, config, tmp_path / "m", progress=said.append)
     assert said.count(NO_ROBOT_NOTE) == 1
     card = json.loads((tmp_path / "m" / "par-E" / "card.json").read_text())
-    assert card["inputs"] == "thesis" and card["inputs_reason"] == "default: no robot known"
     assert card["robot_source"] is None and report.baselines == []
-    assert "dt" not in card["input_columns"]  # the raw features only
+    assert card["inputs"] == "kinematic" and card["inputs_reason"] == "default: no robot known"
+    assert card["input_columns"][-1] == "dt" and "ddq7" in card["input_columns"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import typer
@@ -15,10 +16,13 @@ def identify(
     logs: list[Path] = typer.Argument(..., help="Controller or generic logs of the robot (CSV)."),
     robot: str = typer.Option(
         "irb120",
-        help="The logged robot: a bundled name, an .irml path or a twin folder (nominal parameters).",
+        help="The logged robot: a bundled name, a named arm (ur5, panda, ...), an .irml or .urdf path "
+        "or a twin folder (nominal parameters).",
     ),
     out: Path = typer.Option(
-        ..., "--out", help="Twin folder to write (robot.irml, friction.json, card.json)."
+        ...,
+        "--out",
+        help="Twin folder to write (robot.irml, or robot.urdf for a URDF arm; friction.json, card.json).",
     ),
     holdout: float = typer.Option(
         0.2, "--holdout", min=0.0, max=0.8, help="Share of the samples (the last ones) kept out and scored."
@@ -51,6 +55,12 @@ def identify(
         "--payload-com",
         help="X,Y,Z: the payload's centre of mass in the flange (tool0) frame, m (e.g. 0.05,0,0.08).",
     ),
+    unexcited: str = typer.Option(
+        "prior",
+        "--unexcited",
+        help="prior: keep a parameter the logs do not excite at its prior (the nominal description's, "
+        "the robot's friction, else 0), with a warning; refuse: refuse such logs.",
+    ),
     force: bool = typer.Option(False, "--force", help="Replace a twin already in --out."),
     unchecked: bool = unchecked_option(),
 ) -> int:
@@ -65,12 +75,13 @@ def identify(
     torque comes from --payload-log with --payload-mass and --payload-com (a payload of
     known mass), else from the description's nominal masses; the output says which.
     """
-    from joulepath.dynamics import TWIN_CARD_FILE, TWIN_FRICTION_FILE, TWIN_ROBOT_FILE
+    from joulepath.dynamics import TWIN_CARD_FILE, TWIN_FRICTION_FILE, TWIN_ROBOT_FILE, TWIN_URDF_FILE
     from joulepath.energy import TWIN_DRIVES_FILE
     from joulepath.errors import InvalidInput
     from joulepath.identify import (
         IdentifyOptions,
         PayloadReference,
+        UnexcitedParameterWarning,
         data_from_logs,
         identified_drives,
         identify_from_currents,
@@ -83,23 +94,26 @@ def identify(
     com = _payload_options(payload_log, payload_mass, payload_com)
     inputs = [*map(str, logs), *([str(payload_log)] if payload_log else []), *robot_inputs(robot)]
     signal = "current" if payload_log is not None else logged_signal(logs)
-    files: tuple[str, ...] = (TWIN_ROBOT_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE)
+    nominal = load_robot_for_cli(robot, unchecked=unchecked)
+    robot_file = TWIN_ROBOT_FILE if nominal.description is not None else TWIN_URDF_FILE
+    files: tuple[str, ...] = (robot_file, TWIN_FRICTION_FILE, TWIN_CARD_FILE)
     if signal == "current":
         files = (*files, TWIN_DRIVES_FILE)
     check_out_folder(out, files=files, inputs=inputs)
-    existing = [name for name in files if (out / name).exists()]
+    twin_files = (TWIN_ROBOT_FILE, TWIN_URDF_FILE, *files[1:])
+    existing = [name for name in twin_files if (out / name).exists()]
     if existing and not force:
         raise InvalidInput(
             f"{out}: already holds a twin ({', '.join(existing)}); pass --force to replace it, "
             "or choose another --out"
         )
-    nominal = load_robot_for_cli(robot, unchecked=unchecked)
     options = IdentifyOptions(
         offset=offset,
         stribeck_speed=stribeck_speed or None,
         gear_efficiency=gear_efficiency or None,
         max_condition=max_condition,
         holdout=holdout,
+        unexcited=unexcited,
     )
     with console.status(f"reading {len(logs)} log(s)..."):
         data = data_from_logs(logs, nominal, signal=signal)
@@ -108,8 +122,13 @@ def identify(
             payload = PayloadReference(
                 data=data_from_logs([payload_log], nominal, signal="current"), mass=payload_mass, com=com
             )
+    # each parameter kept at its prior is said once below, in one line (not as a Python warning)
     if signal == "current":
-        with console.status(f"identifying drive gains and dynamics from {data.n_samples:,} samples..."):
+        with (
+            console.status(f"identifying drive gains and dynamics from {data.n_samples:,} samples..."),
+            warnings.catch_warnings(),
+        ):
+            warnings.simplefilter("ignore", UnexcitedParameterWarning)
             both = identify_from_currents(data, nominal, options, payload=payload)
         result, gains = both.identification, both.gains
         drives = identified_drives(gains, nominal.drives, nominal.n_joints)
@@ -124,10 +143,13 @@ def identify(
         console.print(f"drive gains k (N·m/A, joint side): {k}", markup=False)
         console.print(f"scale reference: {gains.reference} ({gains.reference_note})", markup=False)
     else:
-        with console.status(f"identifying from {data.n_samples:,} samples..."):
+        with console.status(f"identifying from {data.n_samples:,} samples..."), warnings.catch_warnings():
+            warnings.simplefilter("ignore", UnexcitedParameterWarning)
             result = run(data, nominal, options)
         write_twin(result, nominal, out)
         gains, drives = None, None
+    for kept in result.kept:
+        err_console.print(f"warning: {kept.warning()}", markup=False)
     f = result.fit
     what = "current" if signal == "current" else "torque"
     console.print(

@@ -52,8 +52,9 @@ def train(
     cv: int = typer.Option(5, min=2, help="Folds."),
     inputs: str = typer.Option(
         "",
-        help="physics (raw + nominal model terms) or thesis (raw); "
-        "default: physics with a robot known (--robot or the table's), else thesis.",
+        help="physics (raw + nominal model terms), kinematic (raw + robot-free energy bases) or thesis "
+        "(raw); default: physics with a robot known (--robot or the table's), else kinematic. The grid "
+        "search's CV is grouped by run (the logs of the table; by move for a table of one log).",
     ),
     out: Path = typer.Option(..., "--out", help="Folder for models and reports."),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),
@@ -117,10 +118,13 @@ def train(
     cols = [
         "family",
         "target",
+        "inputs",
+        "cv_groups",
         "cv_grouped_r2",
         "cv_shuffled_r2",
         "test_r2",
         "test_mae",
+        "test_outside_range_pct",
         "path_median_pct",
         "path_p95_pct",
         "best_params",
@@ -133,6 +137,14 @@ def train(
         console.print(
             f"{b['label']}: R² {s['r2']:.4f}, MAE {s['mae']:.4f} J, path error median "
             f"{s['path_median_pct']:.1f} %, {b['latency_per_row_s_batch'] * 1e6:.2f} µs/row",
+            markup=False,
+        )
+    outside = report.results["test_outside_range_pct"]
+    if (outside > 0).any():
+        console.print(
+            f"note: up to {outside.max():.1f} % of the test rows lie outside the training data's range "
+            "(speeds, accelerations, positions, move durations: each card's training_range); their "
+            "predictions are extrapolations",
             markup=False,
         )
     console.print(f"models, results.csv, report.json and plots in {out}")

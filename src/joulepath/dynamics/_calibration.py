@@ -4,7 +4,10 @@ A twin folder (``joulepath identify ... --out twin/``) is a contract declared he
 once, read by :func:`joulepath.load_robot` and written by :mod:`joulepath.identify`:
 
 * :data:`TWIN_ROBOT_FILE` — an IRML robot description with the identified
-  (physically consistent) link masses, centres of mass and inertias;
+  (physically consistent) link masses, centres of mass and inertias; for an arm read
+  from a URDF (a named arm, a ``.urdf`` file) :data:`TWIN_URDF_FILE` instead: the arm as
+  joulepath reads it (locked joints fixed, fixed links merged) written as a serial URDF
+  with the identified inertials. A folder holds one of the two, never both;
 * :data:`TWIN_FRICTION_FILE` — JSON: the identified :class:`IdentifiedFriction`
   and the drives' gear efficiency;
 * :data:`TWIN_CARD_FILE` — JSON: what the twin was identified from and how well it fits.
@@ -27,9 +30,10 @@ from joulepath.energy import motor_side_torque
 from joulepath.errors import InvalidRobotDescription
 
 TWIN_ROBOT_FILE = "robot.irml"
+TWIN_URDF_FILE = "robot.urdf"
 TWIN_FRICTION_FILE = "friction.json"
 TWIN_CARD_FILE = "card.json"
-TWIN_FILES = (TWIN_ROBOT_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE)
+TWIN_FILES = (TWIN_ROBOT_FILE, TWIN_URDF_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE)
 FRICTION_FORMAT = "joulepath-friction/1"
 
 
@@ -181,11 +185,25 @@ def read_calibration(path: str | os.PathLike[str], n_joints: int) -> Calibration
 
 
 def twin_paths(folder: str | os.PathLike[str]) -> tuple[Path, Path]:
-    """The robot and friction files of a twin folder; InvalidRobotDescription if one is missing."""
+    """The robot file (IRML or URDF) and friction file of a twin folder.
+
+    Raises
+    ------
+    InvalidRobotDescription
+        A file is missing, or the folder holds both an IRML and a URDF robot.
+    """
     f = Path(folder)
-    robot, friction = f / TWIN_ROBOT_FILE, f / TWIN_FRICTION_FILE
+    irml, urdf, friction = f / TWIN_ROBOT_FILE, f / TWIN_URDF_FILE, f / TWIN_FRICTION_FILE
+    if irml.is_file() and urdf.is_file():
+        raise InvalidRobotDescription(
+            f"{f}: holds both {TWIN_ROBOT_FILE} and {TWIN_URDF_FILE}; a twin has one robot file: "
+            "remove the one `joulepath identify` did not write"
+        )
+    robot = urdf if urdf.is_file() else irml
     missing = [p.name for p in (robot, friction) if not p.is_file()]
     if missing:
+        if robot is irml and TWIN_ROBOT_FILE in missing:
+            missing[0] = f"{TWIN_ROBOT_FILE} (or {TWIN_URDF_FILE})"
         raise InvalidRobotDescription(
             f"{f}: a folder, but not a twin: {', '.join(missing)} missing "
             "(a twin folder is what `joulepath identify LOG... --out FOLDER` writes)"
@@ -201,6 +219,7 @@ __all__ = [
     "TWIN_FILES",
     "TWIN_FRICTION_FILE",
     "TWIN_ROBOT_FILE",
+    "TWIN_URDF_FILE",
     "motor_torque",
     "read_calibration",
     "twin_paths",

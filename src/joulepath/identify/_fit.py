@@ -29,6 +29,7 @@ Steps (:func:`identify`):
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
@@ -65,6 +66,46 @@ MAX_CONDITION = 1e4
 
 ETA_BOUNDS = (0.5, 1.0)
 
+UNEXCITED = ("prior", "refuse")
+MAX_KEPT_SHARE = 0.25
+"""Logs that would leave more than this share of the parameters at their priors are refused."""
+KEPT_WEIGHT = 1e3
+"""Pull that holds a kept parameter at its prior in the consistent refinement, relative to the
+strongest pull of the data on any parameter."""
+
+
+class UnexcitedParameterWarning(UserWarning):
+    """The logs do not excite a parameter: it keeps its prior value (:attr:`Identification.kept`)."""
+
+
+@dataclass(frozen=True, slots=True)
+class KeptParameter:
+    """A parameter the logs leave unexcited, kept at its prior value.
+
+    Attributes
+    ----------
+    name : str
+        ``link<i>.<parameter>`` (a base parameter, named by its leading column) or
+        ``joint<j>.<term>`` (a friction term).
+    prior : float
+        The value kept (SI: kg, kg·m, kg·m², N·m, N·m·s/rad).
+    prior_source : str
+        Where the value comes from.
+    reason : str
+        Why it is not identified.
+    """
+
+    name: str
+    prior: float
+    prior_source: str
+    reason: str
+
+    def warning(self) -> str:
+        return (
+            f"{self.name} is not excited by the logs ({self.reason}): kept at its prior {self.prior:.4g} "
+            f"({self.prior_source}); log moves that excite it to identify it"
+        )
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class IdentifyOptions:
@@ -91,6 +132,14 @@ class IdentifyOptions:
         Refuse data whose stacked, column-normalised regressor has a larger condition number.
     holdout : float
         Share of the samples (the last ones, in log order) kept out of the fit and scored.
+    unexcited : {"prior", "refuse"}
+        What to do when the logs leave parameters unexcited (the condition number over
+        ``max_condition``). ``"prior"``: keep the least excited parameter at its prior
+        value (a base parameter at the nominal description's, a friction term at the
+        robot's friction, else 0), one by one until the rest is conditioned within
+        ``max_condition``, with an :class:`UnexcitedParameterWarning` naming each
+        (:attr:`Identification.kept`); refused when that would keep more than
+        :data:`MAX_KEPT_SHARE` of the parameters. ``"refuse"``: refuse the logs.
     rest_speed : float
         rad/s: a sample whose every joint speed is within this counts as the arm at rest
         for the side of the gear losses (:func:`gear_side_speed`): logged speeds that small
@@ -106,6 +155,7 @@ class IdentifyOptions:
     prior_weight: float = 1e-4
     max_condition: float = MAX_CONDITION
     holdout: float = 0.0
+    unexcited: str = "prior"
     rest_speed: float = GEAR_REST_SPEED
 
     def __post_init__(self) -> None:
@@ -123,6 +173,8 @@ class IdentifyOptions:
             raise InvalidInput(f"holdout must be a share in [0, 0.9), got {self.holdout}")
         if not (math.isfinite(self.rest_speed) and self.rest_speed >= 0):
             raise InvalidInput(f"rest_speed must be a speed ≥ 0 in rad/s, got {self.rest_speed}")
+        if self.unexcited not in UNEXCITED:
+            raise InvalidInput(f"unexcited must be one of {UNEXCITED}, got {self.unexcited!r}")
         if not self.max_condition > 1 or not self.prior_weight >= 0:
             raise InvalidInput("max_condition must be > 1 and prior_weight ≥ 0")
 
@@ -186,6 +238,7 @@ class Identification:
     options: IdentifyOptions
     data_hash: str = ""
     sources: tuple[str, ...] = field(default=())
+    kept: tuple[KeptParameter, ...] = field(default=())
 
     @property
     def beta(self) -> FloatArray:
@@ -218,6 +271,7 @@ class Identification:
             "fit": asdict(self.fit),
             "held_out": None if self.held_out is None else asdict(self.held_out),
             "options": asdict(self.options),
+            "kept_at_prior": [asdict(k) for k in self.kept],
             "base_parameters": {name: float(v) for name, v in zip(self.base.names, self.beta, strict=True)},
             "base_parameters_least_squares": {
                 name: float(v) for name, v in zip(self.base.names, self.beta_ls, strict=True)
@@ -273,16 +327,56 @@ def _check_motion(data: IdentificationData, n_params: int) -> None:
         )
 
 
-def _excitation(A: FloatArray, names: tuple[str, ...]) -> tuple[float, str]:
-    """Condition number of ``A`` (rows x params) with unit-norm columns, and the least excited parameter."""
+def _excitation(A: FloatArray) -> tuple[float, int]:
+    """Condition number of ``A`` (rows x params) with unit-norm columns, and the least excited column."""
     norms = np.linalg.norm(A, axis=0)
     zero = np.nonzero(norms == 0)[0]
     if zero.size:
-        return float("inf"), names[int(zero[0])]
+        return float("inf"), int(zero[0])
     R = scipy.linalg.qr(A / norms, mode="r")[0][: A.shape[1]]
     _, s, vt = np.linalg.svd(R)
     cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
-    return cond, names[int(np.argmax(np.abs(vt[-1])))]
+    return cond, int(np.argmax(np.abs(vt[-1])))
+
+
+def _least_excited(A: FloatArray, known: FloatArray) -> tuple[float, int]:
+    """Like :func:`_excitation`, but the column to keep at its prior: of the columns that make up the
+    weakest direction (at least half the largest share), one whose prior is known (``known``)
+    before one whose prior is a bare 0; of those alike (within 1 %, e.g. Coulomb and offset of a
+    joint turning one way), the later column (the offset, the outer link), so that the earlier one
+    is identified."""
+    norms = np.linalg.norm(A, axis=0)
+    if np.any(norms == 0):
+        return _excitation(A)
+    R = scipy.linalg.qr(A / norms, mode="r")[0][: A.shape[1]]
+    _, s, vt = np.linalg.svd(R)
+    cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+    share = np.abs(vt[-1])
+    part = np.nonzero(share >= 0.5 * share.max())[0]
+    if np.any(known[part]):
+        part = part[known[part]]
+    tied = part[share[part] >= 0.99 * share[part].max()]
+    return cond, int(tied[-1])
+
+
+def _select_kept(
+    Aw: FloatArray, kept: list[int], options: IdentifyOptions, known: FloatArray
+) -> tuple[list[int], float, int]:
+    """Columns to keep at their priors (``kept`` plus the least excited, one by one), the condition
+    number of the rest and its least excited column. ``"refuse"`` adds none; neither adds beyond
+    :data:`MAX_KEPT_SHARE` of the columns (the caller refuses then)."""
+    p = Aw.shape[1]
+    kept = list(kept)
+    while True:
+        free = [i for i in range(p) if i not in kept]
+        cond, weak = _least_excited(Aw[:, free], known[free])
+        if (
+            cond <= options.max_condition
+            or options.unexcited == "refuse"
+            or len(kept) + 1 > MAX_KEPT_SHARE * p
+        ):
+            return kept, cond, free[weak]
+        kept.append(free[weak])
 
 
 def r2_per_joint(measured: FloatArray, predicted: FloatArray) -> FloatArray:
@@ -346,18 +440,24 @@ def search_eta(cost: Callable[[float], float], fixed: float | None) -> float:
 class _Problem:
     """The stacked weighted least-squares problem of one data set."""
 
-    def __init__(self, A: FloatArray, tau: FloatArray, qd: FloatArray) -> None:
-        self.A, self.tau, self.qd = A, tau, qd  # A: (N, n, p)
+    def __init__(self, A: FloatArray, tau: FloatArray, qd: FloatArray, prior: FloatArray) -> None:
+        self.A, self.tau, self.qd, self.prior = A, tau, qd, prior  # A: (N, n, p); prior: (p,)
         self.n = tau.shape[1]
 
-    def solve(self, w: FloatArray, eta: float | None) -> tuple[float, FloatArray]:
+    def solve(self, w: FloatArray, eta: float | None, kept: list[int]) -> tuple[float, FloatArray]:
+        """The gear efficiency and parameters of least weighted residual, ``kept`` at their priors."""
         N, n, p = self.A.shape
-        Aw = (self.A * w[None, :, None]).reshape(-1, p)
+        free = np.array([i for i in range(p) if i not in kept], dtype=int)
+        fixed = np.zeros(p)
+        fixed[kept] = self.prior[kept]
+        known = self.A @ fixed
+        Aw = (self.A[:, :, free] * w[None, :, None]).reshape(-1, free.size)
         pinv = np.linalg.pinv(Aw)
 
         def fit(e: float) -> tuple[float, FloatArray]:
-            target = joint_side(self.tau, self.qd, e)
-            x = pinv @ (target * w).ravel()
+            target = joint_side(self.tau, self.qd, e) - known
+            x = fixed.copy()
+            x[free] = pinv @ (target * w).ravel()
             pred = motor_torque(self.A @ x, self.qd, e)
             return float((((pred - self.tau) * w) ** 2).sum()), x
 
@@ -404,7 +504,12 @@ def _consistent(
     prior: FloatArray,
     lower_f: FloatArray,
     prior_weight: float,
+    held: tuple[FloatArray, FloatArray, FloatArray],
+    f_fixed: dict[int, float],
 ) -> tuple[FloatArray, FloatArray]:
+    """``held = (G, g, scale)``: rows ``G @ phi = g`` held with weight :data:`KEPT_WEIGHT` (base
+    parameters kept at their priors, each row divided by its scale); ``f_fixed``: friction
+    coefficients (by index) kept at these values, not searched."""
     N, n, n_phi = Y.shape
     A = np.concatenate([Y, F], axis=2) * w[None, :, None]
     b = (tau_joint * w).reshape(-1, 1)
@@ -414,15 +519,28 @@ def _consistent(
     scale = _prior_scale(prior)
     links = n_phi // 10
     reg = np.sqrt(prior_weight * N * n)
+    G, g, g_scale = held
+    hold = KEPT_WEIGHT * float(np.abs(R).max()) * g_scale  # per unit of the parameter, 1e3 x the data's
+
+    n_f = start_f.size
+    free_f = np.array([k for k in range(n_f) if k not in f_fixed], dtype=int)
+    f_all = np.zeros(n_f)
+    for k, v in f_fixed.items():
+        f_all[k] = v
 
     def phi_of(z: FloatArray) -> FloatArray:
         return np.concatenate([from_log_cholesky(z[10 * i : 10 * i + 10]) for i in range(links)])
 
+    def f_of(z: FloatArray) -> FloatArray:
+        out = f_all.copy()
+        out[free_f] = z[10 * links :]
+        return out
+
     def residual(z: FloatArray) -> FloatArray:
         with np.errstate(all="ignore"):  # trial steps far out (exp overflow) just read as very bad
             phi = phi_of(z)
-            x = np.concatenate([phi, z[10 * links :]])
-            out = np.concatenate([R @ x - c, reg * (phi - prior) / scale])
+            x = np.concatenate([phi, f_of(z)])
+            out = np.concatenate([R @ x - c, reg * (phi - prior) / scale, hold * (G @ phi - g) / g_scale])
         clean: FloatArray = np.nan_to_num(out, nan=1e150, posinf=1e150, neginf=-1e150)
         return clean
 
@@ -430,14 +548,64 @@ def _consistent(
         theta0 = np.concatenate([to_log_cholesky(start_phi[10 * i : 10 * i + 10]) for i in range(links)])
     except np.linalg.LinAlgError:
         theta0 = np.concatenate([to_log_cholesky(prior[10 * i : 10 * i + 10]) for i in range(links)])
-    f0 = np.maximum(start_f, lower_f + 1e-9)
+    f0 = np.maximum(start_f, lower_f + 1e-9)[free_f]
     z0 = np.concatenate([theta0, f0])
-    lo = np.concatenate([np.full(theta0.size, -np.inf), lower_f])
+    lo = np.concatenate([np.full(theta0.size, -np.inf), lower_f[free_f]])
     # a trial step the residual marks with its 1e150 sentinel overflows in the solver's cost
     # (0.5 f·f); the solver rejects that step, so the overflow is no error
     with np.errstate(over="ignore"):
         sol = least_squares(residual, z0, bounds=(lo, np.inf), method="trf", x_scale="jac", max_nfev=300)
-    return phi_of(sol.x), sol.x[10 * links :]
+    return phi_of(sol.x), f_of(sol.x)
+
+
+def _prior_values(
+    robot: Robot, base: BaseParameters, prior: FloatArray, terms: tuple[str, ...]
+) -> tuple[FloatArray, list[str], FloatArray]:
+    """Prior value of every column of ``[Y_b | F]``, where it comes from, and whether it is known.
+
+    Base parameters: the nominal description's. Friction: the robot's own friction
+    where it has the term (an identified twin's, or Coulomb and viscous levels of a
+    friction file), else 0 (none known).
+    """
+    n = robot.n_joints
+    beta = base.project(prior)
+    values = list(beta)
+    sources = [f"nominal description of {robot.name}"] * base.n
+    known = [True] * base.n
+    friction = robot.friction
+    for t in terms:
+        level = getattr(friction, t, None) if friction is not None else None
+        arr = None
+        if level is not None:
+            try:
+                arr = np.broadcast_to(np.asarray(level, dtype=float).ravel(), (n,))
+            except ValueError:
+                arr = None
+        if arr is None or not np.all(np.isfinite(arr)):
+            values.extend([0.0] * n)
+            why = "no friction known" if friction is None else f"the robot's friction gives no {t} level"
+            sources.extend([f"0: {why} ({robot.friction_note})"] * n)
+            known.extend([False] * n)
+        else:
+            values.extend(float(v) for v in arr)
+            sources.extend([f"the robot's friction ({robot.friction_note})"] * n)
+            known.extend([True] * n)
+    return np.array(values), sources, np.array(known)
+
+
+def _held_rows(
+    base: BaseParameters, kept: list[int], prior_x: FloatArray
+) -> tuple[tuple[FloatArray, FloatArray, FloatArray], dict[int, float]]:
+    """Rows ``G phi = g`` (with scales) that hold the kept base parameters at their priors, and the
+    kept friction coefficients (index into the friction columns: value)."""
+    B = base.matrix()
+    rows = [i for i in kept if i < base.n]
+    floors = np.array([0.1, 0.01, 0.01, 0.01, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
+    scale = np.array(
+        [max(abs(float(prior_x[i])), floors[int(base.independent[i]) % 10]) for i in rows], dtype=float
+    )
+    friction = {i - base.n: float(prior_x[i]) for i in kept if i >= base.n}
+    return (B[rows], prior_x[rows], scale), friction
 
 
 def identify(
@@ -481,24 +649,51 @@ def identify(
     A = np.concatenate([Y[:, :, base.independent], F], axis=2)
     names = (*base.names, *(f"joint{j + 1}.{t}" for t in terms for j in range(n)))
     side = gear_side_speed(fit_data.qd, options.rest_speed)
-    problem = _Problem(A, fit_data.tau, side)
+    prior = true_parameters(robot)
+    prior_x, prior_sources, prior_known = _prior_values(robot, base, prior, terms)
+    problem = _Problem(A, fit_data.tau, side, prior_x)
     w = np.ones(n)
-    eta, x = problem.solve(w, options.gear_efficiency)
+    kept: list[int] = []
+    if options.unexcited == "prior":
+        kept = _select_kept(A.reshape(-1, A.shape[2]), kept, options, prior_known)[0]
+    eta, x = problem.solve(w, options.gear_efficiency, kept)
     if options.weighted:
         res = motor_torque(A @ x, side, eta) - fit_data.tau
         sigma = np.sqrt((res**2).mean(axis=0))
         sigma = np.maximum(sigma, 1e-6 * max(float(sigma.max()), 1e-12))
         w = 1.0 / sigma
-        eta, x = problem.solve(w, options.gear_efficiency)
-    cond, weakest = _excitation((A * w[None, :, None]).reshape(-1, A.shape[2]), names)
+        eta, x = problem.solve(w, options.gear_efficiency, kept)
+    Aw = (A * w[None, :, None]).reshape(-1, A.shape[2])
+    more, cond, weak = _select_kept(Aw, kept, options, prior_known)
+    if more != kept:
+        kept = more
+        eta, x = problem.solve(w, options.gear_efficiency, kept)
+    weakest = names[weak]
     if not cond <= options.max_condition:
+        also = (
+            f" (even with {len(kept)} parameter(s) kept at their priors, at most "
+            f"{int(MAX_KEPT_SHARE * 100)} % may be)"
+            if options.unexcited == "prior"
+            else ""
+        )
         raise InvalidInput(
             f"the logs do not excite the dynamics enough to identify them: condition number {cond:.3g} of "
-            f"the stacked regressor (limit {options.max_condition:.3g}); least excited: {weakest}; log more "
-            "varied moves (other speeds, ranges and joint combinations) and identify again"
+            f"the stacked regressor (limit {options.max_condition:.3g}){also}; least excited: {weakest}; "
+            "log more varied moves (other speeds, ranges and joint combinations) and identify again"
         )
+    kept_parameters = tuple(
+        KeptParameter(
+            name=names[i],
+            prior=float(prior_x[i]),
+            prior_source=prior_sources[i],
+            reason="with it free, the stacked regressor's condition number is over "
+            f"{options.max_condition:.3g}",
+        )
+        for i in kept
+    )
+    for k in kept_parameters:
+        warnings.warn(k.warning(), UnexcitedParameterWarning, stacklevel=2)
     beta_ls, f_ls = x[: base.n], x[base.n :]
-    prior = true_parameters(robot)
     phi = _lift(base, beta_ls, prior)
     f = f_ls
     if options.consistent:
@@ -513,6 +708,7 @@ def identify(
             prior,
             lower_f,
             options.prior_weight,
+            *_held_rows(base, kept, prior_x),
         )
     friction = _friction_of(f, terms, n, options)
     eig = min_eigenvalues(phi)
@@ -538,6 +734,7 @@ def identify(
         options=options,
         data_hash=data.data_hash,
         sources=data.sources,
+        kept=kept_parameters,
     )
 
 
@@ -547,10 +744,14 @@ __all__ = [
     "FitScores",
     "Identification",
     "IdentifyOptions",
+    "KeptParameter",
     "MAX_CONDITION",
+    "MAX_KEPT_SHARE",
     "REST_SPEED",
-    "identify",
+    "UNEXCITED",
+    "UnexcitedParameterWarning",
     "gear_side_speed",
+    "identify",
     "joint_side",
     "r2_per_joint",
     "score_prediction",

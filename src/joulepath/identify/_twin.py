@@ -6,10 +6,18 @@ and read back by :func:`joulepath.load_robot`:
 * ``robot.irml`` — the nominal description (kinematics, limits, range sets) with
   each link's identified mass, centre of mass and inertia (a payload logged with the
   robot is part of the last link; the description has no separate payload);
+* ``robot.urdf`` instead, for an arm read from a URDF (a named arm such as ``ur5``, a
+  ``.urdf`` file): the arm's chain as joulepath reads it (kinematics and limits of the
+  nominal URDF, locked joints fixed, fixed links merged) with the identified inertials,
+  written as a serial URDF (:func:`joulepath.identify._urdf.chain_urdf_string`); the
+  nominal URDF (with its meshes) is the one ``twin_of`` names;
 * ``friction.json`` — identified friction and gear efficiency;
 * ``card.json`` — data hash, fit and held-out scores, condition number, base parameters,
-  and ``parameters``: per joint and per parameter what the logs identified and what was
-  assumed or taken as given, with why and from where (:func:`parameter_report`);
+  ``robot_file`` (which of the two robot files the folder holds), ``kept_at_prior`` (the
+  parameters the logs left unexcited, each with its prior, where the prior comes from and
+  why: :attr:`~joulepath.identify.Identification.kept`), and ``parameters``: per joint and
+  per parameter what the logs identified and what was assumed or taken as given, with why
+  and from where (:func:`parameter_report`);
 * ``drives.toml`` — only for a twin identified from motor currents: the identified
   joint-side torque constants and gear efficiency, the other drive data as the nominal
   robot's drives file gives them (:func:`joulepath.identify.identified_drives`), in
@@ -26,12 +34,15 @@ from typing import Any
 
 import numpy as np
 
-from joulepath._io import atomic_write_text, check_replaceable, finite_json, make_folder
+from joulepath._io import atomic_write_text, check_replaceable, finite_json, make_folder, remove_output
 from joulepath.description import (
+    NAMED_ARMS,
     PRESETS,
+    Chain,
     Inertial,
     RobotDescription,
     chain_from_description,
+    named_arm_path,
     preset_path,
     transform_inertial,
 )
@@ -40,6 +51,7 @@ from joulepath.dynamics import (
     TWIN_CARD_FILE,
     TWIN_FRICTION_FILE,
     TWIN_ROBOT_FILE,
+    TWIN_URDF_FILE,
     Calibration,
     Robot,
 )
@@ -47,6 +59,7 @@ from joulepath.energy import TWIN_DRIVES_FILE, DriveModel, drives_toml
 from joulepath.errors import InvalidInput
 from joulepath.identify._currents import DriveGainFit
 from joulepath.identify._fit import Identification
+from joulepath.identify._urdf import chain_urdf_string
 
 CARD_FORMAT = "joulepath-twin-card/1"
 
@@ -79,7 +92,7 @@ def twin_description(nominal: RobotDescription, ident: Identification) -> RobotD
 
 
 def load_name(robot: Robot) -> str | None:
-    """What :func:`joulepath.load_robot` loads ``robot`` by: a bundled name, else its file (resolved)."""
+    """What :func:`joulepath.load_robot` loads ``robot`` by: a bundled or named arm, else its file."""
     if robot.calibration is not None:
         return robot.calibration.twin_of
     if robot.source is None:
@@ -87,22 +100,42 @@ def load_name(robot: Robot) -> str | None:
     for name in PRESETS:
         if Path(robot.source).resolve() == preset_path(name).resolve():
             return name
+    if robot.name in NAMED_ARMS and Path(robot.source).resolve() == named_arm_path(robot.name).resolve():
+        return robot.name
     return str(Path(robot.source).resolve())
 
 
-def twin_robot(nominal: Robot, ident: Identification) -> Robot:
-    """The identified robot, usable wherever a robot is (its friction is :attr:`Robot.friction`)."""
-    if nominal.description is None:
+def twin_chain(nominal: Robot, ident: Identification) -> Chain:
+    """The nominal robot's chain with every link's mass properties replaced by the identified ones."""
+    if nominal.n_joints * 10 != ident.phi.size:
         raise InvalidInput(
-            f"robot {nominal.name!r} comes from a URDF; a twin is written as IRML and needs an IRML "
-            "robot (e.g. a bundled one) as its nominal description"
+            f"the identification has {ident.phi.size // 10} links but robot {nominal.name!r} has "
+            f"{nominal.n_joints}"
         )
-    desc = twin_description(nominal.description, ident)
+    bodies = link_inertials(ident.phi)
+    return replace(
+        nominal.chain,
+        masses=np.array([b.mass for b in bodies]),
+        coms=np.array([b.com_array for b in bodies]),
+        inertias=np.array([b.inertia_array for b in bodies]),
+    )
+
+
+def twin_robot(nominal: Robot, ident: Identification) -> Robot:
+    """The identified robot, usable wherever a robot is (its friction is :attr:`Robot.friction`).
+
+    An IRML robot's twin keeps its description (range sets, info) with the identified
+    inertials; a URDF robot's twin is its chain with the identified inertials
+    (written as ``robot.urdf`` by :func:`write_twin`).
+    """
     calibration = Calibration(
         friction=ident.friction,
         gear_efficiency=ident.gear_efficiency,
         twin_of=load_name(nominal),
     )
+    if nominal.description is None:
+        return Robot(twin_chain(nominal, ident), source=f"twin of {nominal.name}", calibration=calibration)
+    desc = twin_description(nominal.description, ident)
     return Robot(
         chain_from_description(desc),
         description=desc,
@@ -117,7 +150,8 @@ def parameter_report(
     """Per joint and per parameter: what the logs identified, what was assumed, what was given.
 
     Each parameter is a dict with ``status``: ``"identified"`` (from these logs),
-    ``"assumed"`` (the logs do not fix it; ``reason`` says why, ``prior`` where the value
+    ``"assumed"`` (the logs do not fix it, e.g. a parameter they leave unexcited, kept at
+    its prior (:attr:`Identification.kept`); ``reason`` says why, ``prior`` where the value
     comes from), ``"given"`` (not identifiable from positions and currents: taken from
     ``source``, the drives file or an option) or ``"not modelled"``.
 
@@ -139,25 +173,38 @@ def parameter_report(
     options = ident.options
     eta_status = "given" if options.gear_efficiency is not None else "identified"
     out: list[dict[str, Any]] = []
+    kept = {k.name: k for k in ident.kept}
+
+    def term(j: int, name: str, value: float, **more: Any) -> dict[str, Any]:
+        k = kept.get(f"joint{j + 1}.{name}")
+        if k is not None:
+            return {"status": "assumed", "value": value, "prior": k.prior_source, "reason": k.reason}
+        return {"status": "identified", "value": value, **more}
+
     for j in range(n):
         names = [b for b in ident.base.names if b.startswith(f"link{j + 1}.")]
+        held = [b for b in names if b in kept]
+        found = [b for b in names if b not in kept]
+        inertia: dict[str, Any] = {
+            "status": "identified" if found else "assumed" if held else "not identifiable",
+            "base_parameters": found,
+            "note": "the logs fix these base parameters of the link (combinations with the links "
+            "after it); what they leave open follows the nominal description",
+        }
+        if held:
+            inertia["kept_at_prior"] = held
+            inertia["prior"] = kept[held[0]].prior_source
+            inertia["reason"] = "not excited by the logs: " + kept[held[0]].reason
         row: dict[str, Any] = {
             "joint": j + 1,
-            "inertia": {
-                "status": "identified" if names else "not identifiable",
-                "base_parameters": names,
-                "note": "the logs fix these base parameters of the link (combinations with the links "
-                "after it); what they leave open follows the nominal description",
-            },
-            "coulomb": {"status": "identified", "value": f.coulomb[j]},
-            "viscous": {"status": "identified", "value": f.viscous[j]},
+            "inertia": inertia,
+            "coulomb": term(j, "coulomb", f.coulomb[j]),
+            "viscous": term(j, "viscous", f.viscous[j]),
             "offset": (
-                {"status": "identified", "value": f.offset[j]}
-                if options.offset
-                else {"status": "not modelled", "value": 0.0}
+                term(j, "offset", f.offset[j]) if options.offset else {"status": "not modelled", "value": 0.0}
             ),
             "stribeck": (
-                {"status": "identified", "value": f.stribeck[j], "speed": f.stribeck_speed}
+                term(j, "stribeck", f.stribeck[j], speed=f.stribeck_speed)
                 if options.stribeck_speed
                 else {"status": "not modelled", "value": 0.0}
             ),
@@ -204,19 +251,35 @@ def write_twin(
 
     robot = twin_robot(nominal, ident)
     folder = Path(out)
-    names = (TWIN_ROBOT_FILE, TWIN_FRICTION_FILE, TWIN_CARD_FILE, *((TWIN_DRIVES_FILE,) if drives else ()))
+    robot_file = TWIN_ROBOT_FILE if robot.description is not None else TWIN_URDF_FILE
+    names = (robot_file, TWIN_FRICTION_FILE, TWIN_CARD_FILE, *((TWIN_DRIVES_FILE,) if drives else ()))
     paths = [folder / name for name in names]
     if drives is not None and drives.n_joints != nominal.n_joints:
         raise InvalidInput(
             f"drive data of {drives.n_joints} joints for the {nominal.n_joints} of {nominal.name!r}"
         )
-    for p in paths:
+    other = folder / (TWIN_URDF_FILE if robot_file == TWIN_ROBOT_FILE else TWIN_ROBOT_FILE)
+    for p in (*paths, other):
         check_replaceable(p)
     make_folder(folder)
-    assert robot.description is not None and robot.calibration is not None
-    card = {"format": CARD_FORMAT, "twin_of": robot.calibration.twin_of, **ident.card(), **(extra or {})}
+    remove_output(other)  # a twin written before of the other kind: one robot file per folder
+    assert robot.calibration is not None
+    card = {
+        "format": CARD_FORMAT,
+        "twin_of": robot.calibration.twin_of,
+        "robot_file": robot_file,
+        **ident.card(),
+        **(extra or {}),
+    }
     card["parameters"] = parameter_report(ident, gains=gains, drives=drives)
-    atomic_write_text(paths[0], irml_string(robot.description))
+    if robot.description is not None:
+        atomic_write_text(paths[0], irml_string(robot.description))
+    else:
+        note = (
+            f"twin of {robot.calibration.twin_of or nominal.name} written by joulepath identify: the "
+            "nominal kinematics and limits with identified inertials; friction and drives beside it"
+        )
+        atomic_write_text(paths[0], chain_urdf_string(robot.chain, comment=note))
     atomic_write_text(paths[1], json.dumps(robot.calibration.to_json(), indent=2) + "\n")
     atomic_write_text(paths[2], json.dumps(finite_json(card), indent=2, default=_jsonable) + "\n")
     if drives is not None:
@@ -241,6 +304,7 @@ __all__ = [
     "link_inertials",
     "load_name",
     "parameter_report",
+    "twin_chain",
     "twin_description",
     "twin_robot",
     "write_twin",

@@ -10,7 +10,14 @@ from joulepath.learn._families import (
     grid_for,
     make_pipeline,
 )
-from joulepath.learn._features import INPUTS, PhysicsFeatures, input_columns, physics_transform
+from joulepath.learn._features import (
+    INPUTS,
+    KinematicFeatures,
+    PhysicsFeatures,
+    input_columns,
+    kinematic_transform,
+    physics_transform,
+)
 from joulepath.learn._importance import feature_importance, plot_importance, rank_joints
 from joulepath.learn._model import TRUSTED_TYPES, EnergyModel, check_finite_predictions
 from joulepath.learn._search import CandidateResult, SearchResult, grid_search, make_splits
@@ -21,8 +28,11 @@ from joulepath.learn._train import (
     TrainingReport,
     best_model,
     choose_inputs,
+    cv_groups,
     load_models,
+    run_ids,
     train,
+    training_range,
 )
 from joulepath.learn._validate import read_joints_json
 
@@ -33,6 +43,7 @@ __all__ = [
     "GRIDS",
     "INPUTS",
     "KERNEL_SVR_MAX_ROWS",
+    "KinematicFeatures",
     "NO_ROBOT_NOTE",
     "PhysicsFeatures",
     "QUICK_GRIDS",
@@ -48,10 +59,12 @@ __all__ = [
     "best_model",
     "check_finite_predictions",
     "choose_inputs",
+    "cv_groups",
     "feature_importance",
     "grid_for",
     "grid_search",
     "input_columns",
+    "kinematic_transform",
     "load_models",
     "make_pipeline",
     "make_splits",
@@ -62,6 +75,8 @@ __all__ = [
     "plot_importance",
     "rank_joints",
     "read_joints_json",
+    "run_ids",
     "score",
     "train",
+    "training_range",
 ]

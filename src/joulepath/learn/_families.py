@@ -5,7 +5,7 @@ liblinear (``LinearSVR``, squared epsilon-insensitive loss) and the other kernel
 :data:`~joulepath.learn.KERNEL_SVR_MAX_ROWS` sampled rows, so the thesis grid runs
 on the thesis' table sizes.
 
-Every family is a scikit-learn Pipeline: [PhysicsFeatures →] StandardScaler →
+Every family is a scikit-learn Pipeline: [PhysicsFeatures or KinematicFeatures →] StandardScaler →
 estimator (XGBoost trees need no scaling and get none, so the fitted booster can be
 saved in XGBoost's own JSON format). Grid keys are written ``model__param``.
 
@@ -28,7 +28,7 @@ from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
 
 from joulepath.errors import InvalidInput, MissingDependency
-from joulepath.learn._features import PhysicsFeatures
+from joulepath.learn._features import KinematicFeatures, PhysicsFeatures
 from joulepath.learn._svr import ScalableSVR
 
 FAMILIES = ("mlp", "svr", "par", "xgb")
@@ -153,8 +153,10 @@ def make_pipeline(
         if robot is None:
             raise InvalidInput("physics inputs need the robot of the data; give robot=<name or path>")
         steps.append(("physics", PhysicsFeatures(robot=robot, columns=columns)))
+    elif inputs == "kinematic":
+        steps.append(("kinematic", KinematicFeatures(columns=columns)))
     elif inputs != "thesis":
-        raise InvalidInput(f"inputs must be 'thesis' or 'physics', got {inputs!r}")
+        raise InvalidInput(f"inputs must be 'thesis', 'physics' or 'kinematic', got {inputs!r}")
     if family != "xgb":
         steps.append(("scale", StandardScaler()))
     steps.append(("model", _estimator(family, seed)))

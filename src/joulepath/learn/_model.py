@@ -35,7 +35,13 @@ from joulepath._io import atomic_write_bytes, atomic_write_text, make_folder
 from joulepath._typing import FloatArray
 from joulepath.data._schema import card_joints
 from joulepath.errors import InvalidModel, MissingDependency
-from joulepath.learn._features import PHYSICS_VERSION, PhysicsFeatures, physics_transform
+from joulepath.learn._features import (
+    PHYSICS_VERSION,
+    KinematicFeatures,
+    PhysicsFeatures,
+    kinematic_transform,
+    physics_transform,
+)
 from joulepath.learn._svr import ScalableSVR
 from joulepath.learn._validate import (
     check_card,
@@ -49,6 +55,7 @@ from joulepath.learn._validate import (
 CARD_VERSION = 1
 TRUSTED_TYPES = frozenset(
     {
+        "joulepath.learn._features.KinematicFeatures",
         "joulepath.learn._features.PhysicsFeatures",
         "joulepath.learn._svr.ScalableSVR",
         "sklearn.neural_network._stochastic_optimizers.AdamOptimizer",
@@ -90,7 +97,7 @@ def library_versions() -> dict[str, str]:
 class _Forward:
     """The fitted arrays of an MLP pipeline, for a NumPy forward pass."""
 
-    physics: PhysicsFeatures | None
+    physics: PhysicsFeatures | KinematicFeatures | None
     mean: FloatArray
     scale: FloatArray
     weights: tuple[FloatArray, ...]
@@ -139,7 +146,7 @@ class EnergyModel:
         scaler = steps.get("scale")
         if model is None or scaler is None:
             return None
-        physics = steps.get("physics")
+        physics = steps.get("physics", steps.get("kinematic"))
         mean = np.asarray(scaler.mean_, float)
         scale = np.asarray(scaler.scale_, float)
         family = self.card.get("family")
@@ -179,6 +186,35 @@ class EnergyModel:
                 f"{self.card['inputs']!r})"
             )
 
+    def outside_training_range(self, frame: pd.DataFrame) -> np.ndarray:
+        """Per row: whether it lies beyond the data the model was trained on (bool, ``(n_rows,)``).
+
+        A row is outside when a joint's position is beyond the range of the training
+        data, or its speed or acceleration beyond the largest trained on (1 % margin), or
+        when it belongs to a move (``move_id``, ``t``) longer or shorter than every
+        training move. Predictions there are extrapolations: the card's scores do not
+        hold for them. All False for a model whose card has no ``training_range``.
+        """
+        covered = self.card.get("training_range")
+        out = np.zeros(len(frame), dtype=bool)
+        if not isinstance(covered, dict):
+            return out
+        n = len(covered.get("speed_max_rad_s", []))
+        cols = {p: [f"{p}{i}" for i in range(1, n + 1)] for p in ("q", "dq", "ddq")}
+        if all(c in frame.columns for names in cols.values() for c in names):
+            q = frame[cols["q"]].to_numpy(dtype=np.float64)
+            lo, hi = np.asarray(covered["q_min_rad"]), np.asarray(covered["q_max_rad"])
+            pad = 0.01 * (hi - lo)
+            out |= np.any((q < lo - pad) | (q > hi + pad), axis=1)
+            for p, key in (("dq", "speed_max_rad_s"), ("ddq", "acceleration_max_rad_s2")):
+                values = np.abs(frame[cols[p]].to_numpy(dtype=np.float64))
+                out |= np.any(values > 1.01 * np.asarray(covered[key]), axis=1)
+        if "move_id" in frame.columns and "t" in frame.columns and "move_duration_s" in covered:
+            shortest, longest = covered["move_duration_s"]
+            span = frame.groupby("move_id")["t"].transform(lambda t: t.max() - t.min()).to_numpy()
+            out |= (span < 0.99 * shortest) | (span > 1.01 * longest)
+        return out
+
     def predict(self, frame: pd.DataFrame) -> FloatArray:
         """Predict from an energy-table DataFrame (columns checked by name)."""
         self.check_frame(frame)
@@ -199,7 +235,9 @@ class EnergyModel:
             )
         f = self._forward
         if f is not None:
-            if f.physics is not None:
+            if isinstance(f.physics, KinematicFeatures):
+                X = kinematic_transform(X, f.physics.index_)
+            elif f.physics is not None:
                 X = physics_transform(X, f.physics.index_, f.physics._robot())
             z = (X - f.mean) / f.scale
             act = _ACTIVATIONS[f.activation]
@@ -209,8 +247,9 @@ class EnergyModel:
             return out
         if self.family == "xgb":
             steps = dict(self.pipeline.steps)
-            if "physics" in steps:
-                X = steps["physics"].transform(X)
+            for name in ("physics", "kinematic"):
+                if name in steps:
+                    X = steps[name].transform(X)
             booster = steps["model"].get_booster()
             return np.asarray(booster.inplace_predict(X), dtype=np.float64)
         return np.asarray(self.pipeline.predict(X), dtype=np.float64)
@@ -303,6 +342,8 @@ class EnergyModel:
                 phys = PhysicsFeatures(robot=card["robot_source"], columns=cols)
                 phys.fit(np.zeros((1, len(cols))))
                 steps.append(("physics", phys))
+            elif card["inputs"] == "kinematic":
+                steps.append(("kinematic", KinematicFeatures(columns=cols).fit(np.zeros((1, len(cols))))))
             steps.append(("model", model))
             return cls(Pipeline(steps), card, source=src)
         if not isinstance(card["file"], str) or not card["file"].endswith(".skops"):

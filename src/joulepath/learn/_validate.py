@@ -35,7 +35,7 @@ from joulepath.data import FEATURE_SETS, target_columns
 from joulepath.data._schema import MAX_JOINTS, card_joints
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._families import FAMILIES
-from joulepath.learn._features import INPUTS, input_columns, n_physics_terms
+from joulepath.learn._features import INPUTS, input_columns, n_kinematic_terms, n_physics_terms
 
 _ROOT_PARENT = 2147483647
 """What XGBoost writes as the parent of a tree's root."""
@@ -48,8 +48,12 @@ def input_columns_sha256(columns: Sequence[str]) -> str:
 
 
 def n_model_features(n_inputs: int, inputs: str, n_joints: int = 6) -> int:
-    """Columns the estimator sees: the inputs, plus the physics terms for ``inputs="physics"``."""
-    return n_inputs + (n_physics_terms(n_joints) if inputs == "physics" else 0)
+    """Columns the estimator sees: the inputs, plus the physics (or kinematic) terms."""
+    if inputs == "physics":
+        return n_inputs + n_physics_terms(n_joints)
+    if inputs == "kinematic":
+        return n_inputs + n_kinematic_terms(n_joints)
+    return n_inputs
 
 
 # --------------------------------------------------------------------------- card
@@ -334,14 +338,15 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
     from sklearn.preprocessing import StandardScaler
     from sklearn.svm import SVR, LinearSVR
 
-    from joulepath.learn._features import PhysicsFeatures
+    from joulepath.learn._features import KinematicFeatures, PhysicsFeatures
     from joulepath.learn._svr import ScalableSVR
 
     where = str(path)
     steps = dict(pipeline.steps)
     names = [name for name, _ in pipeline.steps]
     physics = card["inputs"] == "physics"
-    expected = (["physics"] if physics else []) + ["scale", "model"]
+    kinematic = card["inputs"] == "kinematic"
+    expected = (["physics"] if physics else ["kinematic"] if kinematic else []) + ["scale", "model"]
     if names != expected:
         raise InvalidModel(
             f"{where}: pipeline steps {names}, but a {card['family']} model with {card['inputs']!r} "
@@ -364,6 +369,15 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
                 f"{where}: the model was trained on other input columns than its card lists "
                 f"({_first_difference(trained, cols)}); restore the card or train the model again"
             )
+    if kinematic:
+        kin = steps["kinematic"]
+        if not isinstance(kin, KinematicFeatures) or not hasattr(kin, "index_"):
+            raise InvalidModel(f"{where}: the kinematic step is not a fitted KinematicFeatures")
+        if kin.columns is None or tuple(kin.columns) != cols:
+            raise InvalidModel(
+                f"{where}: the model was trained on other input columns than its card lists; "
+                "restore the card or train the model again"
+            )
     first = steps[names[0]]
     if getattr(first, "n_features_in_", n_in) != n_in:
         raise InvalidModel(
@@ -375,7 +389,7 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
     if not isinstance(scaler, StandardScaler) or shapes != ((n,), (n,)):
         raise InvalidModel(
             f"{where}: the scaling step does not hold {n} means and scales ({n_in} inputs"
-            + (" + the physics terms)" if physics else ")")
+            + (" + the physics terms)" if physics else " + the kinematic terms)" if kinematic else ")")
         )
     _finite(scaler, ("mean_", "scale_"), where)
     model = steps["model"]

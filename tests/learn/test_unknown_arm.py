@@ -1,0 +1,151 @@
+"""Energy models of an arm joulepath does not know: robot-free inputs, CV by run, the trained range."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from joulepath.data import EnergyTable
+from joulepath.energy import joint_energy
+from joulepath.learn import (
+    EnergyModel,
+    KinematicFeatures,
+    TrainConfig,
+    cv_groups,
+    input_columns,
+    kinematic_transform,
+    run_ids,
+    train,
+    training_range,
+)
+
+
+@pytest.fixture(scope="module")
+def two_run_tables(lab_tables):
+    """The lab tables without their robot; the training table is two runs (logs) of the lab robot."""
+    train_table, test_table = lab_tables
+    frame = train_table.frame
+    moves = np.sort(frame["move_id"].unique())
+    half = int(moves[len(moves) // 2])
+    sources = (
+        {"file": "run1.csv", "first_move_id": int(moves[0]), "moves": half - int(moves[0])},
+        {"file": "run2.csv", "first_move_id": half, "moves": int(moves[-1]) + 1 - half},
+    )
+    return replace(train_table, robot=None, sources=sources), replace(test_table, robot=None)
+
+
+def test_kinematic_transform_adds_the_energy_bases_of_each_joint(rng):
+    cols = input_columns("joint", "kinematic", 6)
+    X = rng.normal(size=(7, len(cols)))
+    X[:, cols.index("dt")] = rng.uniform(0.001, 0.02, 7)
+    out = KinematicFeatures(columns=cols).fit(X).transform(X)
+    assert out.shape == (7, len(cols) + 18)
+    np.testing.assert_array_equal(out[:, : len(cols)], X)
+    qd = X[:, [cols.index(f"dq{i}") for i in range(1, 7)]]
+    qdd = X[:, [cols.index(f"ddq{i}") for i in range(1, 7)]]
+    dt = X[:, cols.index("dt")]
+    # |qd| dt is the energy of a unit torque through joulepath.energy's one definition
+    np.testing.assert_allclose(out[:, len(cols) : len(cols) + 6], joint_energy(np.ones_like(qd), qd, dt))
+    np.testing.assert_allclose(out[:, len(cols) + 6 : len(cols) + 12], joint_energy(qd, qd, dt))
+    np.testing.assert_allclose(out[:, len(cols) + 12 :], joint_energy(qdd, qd, dt))
+    # one row or many: the same rows
+    index = KinematicFeatures(columns=cols).fit(X).index_
+    np.testing.assert_array_equal(kinematic_transform(X[:1], index), out[:1])
+
+
+def test_kinematic_features_refuse_columns_without_speeds(rng):
+    with pytest.raises(ValueError, match="needs columns"):
+        KinematicFeatures(columns=("q1", "dt")).fit(rng.normal(size=(3, 2)))
+    with pytest.raises(ValueError, match="X has 3 columns"):
+        KinematicFeatures(columns=("q1", "dq1")).fit(rng.normal(size=(3, 3)))
+
+
+def test_cv_groups_are_the_runs_of_a_table_of_several_logs(two_run_tables, lab_tables):
+    table = two_run_tables[0]
+    groups, kind = cv_groups(table)
+    assert kind == "run" and set(np.unique(groups)) == {0, 1}
+    runs = run_ids(table)
+    # every move lies in one run, and the runs follow the moves' order
+    per_move = pd.Series(runs).groupby(table.frame["move_id"].to_numpy()).nunique()
+    assert (per_move == 1).all() and np.all(np.diff(runs) >= 0)
+    assert cv_groups(lab_tables[0])[1] == "move"  # one log: by move
+    broken = replace(table, sources=({"file": "x.csv"},))
+    assert run_ids(broken) is None and cv_groups(broken)[1] == "move"
+
+
+def test_default_training_of_an_unknown_arm_is_cross_validated_by_run(two_run_tables, tmp_path):
+    """Kinematic inputs, the grid search's folds by run; the card keeps the CV estimate beside the
+    held-out figure and the range of the training data."""
+    train_table, test_table = two_run_tables
+    report = train(train_table, test_table, TrainConfig(families=("par",), cv=5), tmp_path / "m")
+    card = json.loads((tmp_path / "m" / "par-E" / "card.json").read_text())
+    assert card["cv_grouped"]["groups"] == "run" and card["cv_grouped"]["folds"] == 2
+    assert card["inputs"] == "kinematic" and card["inputs_reason"] == "default: no robot known"
+    row = report.results.iloc[0]
+    assert row["inputs"] == card["inputs"] and row["cv_groups"] == "run"
+    side = card["cv_vs_held_out"]
+    assert side == {
+        "cv_r2": card["cv_grouped"]["r2_mean"],
+        "cv_groups": "run",
+        "held_out_r2": card["test"]["r2"],
+        "held_out_moves": card["test"]["n_moves"],
+    }
+    covered = card["training_range"]
+    speeds = np.abs(train_table.frame[[f"dq{i}" for i in range(1, 7)]].to_numpy()).max(axis=0)
+    np.testing.assert_allclose(covered["speed_max_rad_s"], speeds)
+    assert covered["move_duration_s"][0] <= covered["move_duration_s"][1]
+    # the saved model loads back and predicts what it predicted before
+    model = EnergyModel.load(tmp_path / "m" / "par-E")
+    before = report.results.iloc[0]["test_r2"]
+    from joulepath.learn import score
+
+    assert score(test_table, "E", model.predict(test_table.frame)).r2 == pytest.approx(before, abs=1e-12)
+
+
+@pytest.mark.parametrize("family", ["par", "xgb"])
+def test_a_model_on_kinematic_inputs_round_trips_through_its_files(two_run_tables, tmp_path, family):
+    pytest.importorskip("xgboost") if family == "xgb" else None
+    train_table, test_table = two_run_tables
+    config = TrainConfig(families=(family,), cv=2, inputs="kinematic")
+    report = train(train_table, test_table, config, tmp_path / "m")
+    model = EnergyModel.load(report.models[f"{family}-E"])
+    assert model.card["inputs"] == "kinematic" and model.card["inputs_reason"] == "asked"
+    rows = test_table.frame[list(model.input_columns)].to_numpy()
+    np.testing.assert_allclose(model.predict_rows(rows), model.pipeline.predict(rows), rtol=1e-9, atol=1e-12)
+
+
+def test_outside_training_range_flags_rows_beyond_the_training_data(two_run_tables):
+    train_table, _ = two_run_tables
+    card = {"training_range": training_range(train_table)}
+    model = EnergyModel.__new__(EnergyModel)  # only the card is read
+    model.card = card
+    frame = train_table.frame
+    assert not model.outside_training_range(frame).any()
+    faster = frame.copy()
+    speed = np.abs(frame["dq2"].to_numpy())
+    fast = speed >= 0.5 * speed.max()  # three times these is beyond the fastest trained on
+    faster.loc[fast, "dq2"] *= 3.0
+    np.testing.assert_array_equal(model.outside_training_range(faster), fast)
+    longer = frame.copy()
+    first = longer["move_id"] == longer["move_id"].iloc[0]
+    t = longer.loc[first, "t"]
+    longest = card["training_range"]["move_duration_s"][1]
+    longer.loc[first, "t"] = t.min() + (t - t.min()) * 2.0 * longest / (t.max() - t.min())
+    assert model.outside_training_range(longer)[first.to_numpy()].all()
+    # a card without a range flags nothing
+    model.card = {}
+    assert not model.outside_training_range(faster).any()
+
+
+def test_training_range_of_a_table(two_run_tables):
+    table: EnergyTable = two_run_tables[0]
+    covered = training_range(table)
+    q = table.frame[[f"q{i}" for i in range(1, 7)]].to_numpy()
+    np.testing.assert_allclose(covered["q_min_rad"], q.min(axis=0))
+    np.testing.assert_allclose(covered["q_max_rad"], q.max(axis=0))
+    energy = table.frame.groupby("move_id")["E"].sum()
+    assert covered["move_energy_J"] == [energy.min(), energy.max()]
