@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (provenance and citation strings, kept whole so they read as one line each)
 """The planned saving per ABB arm of the bundled range, on the nominal model and over its uncertainty.
 
 Per family (its default variant), two point-to-point moves (joint angles clipped to the

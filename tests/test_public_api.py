@@ -23,6 +23,7 @@ PACKAGES = [
     "joulepath.experiment",
     "joulepath.report",
     "joulepath.program",
+    "joulepath.rapid",
     "joulepath.measure",
     "joulepath.egm",
     "joulepath.plant",

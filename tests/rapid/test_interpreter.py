@@ -196,9 +196,7 @@ def test_bounded_and_refused_in_one_line(body, extra, io, match):
 
         text = HEAD + "  PROC main()\n" + body + "\n  ENDPROC\nENDMODULE\n"
         task = Task((parse_module(text, path="t.mod"),), frozenset(), "t.mod")
-        with pytest.raises(
-            RapidError, match="beyond its reach .* a larger arm; give it with --robot"
-        ) as err:
+        with pytest.raises(RapidError, match="beyond its reach .* a larger arm; give it with --robot") as err:
             Interpreter(task, kinematics=RobotKinematics(load_robot("irb120"))).run()
         assert str(err.value).startswith("t.mod:5:") and len(str(err.value)) < 300
         return

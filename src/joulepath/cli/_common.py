@@ -163,7 +163,7 @@ def check_out_folder(
 
 def robot_inputs(robot: str) -> list[str]:
     """The robot argument as input paths: the file it names, or a twin folder and its files (else nothing)."""
-    from joulepath.dynamics._calibration import TWIN_FILES
+    from joulepath.dynamics import TWIN_FILES
 
     if not robot:
         return []

@@ -66,8 +66,7 @@ def train(
 ) -> int:
     """Tune (grid search + CV), refit and test energy models; save them with cards and reports."""
     from joulepath import load_robot
-    from joulepath.data import load_table, target_columns
-    from joulepath.data._schema import MAX_JOINTS
+    from joulepath.data import MAX_JOINTS, load_table, target_columns
     from joulepath.errors import InvalidInput
     from joulepath.learn import FAMILIES, NO_ROBOT_NOTE, TrainConfig
     from joulepath.learn import train as run

@@ -1,6 +1,6 @@
 """Data: joint logs (controller and generic), the energy-table schema, ingestion."""
 
-from joulepath.data._features import find_gaps, segment_moves, tcp_columns
+from joulepath.data._features import REST_SPEED, find_gaps, segment_moves, tcp_columns
 from joulepath.data._logs import (
     JointLog,
     controller_log_text,
@@ -16,8 +16,10 @@ from joulepath.data._schema import (
     FEATURES_JOINT,
     GENERIC_REQUIRED,
     LOG_COLUMNS,
+    MAX_JOINTS,
     MOVES_SIDECAR_COLUMNS,
     TARGETS,
+    card_joints,
     feature_columns,
     generic_required,
     joints_in,
@@ -25,6 +27,7 @@ from joulepath.data._schema import (
     target_columns,
 )
 from joulepath.data._table import EnergyTable, check_columns, ingest, load_table, save_table
+from joulepath.data._table import _check_limits as check_limits
 
 __all__ = [
     "EnergyTable",
@@ -34,9 +37,13 @@ __all__ = [
     "GENERIC_REQUIRED",
     "JointLog",
     "LOG_COLUMNS",
+    "MAX_JOINTS",
     "MOVES_SIDECAR_COLUMNS",
+    "REST_SPEED",
     "TARGETS",
+    "card_joints",
     "check_columns",
+    "check_limits",
     "controller_log_text",
     "feature_columns",
     "find_gaps",

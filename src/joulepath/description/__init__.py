@@ -7,6 +7,7 @@ Everything here is data: :class:`RobotDescription` mirrors an IRML file and
 from joulepath.description._chain import (
     chain_from_description,
     combine_inertials,
+    dh_link,
     dh_transform,
     transform_inertial,
 )
@@ -68,6 +69,7 @@ __all__ = [
     "check_inertial",
     "check_physical",
     "combine_inertials",
+    "dh_link",
     "dh_transform",
     "irml_string",
     "named_arm_path",

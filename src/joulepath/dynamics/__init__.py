@@ -2,6 +2,7 @@
 
 from joulepath.dynamics._calibration import (
     TWIN_CARD_FILE,
+    TWIN_FILES,
     TWIN_FRICTION_FILE,
     TWIN_ROBOT_FILE,
     TWIN_URDF_FILE,
@@ -40,6 +41,7 @@ __all__ = [
     "PinocchioRnea",
     "Robot",
     "TWIN_CARD_FILE",
+    "TWIN_FILES",
     "TWIN_FRICTION_FILE",
     "TWIN_ROBOT_FILE",
     "TWIN_URDF_FILE",

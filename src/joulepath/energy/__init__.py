@@ -26,6 +26,7 @@ from joulepath.energy._chain import (
     thesis_power,
 )
 from joulepath.energy._drives import (
+    ASSUMED,
     BUS_KINDS,
     DRIVES_SUFFIX,
     IDLE_MODES,
@@ -50,6 +51,7 @@ from joulepath.energy._measures import (
 )
 
 __all__ = [
+    "ASSUMED",
     "BUS_KINDS",
     "ChainPower",
     "DEFAULT_MEASURE",

@@ -63,8 +63,7 @@ from scipy.optimize import least_squares
 
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot, motor_torque
-from joulepath.energy import DriveModel
-from joulepath.energy._drives import ASSUMED
+from joulepath.energy import ASSUMED, DriveModel
 from joulepath.errors import InvalidInput
 from joulepath.identify._data import IdentificationData
 from joulepath.identify._fit import (

@@ -184,7 +184,7 @@ def data_from_logs(
     """
     if signal not in SIGNALS:
         raise InvalidInput(f"signal must be one of {', '.join(SIGNALS)}, got {signal!r}")
-    from joulepath.data._table import _check_limits  # the ingest check: ranges and speeds, named
+    from joulepath.data import check_limits as _check_limits  # the ingest check: ranges and speeds, named
 
     files = [Path(p) for p in paths if not is_moves_sidecar(p)]
     if not files:

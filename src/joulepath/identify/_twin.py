@@ -42,11 +42,11 @@ from joulepath.description import (
     Inertial,
     RobotDescription,
     chain_from_description,
+    dh_link,
     named_arm_path,
     preset_path,
     transform_inertial,
 )
-from joulepath.description._chain import dh_link
 from joulepath.dynamics import (
     TWIN_CARD_FILE,
     TWIN_FRICTION_FILE,

@@ -20,7 +20,7 @@ from joulepath.learn._features import (
 )
 from joulepath.learn._importance import feature_importance, plot_importance, rank_joints
 from joulepath.learn._model import TRUSTED_TYPES, EnergyModel, check_finite_predictions
-from joulepath.learn._search import CandidateResult, SearchResult, grid_search, make_splits
+from joulepath.learn._search import CandidateResult, SearchResult, connect_scheduler, grid_search, make_splits
 from joulepath.learn._svr import KERNEL_SVR_MAX_ROWS, ScalableSVR, SubsampleWarning
 from joulepath.learn._train import (
     NO_ROBOT_NOTE,
@@ -59,6 +59,7 @@ __all__ = [
     "best_model",
     "check_finite_predictions",
     "choose_inputs",
+    "connect_scheduler",
     "cv_groups",
     "feature_importance",
     "grid_for",

@@ -33,7 +33,7 @@ from sklearn.svm import LinearSVR
 
 from joulepath._io import atomic_write_bytes, atomic_write_text, make_folder
 from joulepath._typing import FloatArray
-from joulepath.data._schema import card_joints
+from joulepath.data import card_joints
 from joulepath.errors import InvalidModel, MissingDependency
 from joulepath.learn._features import (
     PHYSICS_VERSION,

@@ -18,8 +18,7 @@ from sklearn.exceptions import ConvergenceWarning
 from sklearn.model_selection import ParameterGrid
 
 from joulepath._io import atomic_write_bytes, atomic_write_text, make_folder, remove_output
-from joulepath.data import EnergyTable, target_columns
-from joulepath.data._schema import MAX_JOINTS
+from joulepath.data import MAX_JOINTS, EnergyTable, target_columns
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._evaluate import physics_baseline, score
 from joulepath.learn._families import FAMILIES, GRIDS, SUBSTITUTIONS, grid_for, make_pipeline

@@ -31,8 +31,7 @@ from typing import Any
 import numpy as np
 
 from joulepath._typing import FloatArray
-from joulepath.data import FEATURE_SETS, target_columns
-from joulepath.data._schema import MAX_JOINTS, card_joints
+from joulepath.data import FEATURE_SETS, MAX_JOINTS, card_joints, target_columns
 from joulepath.errors import InvalidInput, InvalidModel
 from joulepath.learn._families import FAMILIES
 from joulepath.learn._features import INPUTS, input_columns, n_kinematic_terms, n_physics_terms

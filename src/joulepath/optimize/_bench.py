@@ -151,7 +151,7 @@ def bench_optimizers(
     calls = (delayed(_run_one)(robot, task, cfg, models, joints) for _, cfg, task in jobs)
     out = []
     if scheduler:
-        from joulepath.learn._search import connect_scheduler
+        from joulepath.learn import connect_scheduler
 
         with connect_scheduler(scheduler), parallel_config(backend="dask"):
             results = list(Parallel(return_as="generator")(calls))
