@@ -8,7 +8,7 @@ from typing import Any
 
 import typer
 
-from joulepath.cli._common import check_out_folder, console, progress_lines
+from joulepath.cli._common import check_out_folder, console, err_console, progress_lines
 from joulepath.cli._robot import load_robot_for_cli, unchecked_option
 from joulepath.program import LEVER_PLANS
 
@@ -51,6 +51,19 @@ def _scenario(pairs: list[str], path: Path | None) -> Any:
     return Scenario(out, base.given)
 
 
+def _robot_of_task(program: list[Path]) -> str:
+    """The bundled robot the task's ``MOC.cfg`` names (said on stderr), else the IRB 120."""
+    from joulepath.description import DEFAULT_ROBOT, abb_preset
+    from joulepath.rapid import find_moc
+
+    moc = find_moc(program)
+    name = abb_preset(moc.robot_type) if moc is not None and moc.robot_type else None
+    if moc is not None and moc.robot_type:
+        said = f"--robot {name}" if name else f"no bundled model of it: --robot {DEFAULT_ROBOT}; give --robot"
+        err_console.print(f"robot: {moc.path} names {moc.robot_type}: {said}", markup=False)
+    return name or DEFAULT_ROBOT
+
+
 def cycle(
     program: list[Path] = typer.Argument(
         ...,
@@ -58,7 +71,11 @@ def cycle(
         "folder of a task's modules, e.g. a backup's RAPID/TASK1; an EIO.cfg names the I/O signals), or a "
         "plain cycle file (.toml).",
     ),
-    robot: str = typer.Option("irb120", help="Robot name or .irml/.urdf path."),
+    robot: str = typer.Option(
+        None,
+        help="Robot name or .irml/.urdf path (default: the robot the task's MOC.cfg names where joulepath "
+        "bundles it, else irb120).",
+    ),
     out: Path = typer.Option(..., "--out", help="Run folder."),
     cycle_time: str = typer.Option("same", "--cycle-time", help="'same' (the default program's) or seconds."),
     use_waits: bool = typer.Option(
@@ -200,7 +217,7 @@ def cycle(
     for p in program:
         if not p.exists():  # anything else but a regular file or folder is refused by name when read
             raise typer.BadParameter(f"{p}: no such file or folder", param_hint="PROGRAM")
-    r = load_robot_for_cli(robot, unchecked=unchecked)
+    r = load_robot_for_cli(robot or _robot_of_task(program), unchecked=unchecked)
     check_measure(energy, r.drivetrain)  # one line saying what to provide
     given = _scenario(io, scenario)
     cs = CycleSettings(

@@ -51,6 +51,29 @@ HOME = {name: (0.0, 0.0, 0.0, 0.0, 0.0, 0.0) for name in PRESETS}
 """Named configurations (rad): ABB's home pose is q = 0."""
 
 
+def abb_preset(robot_type: str) -> str | None:
+    """The bundled robot an ABB robot type names (as a controller's ``MOC.cfg`` writes it:
+    ``ROB1_4600_2.55_40`` is an IRB 4600 of 2.55 m reach and 40 kg), or None where none is bundled:
+    the variant of that payload and reach, else none (another variant of the family is another arm).
+
+    >>> abb_preset("ROB1_4600_2.55_40"), abb_preset("ROB1_120_0.58_3"), abb_preset("ROB1_360_1.6_6")
+    ('irb4600-40-2.55', 'irb120', None)
+    """
+    import re
+
+    m = re.match(r"ROB\d*_(\d+)[A-Za-z]*_([0-9.]+)_([0-9.]+)", robot_type)
+    if m is None:
+        return None
+    family, reach, payload = m.group(1), float(m.group(2)), float(m.group(3))
+    if family == "120":
+        return "irb120"
+    for name in ABB_RANGE:
+        fam, pay, rea = name[3:].split("-")
+        if fam == family and abs(float(pay) - payload) < 1e-6 and abs(float(rea) - reach) < 1e-6:
+            return name
+    return None
+
+
 def preset_variant(name: str) -> str:
     """The bundled file a name stands for: a family's name gives its default variant."""
     return FAMILY_DEFAULTS.get(name, name)

@@ -243,6 +243,15 @@ def read_task_cycle(
             }
             - {trace.routine}
         )
+        if len(movers) == 1 and routine is None:  # a template's empty main beside its one path (Path_10)
+            tc = read_task_cycle(
+                paths, robot, io=io, routine=movers[0], seed=seed, progress=progress, given=given
+            )
+            said = (
+                f"{where}: the cycle ({trace.routine}) holds no move: {movers[0]}, the one routine that "
+                "moves the robot, is run as the cycle (--routine NAME names another)"
+            )
+            return replace(tc, trace=replace(tc.trace, notes=(said, *tc.trace.notes)))
         hint = (
             f"; give --routine NAME, one of the routines that move the robot: {', '.join(movers[:8])}"
             + (f" (and {len(movers) - 8} more)" if len(movers) > 8 else "")

@@ -493,6 +493,8 @@ class Interpreter:
         self.outputs: dict[str, Value] = {}
         self._define_types()
         self.predefined = _predefined(self.types)
+        for line in task.notes:
+            self.note(line)
         self.base = np.eye(4)  # the robot's base frame in the world (MOC.cfg), m
         if task.moc is not None:
             x, y, z = (1000.0 * v for v in task.moc.base_pos_m)
@@ -996,6 +998,8 @@ class Interpreter:
         if isinstance(e, (n.Index, n.Field)):
             base = self.ref(e.base)
             r = base if isinstance(base, _Ref) else _Ref(base)
+            if r.cell.type == UNTYPED:  # an element or component of a value declared nowhere: as unknown
+                return r
             if isinstance(e, n.Index):
                 idx = []
                 for i in e.indices:
@@ -1316,6 +1320,7 @@ class Interpreter:
         if q is None:
             q = self.kin.joints(flange, None, self.current_q)
             if q is not None and conf is not None:
+                q = self._toward_quadrants(q, conf)
                 got = self.kin.confdata(q)
                 if not linear and (got[3] != conf[3] or any(abs(got[k] - conf[k]) > 1 for k in range(3))):
                     raise RapidError(
@@ -1331,6 +1336,21 @@ class Interpreter:
         if q is None:
             raise RapidError(f"{pos}: {what}: {self._beyond_reach(rt, flange)}")
         return q
+
+    def _toward_quadrants(self, q: FloatArray, conf: tuple[int, int, int, int]) -> FloatArray:
+        """``q`` with axes 1, 4 and 6 turned by whole turns toward the programmed quadrants (``cf1``,
+        ``cf4``, ``cf6``), where the turned value stays within the axis' range: the same pose."""
+        assert self.kin is not None
+        out = q.copy()
+        for axis, cf in ((0, conf[0]), (3, conf[1]), (5, conf[2])):
+            centre = (cf + 0.5) * (math.pi / 2)
+            turns = round((centre - out[axis]) / (2 * math.pi))
+            if turns:
+                trial = out.copy()
+                trial[axis] += turns * 2 * math.pi
+                if self.kin.in_range(trial) is None:
+                    out = trial
+        return out
 
     def _beyond_reach(self, rt: Record, flange: FloatArray) -> str:
         where = [round(float(v), 1) for v in (geo.pose_matrix(rt)[:3, 3] * 1000.0)]
@@ -2169,6 +2189,13 @@ class Interpreter:
             fine = self.predefined["fine"].value
             assert isinstance(fine, Record)
             zone = fine
+        if speed_t and not all(isinstance(v, float) and v > 0 for v in speed.values[:2]):
+            fallback = self.predefined["v1000"].value
+            assert isinstance(fallback, Record)
+            self.note(
+                f"{s.pos}: {s.name}: its speed comes at run time and its stand-in is not a speed: v1000 taken"
+            )
+            speed = fallback
         self._check_motion_data(speed, zone, s)
         if kind == "circular" and len(targets) < 2:
             raise RapidError(f"{s.pos}: {s.name} needs a circle point and a target; correct the instruction")
@@ -2202,16 +2229,21 @@ class Interpreter:
             if rec.type != want:
                 fix = "use MoveAbsJ" if want == "robtarget" else "use MoveJ (or give a jointtarget)"
                 raise RapidError(f"{s.pos}: {s.name} goes to a {want}; {text} is a {rec.type}: {fix}")
-        for rec, t, text in targets:
+        for k, (rec, t, text) in enumerate(targets):
             if rec.type == "robtarget" and not t:
                 q = geo.orient_values(rec.get("rot"))
                 norm = math.sqrt(sum(v * v for v in q))
+                if norm == 0.0:  # no orientation at all: never given a value here (filled at run time)
+                    why = f"{s.pos}: {text} has no orientation, never given a value here: {UNKNOWN_TARGET}"
+                    targets[k] = (rec, frozenset({why}), text)
+                    continue
                 if abs(norm - 1.0) > 1e-3:
                     raise RapidError(
                         f"{s.pos}: {text}: its orientation {list(q)} is not a unit quaternion "
                         f"(norm {norm:.4g}); "
                         "correct it (or NOrient it)"
                     )
+        target_t = targets[-1][1]
         kept = set(taint | start_taint | target_t | speed_t | zone_t | tool_t | wobj_t)
         if circle is not None:
             kept |= targets[0][1]

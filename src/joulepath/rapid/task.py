@@ -108,6 +108,19 @@ def read_moc(path: Path) -> MotionConfig:
     )
 
 
+def find_moc(paths: Sequence[str | Path]) -> MotionConfig | None:
+    """The ``MOC.cfg`` given among ``paths`` or found in a folder of them, read; None where there is none."""
+    for raw in paths:
+        p = Path(raw)
+        if p.is_file() and p.name.lower() == "moc.cfg":
+            return read_moc(p)
+        if p.is_dir():
+            found = sorted(f for f in p.rglob("*") if f.is_file() and f.name.lower() == "moc.cfg")
+            if found:
+                return read_moc(found[0])
+    return None
+
+
 @dataclass(frozen=True, slots=True)
 class Task:
     """The modules of one task, the signals the I/O configuration declares, and where they came from."""
@@ -117,6 +130,7 @@ class Task:
     source: str
     eio: str | None = None
     moc: MotionConfig | None = None
+    notes: tuple[str, ...] = ()
 
     def module_of(self, path: str) -> n.Module | None:
         return next((m for m in self.modules if m.path == path), None)
@@ -134,6 +148,7 @@ def load_task(paths: Sequence[str | Path]) -> Task:
     files: list[Path] = []
     eio: list[Path] = []
     moc: list[Path] = []
+    found_in_folders: set[Path] = set()
     if not paths:
         raise RapidError("no program given: name a module file (.mod, .sys) or a task's folder")
     for raw in paths:
@@ -145,6 +160,7 @@ def load_task(paths: Sequence[str | Path]) -> Task:
             if not found:
                 raise RapidError(f"{p}: the folder holds no RAPID module (.mod, .sys); give a task's folder")
             files.extend(found)
+            found_in_folders.update(found)
         elif p.suffix.lower() == ".cfg" and p.is_file():
             (moc if p.name.lower() == "moc.cfg" else eio).append(p)
         elif p.exists() or p.is_symlink():
@@ -166,7 +182,20 @@ def load_task(paths: Sequence[str | Path]) -> Task:
         if where not in resolved:
             resolved.add(where)
             unique.append(f)
-    modules = [read_module_file(f) for f in unique]
+    modules = []
+    notes = []
+    for f in unique:
+        try:
+            modules.append(read_module_file(f))
+        except RapidError as err:  # an encrypted module in a backup's folder: the task runs without it
+            if f in found_in_folders and "a binary file" in str(err):
+                notes.append(
+                    f"{f}: an encrypted or binary module, left out (its routines are declared nowhere)"
+                )
+                continue
+            raise
+    if not modules:
+        raise RapidError(f"{', '.join(map(str, paths))}: no module could be read (binary files only)")
     names: dict[str, n.Module] = {}
     for m in modules:
         key = m.name.lower()
@@ -181,5 +210,10 @@ def load_task(paths: Sequence[str | Path]) -> Task:
         signals |= _signals_of_eio(f)
     source = ", ".join(str(Path(p)) for p in paths)
     return Task(
-        tuple(modules), signals, source, str(eio[0]) if eio else None, read_moc(moc[0]) if moc else None
+        tuple(modules),
+        signals,
+        source,
+        str(eio[0]) if eio else None,
+        read_moc(moc[0]) if moc else None,
+        tuple(notes),
     )
