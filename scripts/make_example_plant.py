@@ -284,6 +284,7 @@ knot_spacing = 0.1
 pass_search = 2
 rapid_plan = false      # and one plan (for the streamed samples; optimized.mod where its via points
 retime_segments = false # follow it, else EGM) instead of the three `joulepath cycle` makes by default
+lever_plans = 60       # each cell searches the controller's levers as `joulepath cycle` does, on fewer plans
 """
 
 

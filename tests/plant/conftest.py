@@ -49,6 +49,7 @@ knot_spacing = 0.2
 pass_search = 0
 rapid_plan = false
 retime_segments = false
+lever_plans = 40
 """
 
 
