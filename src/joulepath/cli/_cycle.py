@@ -8,6 +8,7 @@ from typing import Any
 
 import typer
 
+from joulepath._work import work_limit
 from joulepath.cli._common import check_out_folder, console, err_console, progress_lines
 from joulepath.cli._robot import load_robot_for_cli, unchecked_option
 from joulepath.program import LEVER_PLANS
@@ -352,6 +353,11 @@ def print_program_result(done: Any, out: Path, r: Any, *, use_waits: bool, cell:
         )
         for move, why in spec.kept:
             console.print(f"  {move}: {why}", markup=False)
+    if result.long_units:
+        console.print(
+            f"kept as taught, longer than the {work_limit('move_s'):g} s one optimized unit may take "
+            f"(JOULEPATH_MAX_MOVE_S): the unit(s) at line(s) {', '.join(map(str, result.long_units))}"
+        )
     if result.timed_out:
         console.print("--max-time reached: the best verified result of the moves solved by then")
     if cell is not None:

@@ -397,6 +397,7 @@ class CycleResult:
     vias: dict[int, tuple[int, ...]] = field(default_factory=dict)  # per optimized move: indices into .fine
     planned: Trajectory | None = None  # the whole optimized cycle, 2.5 ms grid
     taught_units: tuple[int, ...] = ()  # first lines of the units kept as taught
+    long_units: tuple[int, ...] = ()  # first lines of units longer than the move_s limit, kept as taught
     timed_out: bool = False  # max_time_s was reached before every solve
     zone_miss_mm: float = 0.0  # largest TCP distance beyond a fly-by target's zone (0: within all)
     open_ends: frozenset[int] = frozenset()  # optimized moves whose piece ends blended into a kept move
@@ -558,7 +559,7 @@ class CycleOptimizer:
             plan_cycle(spec, settings.controller, progress=self.progress) if plan is None else plan
         )
         self.gradient = replace(settings.gradient, energy_every=settings.energy_every)
-        check_motion_time(self.plan, spec.source, optimized=True)
+        check_motion_time(self.plan, spec.source)  # a unit longer than move_s is kept as taught (below)
         if spec.module is None:
             _refuse_short_durations(spec, self.plan)
         self._plants: dict[int, Plant] = {}
@@ -588,15 +589,14 @@ class CycleOptimizer:
                 self.segment_of[members[0]] = window
                 if inner:
                     self.within.add(members[0])
-        for i, members in self.chains.items():  # a fly-by chain is solved as one move: bounded as one
-            if len(members) > 1:
-                check_work(
-                    "move_s",
-                    self.span[i],
-                    f"{spec.source}:{self.by_index[i].step.line}: {len(members)} moves joined by zones",
-                    "they are optimized as one move through their targets; end one of them at a stop "
-                    "(fine) to split the chain, or optimize only moves from rest to rest (--stop-at-targets)",
-                )
+        # a unit (a move, or a fly-by chain solved as one move) longer than the move_s limit is kept as
+        # taught: its solve grows with its duration (joulepath._work); said in the result (long_units)
+        limit = work_limit("move_s")
+        self.long_units = [i for i in self.chains if self.span[i] > limit + 1e-9]
+        for i in self.long_units:
+            for table in (self.chains, self.span, self.segment_of):
+                del table[i]
+            self.within.discard(i)
         self.optimizable = list(self.chains)  # one unit per window, keyed by its first moving move
         in_units = {j for i in self.chains for j in self.segment_of[i].moves}
         self.kept = [m.index for m in moves if m.index not in in_units]
@@ -2541,6 +2541,7 @@ def _assemble(
         vias=vias,
         planned=motion.trajectory,
         taught_units=tuple(spec.steps[i].line for i in taught_units),
+        long_units=tuple(spec.steps[i].line for i in opt.long_units),
         timed_out=opt.timed_out,
         open_ends=frozenset(
             opt.chains[i][-1]

@@ -304,6 +304,9 @@ def cycle_json(
         "the optimizer may change: every move but those kept as taught (kept_moves: their target, speed, "
         "zone or branch is known only at run time, a process instruction, \\Conc)",
         "taught_units": list(result.taught_units),
+        "long_units": list(result.long_units),
+        "long_units_note": "first lines of the units (a move, or moves joined by zones) longer than the "
+        "move_s limit (JOULEPATH_MAX_MOVE_S): kept as taught, not optimized",
         "timed_out": result.timed_out,
         "zone_miss_mm": result.zone_miss_mm,
         "default_cycle_s": result.default_cycle_s,
