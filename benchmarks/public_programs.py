@@ -183,13 +183,29 @@ def extract(manifest: list[dict[str, object]], mirrors: Path, dest: Path) -> Non
         print(f"extracted {p['id']}", file=sys.stderr)
 
 
+LARGER_ARMS = ("irb140", "irb1200", "irb1600", "irb2600", "irb4600", "irb6700")
+"""The bundled ABB families, smallest first: ``--larger`` retries a program refused as out of reach on
+each in turn, and records the first that reads it (the smallest bundled arm its targets fit)."""
+
+
 def run_one(folder: Path, args: argparse.Namespace) -> dict[str, object]:
+    row = _run_one(folder, args, args.robot)
+    if getattr(args, "larger", False) and row["class"] == "out-of-reach":
+        for arm in LARGER_ARMS:
+            again = _run_one(folder, args, arm)
+            if again["class"] != "out-of-reach":
+                row.update({f"larger_{k}": v for k, v in again.items()}, larger_robot=arm)
+                break
+    return row
+
+
+def _run_one(folder: Path, args: argparse.Namespace, robot: str | None) -> dict[str, object]:
     out = Path(tempfile.mkdtemp(prefix="jp-public-")) / "run"
     argv = [sys.executable, "-m", "joulepath", "cycle", str(folder), "--out", str(out)]
     if args.export:
         argv += ["--export", args.export]
-    if args.robot:
-        argv += ["--robot", args.robot]
+    if robot:
+        argv += ["--robot", robot]
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
     started = datetime.now(UTC).strftime("%Y-%m-%d %H:%M")
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -312,6 +328,21 @@ def report(rows: list[dict[str, object]], args: argparse.Namespace) -> str:
         out.append(
             f"| {cls} | {len(members)} | {small} | {len(members) - small} | {described.get(cls, '')} |"
         )
+    retried = [r for r in rows if r.get("larger_robot")]
+    if retried:
+        fit = [r for r in retried if r.get("larger_cycle")]
+        arms = ", ".join(f"{r['larger_robot']}" for r in fit)
+        out += [
+            "",
+            f"Out of the IRB 120's reach, retried on the bundled ABB families (smallest first, `--larger`): "
+            f"{len(retried)} read by a larger arm, **{len(fit)} get a cycle** with `--robot` named ({arms}); "
+            "the others: "
+            + (
+                ", ".join(sorted({str(r["larger_class"]) for r in retried if not r.get("larger_cycle")}))
+                or "none"
+            )
+            + ".",
+        ]
     cpu = [float(r["cpu_s"]) for r in rows if r.get("cpu_s") is not None]
     if cpu:
         out += ["", f"CPU s per program: median {statistics.median(cpu):.1f}, max {max(cpu):.1f}."]
@@ -335,6 +366,11 @@ def main() -> None:
     ap.add_argument("folder", nargs="?", type=Path, default=PROGRAMS, help="the programs' folder (ID/...)")
     ap.add_argument("--export", default=None, help="egm, rapid or auto (passed to joulepath cycle)")
     ap.add_argument("--robot", default=None, help="passed to joulepath cycle")
+    ap.add_argument(
+        "--larger",
+        action="store_true",
+        help="retry a program refused as out of reach on each bundled ABB family, smallest first",
+    )
     ap.add_argument("--timeout", type=float, default=300.0, help="s per program (default 300)")
     ap.add_argument("--jobs", type=int, default=1, help="programs at once (default 1)")
     ap.add_argument("--only", nargs="*", default=[], help="run the programs whose id holds one of these")
