@@ -494,6 +494,12 @@ def _prior_scale(prior: FloatArray) -> FloatArray:
     return out
 
 
+CONSISTENT_TOL = 1e-12
+"""kg·m²: a link's pseudo-inertia with its smallest eigenvalue above minus this is consistent (an
+eigenvalue of zero to rounding, -1.7e-18 on a UR5's first link refined to the boundary, is not a
+violation)."""
+
+
 def _consistent(
     Y: FloatArray,
     F: FloatArray,
@@ -730,7 +736,7 @@ def identify(
         fit=score_prediction(motor_torque(Y @ phi + friction.torque(fit_data.qd), side, eta), fit_data),
         held_out=None if held is None else score_prediction(predict(held), held),
         min_pseudo_inertia_eig=eig,
-        consistent=bool(np.all(eig > 0)),
+        consistent=bool(np.all(eig > -CONSISTENT_TOL)),
         options=options,
         data_hash=data.data_hash,
         sources=data.sources,
