@@ -161,7 +161,7 @@ def name_roles(
                 for a, type_ in argument_types(s, process_linear, process_circular):
                     if isinstance(a.value, (n.Name, n.FuncCall)):  # a datum, or a function's value
                         out.setdefault(a.value.name.lower(), type_)
-            for node in _nodes(r.body):  # the built-in functions' arguments (CalcJointT(p, tool ...))
+            for node in n.walk_nodes(r.body):  # the built-in functions' arguments (CalcJointT(p, tool ...))
                 if isinstance(node, n.FuncCall) and node.name.lower() not in declared:
                     for a, type_ in table_types(node) or ():
                         if isinstance(a.value, (n.Name, n.FuncCall)):
@@ -169,32 +169,5 @@ def name_roles(
     return out
 
 
-def _nodes(root: object) -> Iterator[object]:
-    stack: list[object] = [root]
-    while stack:
-        node = stack.pop()
-        yield node
-        if isinstance(node, tuple):
-            stack.extend(node)
-        elif hasattr(node, "__dataclass_fields__") and not isinstance(node, n.Pos):
-            for name in node.__dataclass_fields__:
-                if name not in ("pos", "text", "path"):
-                    v = getattr(node, name)
-                    if isinstance(v, tuple) or hasattr(v, "__dataclass_fields__"):
-                        stack.append(v)
-
-
 def _calls(body: tuple[n.Stmt, ...]) -> Iterator[n.Call]:
-    for s in body:
-        if isinstance(s, n.Call):
-            yield s
-        elif isinstance(s, n.If):
-            for _, b in s.branches:
-                yield from _calls(b)
-            yield from _calls(s.orelse)
-        elif isinstance(s, (n.For, n.While)):
-            yield from _calls(s.body)
-        elif isinstance(s, n.Test):
-            for _, b in s.cases:
-                yield from _calls(b)
-            yield from _calls(s.default or ())
+    return (s for s in n.walk_statements(body) if isinstance(s, n.Call))

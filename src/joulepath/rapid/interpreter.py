@@ -565,40 +565,19 @@ class Interpreter:
                 self.routines[key] = (r, m)
 
     def _walk_stmts(self) -> Iterator[n.Stmt]:
-        def walk(body: tuple[n.Stmt, ...]) -> Iterator[n.Stmt]:
-            for s in body:
-                yield s
-                if isinstance(s, n.If):
-                    for _, b in s.branches:
-                        yield from walk(b)
-                    yield from walk(s.orelse)
-                elif isinstance(s, (n.For, n.While)):
-                    yield from walk(s.body)
-                elif isinstance(s, n.Test):
-                    for _, b in s.cases:
-                        yield from walk(b)
-                    if s.default:
-                        yield from walk(s.default)
-
         for m in self.task.modules:
             for r in m.routines:
                 if r.kind != "TRAP":
-                    yield from walk(r.body)
+                    yield from n.walk_statements(r.body)
 
     def _assigned_names(self) -> set[str]:
         out: set[str] = set()
         for s in self._walk_stmts():
             if isinstance(s, n.Assign):
-                base = s.target
-                while isinstance(base, (n.Index, n.Field)):
-                    base = base.base
-                if isinstance(base, n.Name):
-                    out.add(base.name.lower())
+                out.add(n.base_name(s.target) or "")
             elif isinstance(s, n.Call):  # a variable passed to a routine may be written there
-                for a in s.args:
-                    if isinstance(a.value, n.Name):
-                        out.add(a.value.name.lower())
-        return out
+                out.update(a.value.name.lower() for a in s.args if isinstance(a.value, n.Name))
+        return out - {""}
 
     def _set_names(self) -> set[str]:
         """Data the task's statements set: assigned, passed to a routine of the task, or written by an
@@ -606,11 +585,7 @@ class Interpreter:
         out: set[str] = set()
         for s in self._walk_stmts():
             if isinstance(s, n.Assign):
-                base = s.target
-                while isinstance(base, (n.Index, n.Field)):
-                    base = base.base
-                if isinstance(base, n.Name):
-                    out.add(base.name.lower())
+                out.add(n.base_name(s.target) or "")
             elif isinstance(s, n.Call):
                 key = s.name.lower()
                 documented = builtins.lookup(key) if key not in self.routines else None
@@ -623,11 +598,7 @@ class Interpreter:
                     except builtins.ArgumentError:
                         matched = {}
                     args = [v for k, v in matched.items() if k.lower() in written]
-                for v in args:
-                    while isinstance(v, (n.Index, n.Field)):
-                        v = v.base
-                    if isinstance(v, n.Name):
-                        out.add(v.name.lower())
+                out.update(name for name in map(n.base_name, args) if name)
         return out
 
     def _signal_names(self) -> set[str]:
@@ -2526,23 +2497,13 @@ def _robax(jt: Record) -> FloatArray:
 
 def _set_in(body: tuple[n.Stmt, ...]) -> set[str]:
     """Names (lower case) a statement list assigns or passes to a call, nested blocks included."""
-    out: set[str] = set()
-    for s in _expressions(body):
-        target: object = None
+    out: set[str | None] = set()
+    for s in n.walk_statements(body):
         if isinstance(s, n.Assign):
-            target = s.target
+            out.add(n.base_name(s.target))
         elif isinstance(s, n.Call):
-            for a in s.args:
-                v: object = a.value
-                while isinstance(v, (n.Index, n.Field)):
-                    v = v.base
-                if isinstance(v, n.Name):
-                    out.add(v.name.lower())
-        while isinstance(target, (n.Index, n.Field)):
-            target = target.base
-        if isinstance(target, n.Name):
-            out.add(target.name.lower())
-    return out
+            out.update(n.base_name(a.value) for a in s.args)
+    return {name for name in out if name}
 
 
 def _pairs(args: tuple[n.Arg, ...]) -> list[tuple[str | None, n.Expr | None]]:
@@ -2655,19 +2616,7 @@ def moves_in(r: n.Routine) -> bool:
 
 def _expressions(m: object) -> Iterator[object]:
     """Every node of a module (depth first), for scans by kind."""
-    stack: list[object] = [m]
-    while stack:
-        node = stack.pop()
-        yield node
-        if isinstance(node, tuple):
-            stack.extend(node)
-        elif hasattr(node, "__dataclass_fields__") and not isinstance(node, n.Pos):
-            for name in node.__dataclass_fields__:
-                if name in ("text", "pos", "path"):
-                    continue
-                v = getattr(node, name)
-                if isinstance(v, (tuple, list)) or hasattr(v, "__dataclass_fields__"):
-                    stack.append(v)
+    return n.walk_nodes(m)
 
 
 def _apply(op: str, a: Value, b: Value) -> Value:

@@ -10,6 +10,7 @@ source, and the writer edits exactly that span.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 
@@ -354,3 +355,46 @@ class Module:
     @property
     def system(self) -> bool:
         return any(a.upper() == "SYSMODULE" for a in self.attributes)
+
+
+def walk_statements(body: tuple[Stmt, ...]) -> Iterator[Stmt]:
+    """Every statement of a statement list, nested blocks (``IF``, ``FOR``, ``WHILE``, ``TEST``) included,
+    in source order."""
+    for s in body:
+        yield s
+        if isinstance(s, If):
+            for _, b in s.branches:
+                yield from walk_statements(b)
+            yield from walk_statements(s.orelse)
+        elif isinstance(s, (For, While)):
+            yield from walk_statements(s.body)
+        elif isinstance(s, Test):
+            for _, b in s.cases:
+                yield from walk_statements(b)
+            yield from walk_statements(s.default or ())
+
+
+def walk_nodes(root: object) -> Iterator[object]:
+    """Every node below ``root`` (a module, a routine, a statement list, an expression), depth first,
+    for scans by kind."""
+    stack: list[object] = [root]
+    while stack:
+        node = stack.pop()
+        yield node
+        if isinstance(node, tuple):
+            stack.extend(node)
+        elif hasattr(node, "__dataclass_fields__") and not isinstance(node, Pos):
+            for name in node.__dataclass_fields__:
+                if name in ("text", "pos", "path"):
+                    continue
+                v = getattr(node, name)
+                if isinstance(v, (tuple, list)) or hasattr(v, "__dataclass_fields__"):
+                    stack.append(v)
+
+
+def base_name(e: object) -> str | None:
+    """The datum an lvalue or argument names (``a{2}.b`` names ``a``), lower case; None for another
+    expression."""
+    while isinstance(e, (Index, Field)):
+        e = e.base
+    return e.name.lower() if isinstance(e, Name) else None
