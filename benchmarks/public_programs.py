@@ -29,7 +29,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import re
 import resource
 import shutil
@@ -43,6 +42,9 @@ import tomllib
 from concurrent.futures import ThreadPoolExecutor
 from datetime import UTC, datetime
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _report import machine  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 MANIFEST = Path(__file__).with_suffix(".toml")
@@ -282,18 +284,6 @@ def commit_of_code() -> str:
         return (head.stdout.strip() or "unknown") + (" (with local changes)" if dirty.stdout.strip() else "")
     except Exception:  # noqa: BLE001 - a label only
         return "unknown"
-
-
-def machine() -> str:
-    cpu = platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}; {os.cpu_count()} logical CPUs; Python {platform.python_version()}"
 
 
 def report(rows: list[dict[str, object]], args: argparse.Namespace) -> str:
