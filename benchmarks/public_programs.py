@@ -112,16 +112,19 @@ CLASSES: list[tuple[str, str, re.Pattern[str]]] = [
         "duplicate",
         "two modules or routines of one name",
         re.compile(
-            r"two modules|also declared|declared twice|already declared|duplicate|more than one (module|routine)",
+            r"two modules|also declared|is also in|declared twice|already declared|duplicate|"
+            r"more than one (module|routine)",
             re.I,
         ),
     ),
+    ("payload", "a tool heavier than the robot's rated payload", re.compile(r"rated payload")),
     ("no-main", "no main routine", re.compile(r"no (routine )?`?main|--routine")),
     (
         "syntax",
         "not read as RAPID: syntax, placeholders (<SMT>), an encrypted module, argument lists",
         re.compile(
             r"syntax|ends without|expected|unexpected|is not RAPID|is an? (FUNC|PROC)|not valid RAPID|binary file|needs an? |"
+            r"cannot be assigned|"
             r"placeholder",
             re.I,
         ),
