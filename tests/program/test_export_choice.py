@@ -38,7 +38,7 @@ def test_auto_writes_rapid_with_both_figures_and_egm_only_below_half(tmp_path):
     prog = tmp_path / "small.mod"
     prog.write_text(SMALL)
     out = tmp_path / "run"
-    args = ["--knot-spacing", "0.1", "--table-points", "2", "--lever-plans", "30"]
+    args = ["--knot-spacing", "0.1", "--table-points", "2", "--lever-plans", "30", "--max-time", "40"]
     assert main(["cycle", str(prog), "--out", str(out), *args]) in (0, 1)
     data = json.loads((out / "cycle.json").read_text())
     plan = data["egm_plan_saved_pct"]
