@@ -1884,9 +1884,8 @@ class Interpreter:
         """An instruction of RAPID or of an option (:mod:`joulepath.rapid.builtins`) that the cycle's
         model does not run: its arguments checked against its documented signature, what it writes
         from the outside world marked; one that moves the arm makes the next move's start unknown."""
-        pairs = _pairs(s.args)
         try:
-            builtins.match_arguments(b, pairs)
+            matched = builtins.match_arguments(b, _pairs(s.args))
         except builtins.ArgumentError as err:
             raise RapidError(f"{s.pos}: {s.name}: {err}; correct its arguments ({b.signature})") from None
         whose = f"the {b.option} option's" if b.option else "a RAPID"
@@ -1899,12 +1898,12 @@ class Interpreter:
             self.note(f"{s.pos}: {s.name}: {whose} instruction, run as no motion and no time")
         written = {p.name.lower() for p in b.writes}
         if written:
-            self._mark_written(s, written, b)
+            self._mark_written(s, written, matched)
         self.events.append(Action(s, s.name, self._context()))
 
-    def _mark_written(self, s: n.Call, written: set[str], b: builtins.Builtin) -> None:
-        """Mark the arguments a documented instruction writes (with data known only at run time)."""
-        matched = builtins.match_arguments(b, _pairs(s.args))
+    def _mark_written(self, s: n.Call, written: set[str], matched: Mapping[str, n.Expr | None]) -> None:
+        """Mark the arguments a documented instruction writes (with data known only at run time);
+        ``matched``: its arguments by parameter (:func:`joulepath.rapid.builtins.match_arguments`)."""
         why = frozenset({f"{s.pos}: {s.name} writes data known only at run time"})
         for name, a in matched.items():
             if name.lower() not in written or not isinstance(a, (n.Name, n.Index, n.Field)):
