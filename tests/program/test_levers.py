@@ -165,10 +165,58 @@ def test_full_acc_reproduces_the_timing_before_levers(robot, name, monkeypatch):
         _with_all(spec, acc_pct=100.0, ramp_pct=100.0, vel_override_pct=100.0), config, paths=paths
     )
     monkeypatch.setattr(timing, "fastest_profile", _fastest_profile_before_levers)
-    before = plan_cycle(spec, config, paths=paths)
+    before = plan_cycle(spec, config)  # no cache: its profiles are the function's before the levers
     for plan in (now, explicit):
         assert plan.cycle_time == before.cycle_time
         assert [(m.t0, m.profile) for m in plan.moves] == [(m.t0, m.profile) for m in before.moves]
+
+
+def _timed_chain_module() -> str:
+    """Timed fly-by chains (\\T and zones on joint moves), a stop, a MoveL and a wait."""
+    return _module(
+        "            MoveJ pA, v1000\\T:=0.9, z50, tool0;\n"
+        "            MoveJ pB, v1000\\T:=0.8, z50, tool0;\n"
+        "            MoveAbsJ jH, v1000\\T:=0.7, z40, tool0;\n"
+        "            MoveJ pC, v500\\T:=0.9, fine, tool0;\n"
+        "            MoveL pA, v800, z10, tool0;\n"
+        "            WaitTime 0.2;\n"
+        "            MoveJ pB, v1000\\T:=1.0, z50, tool0;\n"
+        "            MoveJ pC, v1000\\T:=0.3, z50, tool0;\n"
+        "            MoveJ pA, v1000, fine, tool0;\n"
+    )
+
+
+def _same_plans(a, b) -> None:
+    assert a.cycle_time == b.cycle_time
+    assert [(m.index, m.t0, m.profile) for m in a.moves] == [(m.index, m.t0, m.profile) for m in b.moves]
+
+
+def test_the_plan_cache_plans_every_setting_as_without_it(robot):
+    """A search's cache (paths, profiles, timed chains) gives each plan exactly as planned afresh,
+    whatever the settings planned before with the same cache."""
+    spec = _spec(_timed_chain_module(), robot)
+    assert any(isinstance(m.profile, timing.ChainProfile) for m in plan_cycle(spec, ControllerConfig()).moves)
+    config = ControllerConfig()
+    paths = PathCache()
+    variants = [
+        spec,
+        _with_all(spec, acc_pct=60.0),
+        spec,
+        _with_all(spec, ramp_pct=40.0, vel_override_pct=80.0),
+        _with_all(spec, acc_pct=60.0),
+    ]
+    for variant in variants:
+        _same_plans(plan_cycle(variant, config, paths=paths), plan_cycle(variant, config))
+    assert paths.chains  # the chains were kept, and asked again
+
+
+def test_a_cycle_is_evaluated_the_same_at_times_in_any_order(robot):
+    plan = plan_cycle(_spec(_timed_chain_module(), robot), ControllerConfig())
+    t = np.linspace(0.0, plan.cycle_time, 997)
+    order = np.random.default_rng(3).permutation(t.size)
+    ordered, shuffled = evaluate_cycle(plan, t), evaluate_cycle(plan, t[order])
+    for field in ("q", "qd", "qdd"):
+        np.testing.assert_array_equal(getattr(shuffled, field), getattr(ordered, field)[order])
 
 
 # ---------------------------------------------------------------- AccSet / VelSet in the reader

@@ -42,8 +42,8 @@ them.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.interpolate import CubicSpline
@@ -93,6 +93,8 @@ class SegmentPath:
     spline: CubicSpline | None  # None: the joint line q0 + s (q1 - q0)
     length_mm: float
     angle_deg: float
+    ends: tuple[FloatArray, FloatArray] | None = field(default=None, repr=False)
+    """``q`` at ``s`` = 0 and 1 as :meth:`at` gives them, once :func:`evaluate_cycle` has asked."""
 
     def at(self, s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``q, dq/ds, d²q/ds²`` at ``s`` (n,) -> (n, joints)."""
@@ -220,9 +222,10 @@ def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:
     qs = [q0]
     for k, q in enumerate(along, start=1):
         if q is None or np.abs(q - qs[-1]).max() > 0.5:
+            what, fix = _line_break(robot, poses @ inv_tcp, q0, k)
             raise InvalidInput(
-                f"{where}:{step.line}: {step.label}: the straight line leaves the reachable space or "
-                f"passes a singularity at {100 * s[k]:.0f} % of the way; use MoveJ or move the target"
+                f"{where}:{step.line}: {step.label}: the straight line {what} at {100 * s[k]:.0f} % "
+                f"of the way; {fix}"
             )
         qs.append(q)
     if np.abs(qs[-1] - q1).max() > 1e-6:
@@ -233,6 +236,39 @@ def segment_path(step: Step, q0: FloatArray, where: str) -> SegmentPath:
     spline = CubicSpline(s, np.stack(qs), axis=0)
     length = float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()) * 1000.0
     return SegmentPath(q0, q1, spline, length, _angle_deg(r0, r1))
+
+
+SINGULAR_DEG = 5.0
+"""Axis 5 within this of 0 (deg) where a line's joints jump: the wrist singularity (axes 4 and 6 aligned)."""
+
+
+def _line_break(robot: Robot, poses: FloatArray, q0: FloatArray, k: int) -> tuple[str, str]:
+    """Why the joints along a line's poses (tool0, from ``q0``) break off at pose ``k`` (1-based), and
+    the fix, in words: an axis that passes its range on the way (the line is out of this arm's
+    reach: perhaps a program for an arm with wider ranges), the wrist singularity, or another one
+    (the arm's wrist centre over axis 1, or the arm stretched). The branch is followed again
+    without the ranges to tell them apart."""
+    lo, hi = robot.joint_ranges()
+    free = solve_ik_along(robot.chain, poses, lower=lo - 4 * np.pi, upper=hi + 4 * np.pi, start=q0)
+    qs = [q0]
+    for q in free[:k]:
+        if q is None or np.abs(q - qs[-1]).max() > 0.5:
+            break
+        qs.append(q)
+    else:
+        path = np.stack(qs)
+        outside = (path < lo - 1e-9) | (path > hi + 1e-9)
+        if outside.any():
+            j = int(np.argmax(outside.any(axis=0)))
+            return (
+                f"needs axis {j + 1} past its range ({np.degrees(lo[j]):.0f} to {np.degrees(hi[j]):.0f} deg)",
+                "out of this arm's reach: for an arm with wider ranges give it with --robot, else use MoveJ",
+            )
+    if abs(np.degrees(qs[-1][4])) < SINGULAR_DEG:
+        wrist = "passes the wrist singularity (axis 5 at 0)"
+        return wrist, "the controller stops there too: use MoveJ or move the target"
+    other = "passes a singular point (the wrist over axis 1, or the arm stretched)"
+    return other, "use MoveJ or move the target"
 
 
 def arc_points(p0: FloatArray, pv: FloatArray, p1: FloatArray, s: FloatArray, where: str) -> FloatArray:
@@ -376,10 +412,18 @@ def _rest_ramp(T: float, m: float) -> float | None:
 
 
 def chain_corners(
-    plans: Sequence[tuple[int, Step, SegmentPath, Profile, float, bool]], config: ControllerConfig
+    plans: Sequence[tuple[int, Step, SegmentPath, Profile, float, bool]],
+    config: ControllerConfig,
+    cache: dict[tuple[object, ...], dict[int, tuple[AnyProfile, float]]] | None = None,
 ) -> dict[int, tuple[AnyProfile, float]]:
     """Timed fly-by corners (see the module docstring): the moves they touch, by position in
-    ``plans``, with their chain profiles and the overlap (s) with the next move (its ramp out)."""
+    ``plans``, with their chain profiles and the overlap (s) with the next move (its ramp out).
+
+    Each chain (a run of consecutive candidate corners) is timed on its own: what a chain's
+    moves run depends only on them, and a corner the controller cannot keep is dropped from its
+    chain. ``cache`` (optional; :class:`PathCache` keeps one) holds each chain's result by what it
+    depends on, so that a search that changes one move re-times only the chain it is in.
+    """
     n = len(plans)
 
     def candidate(k: int) -> bool:
@@ -396,12 +440,61 @@ def chain_corners(
             and fb.duration > 0
         )
 
-    active = {k for k in range(n - 1) if candidate(k)}
+    out: dict[int, tuple[AnyProfile, float]] = {}
+    for chain in _runs(k for k in range(n - 1) if candidate(k)):
+        key = None if cache is None else _chain_key(plans, chain, config)
+        found = None if key is None or cache is None else cache.get(key)
+        if found is None:
+            found = _timed_chain(plans, chain, config)
+            if key is not None and cache is not None:
+                cache[key] = {j - chain[0]: v for j, v in found.items()}
+        else:
+            found = {j + chain[0]: v for j, v in found.items()}
+        out.update(found)
+    return out
+
+
+def _runs(corners: Iterable[int]) -> list[list[int]]:
+    """Consecutive corners grouped: the chains."""
+    runs: list[list[int]] = []
+    for k in corners:
+        if runs and runs[-1][-1] == k - 1:
+            runs[-1].append(k)
+        else:
+            runs.append([k])
+    return runs
+
+
+def _timed_chain(
+    plans: Sequence[tuple[int, Step, SegmentPath, Profile, float, bool]],
+    chain: list[int],
+    config: ControllerConfig,
+) -> dict[int, tuple[AnyProfile, float]]:
+    """One chain's profiles, its corners the controller cannot keep dropped one at a time."""
+    active = set(chain)
     while True:
         out, bad = _chain_profiles(plans, active, config)
         if bad is None:
             return out
         active.discard(bad)
+
+
+def _chain_key(
+    plans: Sequence[tuple[int, Step, SegmentPath, Profile, float, bool]],
+    chain: list[int],
+    config: ControllerConfig,
+) -> tuple[object, ...]:
+    """What a chain's timing depends on: each of its moves' path, rest profile, ``\\T``, zone and
+    ``AccSet`` share (the path by identity: a :class:`PathCache`'s paths are kept)."""
+    members = range(chain[0], chain[-1] + 2)
+    return (
+        config,
+        plans[chain[0]][1].robot,
+        tuple(
+            (plans[j][2], plans[j][3], timed_s(plans[j][1]), plans[j][1].zone_mm, acc_share(plans[j][1]))
+            for j in members
+        ),
+    )
 
 
 def _chain_profiles(
@@ -481,6 +574,30 @@ class PathCache:
     def __init__(self) -> None:
         self._paths: dict[tuple[int, bool, bytes, bytes, bytes], SegmentPath] = {}
         self._fractions: dict[tuple[AnyProfile, float], float] = {}
+        self._profiles: dict[tuple[object, ...], Profile] = {}
+        self.chains: dict[tuple[object, ...], dict[int, tuple[AnyProfile, float]]] = {}
+        """Timed fly-by chains by what they depend on (:func:`chain_corners`)."""
+
+    def profile(self, step: Step, path: SegmentPath, config: ControllerConfig) -> Profile:
+        """:func:`fastest_profile` of ``step`` on ``path`` (a path of this cache), found once for the
+        timing it depends on: the speed data, ``\\T``, ``AccSet`` and ``VelSet``."""
+        assert step.speed is not None
+        key = (
+            path,
+            step.robot,
+            config,
+            step.speed.v_tcp,
+            step.speed.v_ori,
+            step.time_s,
+            step.acc_pct,
+            step.ramp_pct,
+            step.vel_override_pct,
+            step.vel_max_mm_s,
+        )
+        found = self._profiles.get(key)
+        if found is None:
+            found = self._profiles[key] = fastest_profile(step, path, config)
+        return found
 
     def time_at_fraction(self, p: AnyProfile, fraction: float) -> float:
         """When profile ``p`` reaches ``fraction`` of its path (s), found once."""
@@ -525,13 +642,15 @@ def plan_cycle(
         if np.abs(step.q - q).max() <= 1e-9:
             fastest = Profile(ta=0.0, tc=0.0, v=0.0)
         else:
-            fastest = fastest_profile(step, path, config)
+            fastest = (
+                fastest_profile(step, path, config) if paths is None else paths.profile(step, path, config)
+            )
         radius = step.zone_mm
         stop = stops_after(spec, i)
         frac = 0.0 if stop or radius is None or path.length_mm <= 0 else min(radius / path.length_mm, 0.5)
         plans.append((i, step, path, fastest, frac, stop))
         q = step.q
-    chained = chain_corners(plans, config)
+    chained = chain_corners(plans, config, None if paths is None else paths.chains)
     t = 0.0
     out: list[PlannedMove] = []
     waits: list[tuple[int, float, float]] = []
@@ -564,23 +683,47 @@ def plan_cycle(
 
 def evaluate_cycle(plan: PlannedCycle, t: FloatArray) -> Trajectory:
     """The commanded motion (superposed moves) at times ``t``."""
+    t = np.asarray(t, dtype=float)
     n_j = plan.start.size
     q = np.tile(plan.start, (t.size, 1))
     qd = np.zeros((t.size, n_j))
     qdd = np.zeros((t.size, n_j))
-    for m in plan.moves:
-        base, _, _ = m.path.at(np.array([0.0]))
-        end, _, _ = m.path.at(np.array([1.0]))
-        after = t >= m.t_end
-        q[after] += end[0] - base[0]
-        inside = (t >= m.t0) & ~after
-        if m.profile.duration > 0 and inside.any():
+    ordered = t.size < 2 or bool(np.all(t[1:] >= t[:-1]))
+    ends = _path_ends(plan)
+    for m, (base, end) in zip(plan.moves, ends, strict=True):
+        # the samples at or after the move's end, and those inside it: a suffix and a slice of
+        # sorted times (the same samples, in the same order, as the masks of unsorted ones)
+        if ordered:
+            a = int(np.searchsorted(t, m.t_end, side="left"))
+            after: slice | FloatArray = slice(a, None)
+            inside: slice | FloatArray = slice(min(int(np.searchsorted(t, m.t0, side="left")), a), a)
+            any_inside = inside.stop > inside.start
+        else:
+            after = t >= m.t_end
+            inside = (t >= m.t0) & ~after
+            any_inside = bool(inside.any())
+        q[after] += end - base
+        if m.profile.duration > 0 and any_inside:
             s, sd, sdd = evaluate_any(m.profile, t[inside] - m.t0)
             pq, pd, pdd = m.path.at(s)
-            q[inside] += pq - base[0]
+            q[inside] += pq - base
             qd[inside] += pd * sd[:, None]
             qdd[inside] += pdd * (sd * sd)[:, None] + pd * sdd[:, None]
     return Trajectory(t=t, q=q, qd=qd, qdd=qdd)
+
+
+def _path_ends(plan: PlannedCycle) -> list[tuple[FloatArray, FloatArray]]:
+    """Each move's path at ``s`` = 0 and 1 (as :meth:`SegmentPath.at` gives them), found once a path."""
+    out = []
+    for m in plan.moves:
+        found = m.path.ends
+        if found is None:
+            base, _, _ = m.path.at(np.array([0.0]))
+            end, _, _ = m.path.at(np.array([1.0]))
+            found = (base[0], end[0])
+            object.__setattr__(m.path, "ends", found)
+        out.append(found)
+    return out
 
 
 def standalone(move: PlannedMove, *, dt: float = FINE_DT) -> Trajectory:
