@@ -498,3 +498,42 @@ def test_a_module_past_the_bound_is_first_brought_within_it(robot):
     assert _farthest_mm(again, ref) <= limit_mm
     assert lv.cycle_s <= baseline[0] + 1e-6
     assert any(m.chosen.zone != m.taught.zone for m in lv.moves)
+
+
+def _long_chain_module() -> str:
+    """One long timed fly-by chain whose short moves break corners in its middle."""
+    moves = [("pA", 0.9), ("pB", 0.9), ("pC", 0.15), ("pA", 0.3), ("pB", 1.2), ("pC", 0.5), ("pA", 0.15)]
+    lines = "".join(f"            MoveJ {p}, v1000\\T:={t}, z50, tool0;\n" for p, t in moves)
+    return _module(lines + "            MoveJ pB, v1000, fine, tool0;\n")
+
+
+def _dropped_one_at_a_time(plans, chain, config):
+    """The reference: the whole chain timed again after each corner it drops."""
+    active = set(chain)
+    while True:
+        out, bad = timing._chain_profiles(plans, active, config)
+        if bad is None:
+            return out
+        active.discard(bad)
+
+
+@pytest.mark.parametrize("acc", [100.0, 60.0, 30.0])
+def test_a_chain_split_at_its_dropped_corners_times_as_the_whole_chain(robot, acc, monkeypatch):
+    """Timing each part of a chain on its own after a corner is dropped drops the same corners and
+    gives the same profiles as timing the whole chain again after each drop."""
+    spec = _with_all(_spec(_long_chain_module(), robot), acc_pct=acc)
+    config = ControllerConfig()
+    drops = []
+    real = timing._chain_profiles
+
+    def counted(plans, active, config):
+        out, bad = real(plans, active, config)
+        if bad is not None and min(active) < bad < max(active):
+            drops.append(bad)  # a corner dropped with corners on both sides: the chain splits
+        return out, bad
+
+    monkeypatch.setattr(timing, "_chain_profiles", counted)
+    split = plan_cycle(spec, config)
+    monkeypatch.setattr(timing, "_timed_chain", _dropped_one_at_a_time)
+    _same_plans(split, plan_cycle(spec, config))
+    assert drops, "no chain was split: the case does not test the split"

@@ -470,13 +470,20 @@ def _timed_chain(
     chain: list[int],
     config: ControllerConfig,
 ) -> dict[int, tuple[AnyProfile, float]]:
-    """One chain's profiles, its corners the controller cannot keep dropped one at a time."""
-    active = set(chain)
-    while True:
-        out, bad = _chain_profiles(plans, active, config)
-        if bad is None:
-            return out
-        active.discard(bad)
+    """One chain's profiles, its corners the controller cannot keep dropped one at a time.
+
+    A dropped corner splits the chain in two that share no move's timing (a move's profile depends
+    only on the corners before and after it), so each part is timed on its own: the corners each
+    part drops, and in what order, are those the whole chain would drop.
+    """
+    out, bad = _chain_profiles(plans, set(chain), config)
+    if bad is None:
+        return out
+    found: dict[int, tuple[AnyProfile, float]] = {}
+    for part in (chain[: chain.index(bad)], chain[chain.index(bad) + 1 :]):
+        if part:
+            found.update(_timed_chain(plans, part, config))
+    return found
 
 
 def _chain_key(
@@ -685,11 +692,22 @@ def evaluate_cycle(plan: PlannedCycle, t: FloatArray) -> Trajectory:
     """The commanded motion (superposed moves) at times ``t``."""
     t = np.asarray(t, dtype=float)
     n_j = plan.start.size
-    q = np.tile(plan.start, (t.size, 1))
     qd = np.zeros((t.size, n_j))
     qdd = np.zeros((t.size, n_j))
     ordered = t.size < 2 or bool(np.all(t[1:] >= t[:-1]))
     ends = _path_ends(plan)
+    t_ends = np.array([m.t_end for m in plan.moves])
+    # the moves a sample is past are a prefix of the moves when they end in order (a move that
+    # blends into the next ends before it): the sample then starts from the running sum of the
+    # prefix's displacements, added in the order the moves come (the same sums, to the bit)
+    prefix = ordered and bool(np.all(np.diff(t_ends) >= 0.0))
+    if prefix:
+        steps = (
+            np.vstack([plan.start[None], [end - base for base, end in ends]]) if ends else plan.start[None]
+        )
+        q = np.cumsum(steps, axis=0)[np.searchsorted(t_ends, t, side="right")]
+    else:
+        q = np.tile(plan.start, (t.size, 1))
     for m, (base, end) in zip(plan.moves, ends, strict=True):
         # the samples at or after the move's end, and those inside it: a suffix and a slice of
         # sorted times (the same samples, in the same order, as the masks of unsorted ones)
@@ -702,7 +720,8 @@ def evaluate_cycle(plan: PlannedCycle, t: FloatArray) -> Trajectory:
             after = t >= m.t_end
             inside = (t >= m.t0) & ~after
             any_inside = bool(inside.any())
-        q[after] += end - base
+        if not prefix:
+            q[after] += end - base
         if m.profile.duration > 0 and any_inside:
             s, sd, sdd = evaluate_any(m.profile, t[inside] - m.t0)
             pq, pd, pdd = m.path.at(s)
