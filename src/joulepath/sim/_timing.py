@@ -46,6 +46,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 from scipy.interpolate import CubicSpline
 
 from joulepath._typing import FloatArray
@@ -711,15 +712,16 @@ def evaluate_cycle(plan: PlannedCycle, t: FloatArray) -> Trajectory:
     for m, (base, end) in zip(plan.moves, ends, strict=True):
         # the samples at or after the move's end, and those inside it: a suffix and a slice of
         # sorted times (the same samples, in the same order, as the masks of unsorted ones)
+        after: slice | npt.NDArray[np.bool_]
+        inside: slice | npt.NDArray[np.bool_]
         if ordered:
             a = int(np.searchsorted(t, m.t_end, side="left"))
-            after: slice | FloatArray = slice(a, None)
-            inside: slice | FloatArray = slice(min(int(np.searchsorted(t, m.t0, side="left")), a), a)
-            any_inside = inside.stop > inside.start
+            first = min(int(np.searchsorted(t, m.t0, side="left")), a)
+            after, inside, any_inside = slice(a, None), slice(first, a), a > first
         else:
-            after = t >= m.t_end
-            inside = (t >= m.t0) & ~after
-            any_inside = bool(inside.any())
+            late = t >= m.t_end
+            within = (t >= m.t0) & ~late
+            after, inside, any_inside = late, within, bool(within.any())
         if not prefix:
             q[after] += end - base
         if m.profile.duration > 0 and any_inside:
