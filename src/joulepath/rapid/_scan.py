@@ -9,12 +9,8 @@ from joulepath.rapid import builtins
 from joulepath.rapid import nodes as n
 from joulepath.rapid._trace import Taint
 from joulepath.rapid._vocabulary import (
-    ABSJ_MOTIONS,
-    CIRCULAR_MOTIONS,
     IO_SETTERS,
     IO_WAITS,
-    JOINT_MOTIONS,
-    LINEAR_MOTIONS,
 )
 from joulepath.rapid.task import Task
 
@@ -109,20 +105,14 @@ def pairs(args: tuple[n.Arg, ...]) -> list[tuple[str | None, n.Expr | None]]:
 
 
 def moves_in(r: n.Routine) -> bool:
-    motion = set(JOINT_MOTIONS) | set(LINEAR_MOTIONS) | set(CIRCULAR_MOTIONS) | set(ABSJ_MOTIONS)
+    """Whether a routine holds a move, or a call that may move (listed for the user to choose)."""
 
     def walk(body: tuple[n.Stmt, ...]) -> bool:
         for s in body:
-            if isinstance(s, n.Call) and s.name.lower() in motion:
-                return True
-            if isinstance(s, n.If) and (any(walk(b) for _, b in s.branches) or walk(s.orelse)):
-                return True
-            if isinstance(s, (n.For, n.While)) and walk(s.body):
-                return True
-            if isinstance(s, n.Test) and (any(walk(b) for _, b in s.cases) or walk(s.default or ())):
-                return True
             if isinstance(s, n.Call):
-                return True  # a call may move; listed for the user to choose
+                return True  # a move, or a call that may move
+            if any(walk(b) for b in n.blocks(s)):
+                return True
         return False
 
     return walk(r.body)

@@ -367,15 +367,8 @@ def has_motion(ip: Machine, body: tuple[n.Stmt, ...], depth: int) -> bool:
                 return True
         elif isinstance(s, n.LateCall):
             return True
-        elif isinstance(s, n.If):
-            if any(has_motion(ip, b, depth) for _, b in s.branches) or has_motion(ip, s.orelse, depth):
-                return True
-        elif isinstance(s, (n.For, n.While)):
-            if has_motion(ip, s.body, depth):
-                return True
-        elif isinstance(s, n.Test):
-            if any(has_motion(ip, b, depth) for _, b in s.cases) or has_motion(ip, s.default or (), depth):
-                return True
+        elif any(has_motion(ip, b, depth) for b in n.blocks(s)):
+            return True
     return False
 
 
@@ -410,17 +403,8 @@ def _motion_weight(ip: Machine, body: tuple[n.Stmt, ...], depth: int = 0) -> int
             key = s.name.lower()
             found = ip.routines.get(key)
             total += 1 if key in ALL_MOTIONS else _motion_weight(ip, found[0].body, depth + 1) if found else 0
-        elif isinstance(s, n.If):
-            total += max(
-                [_motion_weight(ip, b, depth) for _, b in s.branches] + [_motion_weight(ip, s.orelse, depth)]
-            )
-        elif isinstance(s, (n.For, n.While)):
-            total += _motion_weight(ip, s.body, depth)
-        elif isinstance(s, n.Test):
-            total += max(
-                [_motion_weight(ip, b, depth) for _, b in s.cases]
-                + [_motion_weight(ip, s.default or (), depth)]
-            )
+        else:  # the alternative that moves most (a loop's body: its one turn)
+            total += max((_motion_weight(ip, b, depth) for b in n.blocks(s)), default=0)
     return total
 
 
