@@ -136,7 +136,6 @@ class Machine:
         self._initialising: set[tuple[str, str]] = set()
 
     # ---- setup
-
     def _define_types(self) -> None:
         for m in self.task.modules:
             for r in m.records:
@@ -188,7 +187,6 @@ class Machine:
                 self.routines[key] = (r, m)
 
     # ---- budget
-
     def tick(self, pos: n.Pos) -> None:
         self.steps += 1
         if self.steps > self.max_steps or (
@@ -219,7 +217,6 @@ class Machine:
         return tuple(out + self.loops)
 
     # ---- names
-
     def _module(self) -> n.Module | None:
         return self.stack[-1].module if self.stack else None
 
@@ -349,7 +346,6 @@ class Machine:
         return self.routines.get(key)
 
     # ---- declarations
-
     def _dims(self, decl: n.DataDecl) -> tuple[int, ...]:
         dims = []
         for e in decl.dims:
@@ -434,7 +430,6 @@ class Machine:
             k += 1
 
     # ---- values
-
     def unfinished(self, p: n.Placeholder) -> RapidError:
         return RapidError(
             f"{p.pos}: {p.text} is a placeholder of unfinished code, and the cycle runs it; write it "
