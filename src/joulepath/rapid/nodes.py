@@ -10,8 +10,9 @@ source, and the writer edits exactly that span.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from typing import Any
 
 
 @dataclass(frozen=True, slots=True)
@@ -357,21 +358,20 @@ class Module:
         return any(a.upper() == "SYSMODULE" for a in self.attributes)
 
 
+def blocks(s: Stmt) -> tuple[tuple[Stmt, ...], ...]:
+    """The statement lists a statement holds, one per alternative: ``IF``'s branches then its ``ELSE``,
+    ``TEST``'s cases then its ``DEFAULT``, a loop's body (:data:`BLOCKS`); none for a simple one."""
+    get = BLOCKS.get(type(s))
+    return get(s) if get is not None else ()
+
+
 def walk_statements(body: tuple[Stmt, ...]) -> Iterator[Stmt]:
     """Every statement of a statement list, nested blocks (``IF``, ``FOR``, ``WHILE``, ``TEST``) included,
     in source order."""
     for s in body:
         yield s
-        if isinstance(s, If):
-            for _, b in s.branches:
-                yield from walk_statements(b)
-            yield from walk_statements(s.orelse)
-        elif isinstance(s, (For, While)):
-            yield from walk_statements(s.body)
-        elif isinstance(s, Test):
-            for _, b in s.cases:
-                yield from walk_statements(b)
-            yield from walk_statements(s.default or ())
+        for b in blocks(s):
+            yield from walk_statements(b)
 
 
 def walk_nodes(root: object) -> Iterator[object]:
@@ -398,3 +398,12 @@ def base_name(e: object) -> str | None:
     while isinstance(e, (Index, Field)):
         e = e.base
     return e.name.lower() if isinstance(e, Name) else None
+
+
+BLOCKS: dict[type, Callable[[Any], tuple[tuple[Stmt, ...], ...]]] = {
+    If: lambda s: (*(b for _, b in s.branches), s.orelse),
+    Test: lambda s: (*(b for _, b in s.cases), s.default or ()),
+    For: lambda s: (s.body,),
+    While: lambda s: (s.body,),
+}
+"""Compound statement type -> the statement lists it holds (:func:`blocks`)."""

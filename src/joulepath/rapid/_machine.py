@@ -1,0 +1,548 @@
+"""The interpreter's machine: its state, the names it resolves, and its dispatch by node type.
+
+:class:`Machine` holds one run's state explicitly (see :mod:`joulepath.rapid.interpreter`): the task's
+data and routines, an environment per routine call, the motion settings in force, the step budget
+(:meth:`Machine.tick`). It resolves names (:meth:`Machine.lookup`, a stand-in for a name declared
+nowhere), declares data, and evaluates an expression (:meth:`Machine.ev`) or runs a statement
+(:meth:`Machine.exec`) by the handler its node type has in :attr:`Machine.expressions` or
+:attr:`Machine.statements`: the tables of :mod:`joulepath.rapid._expressions` and
+:mod:`joulepath.rapid._statements`, plugged in by :class:`joulepath.rapid.interpreter.Interpreter`,
+in the way of :class:`ast.NodeVisitor`. It has no ``isinstance`` chain over node types.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+
+from joulepath._typing import FloatArray
+from joulepath.errors import RapidError
+from joulepath.rapid import _standins as standins
+from joulepath.rapid import geometry as geo
+from joulepath.rapid import nodes as n
+from joulepath.rapid._scan import assigned_names, set_names, signal_names
+from joulepath.rapid._state import (
+    MAX_SECONDS,
+    MAX_STEPS,
+    UNKNOWN_TARGET,
+    UNTYPED,
+    Cell,
+    Frame,
+    GotoLabel,
+    Ref,
+    opaque_ok,
+    parse_literal,
+    predefined_data,
+    signal_kind,
+)
+from joulepath.rapid._trace import CLEAN, Event, Kinematics, MotionSettings, Taint
+from joulepath.rapid._vocabulary import PROCESS_CIRCULAR, PROCESS_LINEAR
+from joulepath.rapid.task import Task
+from joulepath.rapid.values import (
+    NUM_TYPES,
+    SIGNAL_TYPES,
+    Array,
+    Record,
+    Signal,
+    TypeErrorRapid,
+    Types,
+    Value,
+    describe,
+    num,
+)
+
+ExprHandler = Callable[["Machine", Any], tuple[Value, Taint]]
+"""The handler of one expression node type: its value and the reasons it is uncertain."""
+StmtHandler = Callable[["Machine", Any], None]
+"""The handler of one statement node type."""
+CallHandler = Callable[["Machine", n.Call, str], None]
+"""The handler of an instruction: the machine, the call, the instruction's name in lower case."""
+
+
+class Machine:
+    """One run's state, its names and its dispatch by node type (see the module's docstring)."""
+
+    expressions: ClassVar[Mapping[type, ExprHandler]] = {}
+    """Expression node type -> its handler (:data:`joulepath.rapid._expressions.EXPRESSIONS`)."""
+    statements: ClassVar[Mapping[type, StmtHandler]] = {}
+    """Statement node type -> its handler (:data:`joulepath.rapid._statements.STATEMENTS`)."""
+
+    def __init__(
+        self,
+        task: Task,
+        *,
+        io: Mapping[str, float | str | bool] | None = None,
+        seed: int = 0,
+        kinematics: Kinematics | None = None,
+        max_steps: int = MAX_STEPS,
+        max_seconds: float | None = MAX_SECONDS,
+        progress: Callable[[str], None] | None = None,
+        given: Mapping[str, Value] | None = None,
+        rated_payload_kg: float | None = None,
+    ) -> None:
+        self.task = task
+        self.given = {k.lower(): v for k, v in (given or {}).items()}
+        self.rated_payload_kg = rated_payload_kg
+        self.assumed: list[standins.Assumption] = []
+        self.assumed_routines: set[str] = set()
+        self.types = Types()
+        self.kin = kinematics
+        self.rng = np.random.default_rng(seed)
+        self.seed = seed
+        self.io = {k.lower(): v for k, v in (io or {}).items()}
+        self.io_used: set[str] = set()
+        self.max_steps, self.max_seconds = max_steps, max_seconds
+        self.progress = progress
+        self.steps = 0
+        self.t0 = time.perf_counter()
+        self.events: list[Event] = []
+        self.notes: list[str] = []
+        self._noted: set[str] = set()
+        self.cycle_start = 0
+        self.cycle_end: int | None = None
+        self.loop: n.Pos | None = None
+        self.ctx_taint: Taint = CLEAN
+        self.after_branch: Taint = CLEAN
+        self.settings = MotionSettings()
+        self.pdisp: FloatArray | None = None
+        self.current_q: FloatArray | None = None
+        self.current_taint: Taint = CLEAN
+        self.stack: list[Frame] = []
+        self.loops: list[str] = []
+        self.outputs: dict[str, Value] = {}
+        self._define_types()
+        self.predefined = predefined_data(self.types)
+        for line in task.notes:
+            self.note(line)
+        self.base = np.eye(4)  # the robot's base frame in the world (MOC.cfg), m
+        if task.moc is not None:
+            x, y, z = (1000.0 * v for v in task.moc.base_pos_m)
+            self.base = geo.frame((x, y, z), task.moc.base_quat)
+            for line in task.moc.lines():
+                self.note(line)
+        self.globals: dict[str, tuple[n.DataDecl, n.Module]] = {}
+        self.locals_of: dict[str, dict[str, tuple[n.DataDecl, n.Module]]] = {}
+        self.cells: dict[tuple[str, str], Cell] = {}
+        self.routines: dict[str, tuple[n.Routine, n.Module]] = {}
+        self.local_routines: dict[str, dict[str, tuple[n.Routine, n.Module]]] = {}
+        self._index()
+        self.assigned = assigned_names(task)
+        self.signals_used = signal_names(task, self.globals)
+        self.roles = standins.name_roles(self.task.modules, PROCESS_LINEAR, PROCESS_CIRCULAR)
+        self.set_names = set_names(task, self.routines)
+        self._initialising: set[tuple[str, str]] = set()
+
+    # ---- setup
+    def _define_types(self) -> None:
+        for m in self.task.modules:
+            for r in m.records:
+                key = r.name.lower()
+                if key in self.types.records:
+                    raise RapidError(
+                        f"{r.pos}: the record type {r.name} is defined twice; keep one definition"
+                    )
+                self.types.records[key] = tuple((ft, fn.lower()) for ft, fn in r.fields)
+            for a in m.aliases:
+                self.types.aliases[a.name.lower()] = a.type.lower()
+        # RECORD fields were read as (type, name): store as (name, type)
+        for m in self.task.modules:
+            for r in m.records:
+                self.types.records[r.name.lower()] = tuple((fn.lower(), ft) for ft, fn in r.fields)
+
+    def _index(self) -> None:
+        where: dict[str, n.Pos] = {}
+        for m in self.task.modules:
+            mkey = m.name.lower()
+            self.locals_of[mkey] = {}
+            self.local_routines[mkey] = {}
+            for d in m.data:
+                key = d.name.lower()
+                if d.scope == "LOCAL":
+                    self.locals_of[mkey][key] = (d, m)
+                    continue
+                if key in self.globals and not (
+                    d.storage == "PERS" and self.globals[key][0].storage == "PERS"
+                ):
+                    raise RapidError(
+                        f"{d.pos}: {d.name} is also declared at {where[key]}; a task's global names are "
+                        "unique: rename one or make it LOCAL"
+                    )
+                if key not in self.globals:
+                    self.globals[key] = (d, m)
+                    where[key] = d.pos
+            for r in m.routines:
+                key = r.name.lower()
+                if r.local:
+                    self.local_routines[mkey][key] = (r, m)
+                    continue
+                if key in self.routines:
+                    other = self.routines[key][0]
+                    raise RapidError(
+                        f"{r.pos}: routine {r.name} is also declared at {other.pos}; "
+                        "rename one or make it LOCAL"
+                    )
+                self.routines[key] = (r, m)
+
+    # ---- budget
+    def tick(self, pos: n.Pos) -> None:
+        self.steps += 1
+        if self.steps > self.max_steps or (
+            self.max_seconds is not None
+            and self.steps % 4096 == 0
+            and time.perf_counter() - self.t0 > self.max_seconds
+        ):
+            raise RapidError(
+                f"{pos}: the program runs more than {self.max_steps} statements without finishing a cycle "
+                f"({time.perf_counter() - self.t0:.0f} s): a loop that never ends or never moves, or calls "
+                "that multiply; give the inputs it waits for (--io) or check the loop's condition"
+            )
+
+    def source_of(self, pos: n.Pos) -> str:
+        """The source text at ``pos`` (one line, spaces collapsed)."""
+        m = self.task.module_of(pos.file)
+        if m is None:
+            return "(expression)"
+        return " ".join(m.text[pos.start : pos.end].split())
+
+    def note(self, text: str) -> None:
+        if text not in self._noted:
+            self._noted.add(text)
+            self.notes.append(text)
+
+    def context(self) -> tuple[str, ...]:
+        out = [f"{f.label}" for f in self.stack[2:]]
+        return tuple(out + self.loops)
+
+    # ---- names
+    def _module(self) -> n.Module | None:
+        return self.stack[-1].module if self.stack else None
+
+    def _global_cell(self, key: str, decl: n.DataDecl, module: n.Module) -> Cell:
+        ck = (module.name.lower() if decl.scope == "LOCAL" else "", key)
+        cell = self.cells.get(ck)
+        if cell is not None:
+            return cell
+        if ck in self._initialising:
+            raise RapidError(f"{decl.pos}: {decl.name} is initialised from itself; give it a value")
+        self._initialising.add(ck)
+        try:
+            saved = self.stack
+            self.stack = [Frame(None, module, {}, set(), module.name)]
+            try:
+                cell = self.declare(decl)
+            finally:
+                self.stack = saved
+        finally:
+            self._initialising.discard(ck)
+        self.cells[ck] = cell
+        return cell
+
+    def lookup(self, name: str, pos: n.Pos) -> Cell | Ref:
+        key = name.lower()
+        if self.stack:
+            frame = self.stack[-1]
+            if key in frame.locals:
+                return frame.locals[key]
+            if frame.module is not None:
+                local = self.locals_of.get(frame.module.name.lower(), {}).get(key)
+                if local is not None:
+                    return self._global_cell(key, local[0], local[1])
+        if key in self.globals:
+            decl, module = self.globals[key]
+            return self._global_cell(key, decl, module)
+        if key in self.predefined:
+            return self.predefined[key]
+        if key in self.signals_used or key in self.io:
+            ck = ("", key)
+            if ck not in self.cells:
+                self.cells[ck] = Cell(name, "signal", "IO", Signal(name, signal_kind(name)), CLEAN, None)
+            return self.cells[ck]
+        if key == "errno" or key.startswith("err_"):
+            return Cell(name, "errnum", "CONST", 0.0, CLEAN, None)
+        return self.stand_in(name, pos)
+
+    def stand_in(self, name: str, pos: n.Pos) -> Cell:
+        """A name declared nowhere in what was given: a stand-in by the role the program gives it
+        (:mod:`joulepath.rapid._standins`), or the scenario's value for it; said once, in
+        :attr:`Trace.assumed`."""
+        key = name.lower()
+        found = self.cells.get(("", key))
+        if found is not None:
+            return found
+        role = self.roles.get(key, "value")
+        taint: Taint = CLEAN
+        if key in self.given:
+            type_ = role if role != "value" else "num"
+            given = self.given[key]
+            try:
+                if isinstance(given, str) and type_ != "string":  # a RAPID literal: "[2000, 500, 5000, 1000]"
+                    given, _ = self.ev(parse_literal(given))
+                value = self.types.coerce(given, type_)
+            except TypeErrorRapid as err:
+                raise RapidError(f"{pos}: the scenario's {name}: {err}; give a {type_}") from None
+            said = "the scenario's value"
+        else:
+            value, taint, said = self._stand_in_value(name, role, pos)
+        storage = "CONST" if role in ("tooldata", "wobjdata", "speeddata", "zonedata", "loaddata") else "VAR"
+        type_ = UNTYPED if role == "value" and key not in self.given else role
+        cell = Cell(name, type_, storage, value, taint, pos)
+        self.cells[("", key)] = cell
+        self.assumed.append(standins.Assumption(name, role, said, pos))
+        return cell
+
+    def _stand_in_value(self, name: str, role: str, pos: n.Pos) -> tuple[Value, Taint, str]:
+        pre = self.predefined
+        if role == "tooldata":
+            payload = self.rated_payload_kg
+            mass = 0.0 if payload is None else round(standins.LOAD_FRACTION * payload, 3)
+            cog = standins.LOAD_COG_MM if mass > 0 else 0.0
+            value = self.types.coerce(
+                (
+                    True,
+                    ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)),
+                    (mass, (0.0, 0.0, cog), (1.0, 0.0, 0.0, 0.0), 0.0, 0.0, 0.0),
+                ),
+                "tooldata",
+            )
+            load = (
+                f"a load of {mass:g} kg ({100 * standins.LOAD_FRACTION:.0f} % of the rated payload) "
+                f"{cog:g} mm out along tool0's z"
+                if mass > 0
+                else "no load (the robot's rated payload is not known)"
+            )
+            return value, CLEAN, f"tool0's frame and {load}; give [tool.{name}] in the scenario file"
+        if role == "wobjdata":
+            return (
+                pre["wobj0"].value,
+                CLEAN,
+                f"wobj0 (the robot's base frame); give [wobj.{name}] in the scenario file",
+            )
+        if role == "speeddata":
+            return pre["v1000"].value, CLEAN, f"v1000; give {name} in the scenario file's [data]"
+        if role == "zonedata":
+            return pre["fine"].value, CLEAN, f"fine (a stop point); give {name} in the scenario file's [data]"
+        if role == "loaddata":
+            return pre["load0"].value, CLEAN, f"load0 (no load); give {name} in the scenario file's [data]"
+        if role in standins.TARGET_TYPES:
+            why = frozenset({f"{pos}: {name} is declared nowhere in what was given: {UNKNOWN_TARGET}"})
+            said = (
+                f"{UNKNOWN_TARGET}: the moves to and from it are kept as taught; give it in the scenario's "
+                "[targets]"
+            )
+            return self.types.default(role), why, said
+        why = frozenset({f"{pos}: {name} is declared nowhere in what was given: known only at run time"})
+        return 0.0, why, "a value known only at run time (0 taken, and what it decides is marked)"
+
+    def routine(self, name: str, pos: n.Pos) -> tuple[n.Routine, n.Module] | None:
+        key = name.lower()
+        module = self._module()
+        if module is not None:
+            local = self.local_routines.get(module.name.lower(), {}).get(key)
+            if local is not None:
+                return local
+        return self.routines.get(key)
+
+    # ---- declarations
+    def _dims(self, decl: n.DataDecl) -> tuple[int, ...]:
+        dims = []
+        for e in decl.dims:
+            v, _ = self.ev(e)
+            d = num(v)
+            if d != int(d) or not 1 <= d <= 100_000:
+                raise RapidError(f"{decl.pos}: the array {decl.name} has dimension {d:g}; give 1 to 100000")
+            dims.append(int(d))
+        if len(dims) > 3:
+            raise RapidError(f"{decl.pos}: {decl.name} has {len(dims)} dimensions; RAPID allows 1 to 3")
+        return tuple(dims)
+
+    def declare(self, decl: n.DataDecl) -> Cell:
+        type_ = self.types.resolve(decl.type)
+        known = type_ in NUM_TYPES or type_ in ("bool", "string") or type_ in self.types.records
+        if not known and type_ not in SIGNAL_TYPES and not opaque_ok(type_):
+            raise RapidError(
+                f"{decl.pos}: the data type {decl.type} is declared nowhere; pass the module with its "
+                "RECORD definition"
+            )
+        dims = self._dims(decl)
+        taint: Taint = CLEAN
+        if decl.init is not None:
+            value, taint = self.ev(decl.init)
+            try:
+                value = self.types.array(value, type_, dims) if dims else self.types.coerce(value, type_)
+            except TypeErrorRapid as err:
+                raise RapidError(f"{decl.pos}: {decl.name}: {err}; correct the value") from None
+        elif type_ in SIGNAL_TYPES:
+            value = Signal(decl.name, type_[6:])
+        elif dims:
+            size = int(np.prod(dims))
+            value = Array(type_, dims, tuple(self.types.default(type_) for _ in range(size)))
+        else:
+            value = self.types.default(type_)
+            if type_ in standins.TARGET_TYPES and decl.storage == "VAR":  # known once the program sets it
+                given = self.given.get(decl.name.lower())
+                if given is not None:
+                    value = self.types.coerce(given, type_)
+                else:
+                    taint = frozenset({f"{decl.pos}: {decl.name} is declared without a value"})
+        return Cell(decl.name, type_, decl.storage, value, taint, decl.pos)
+
+    # ---- dispatch by node type
+    def ev(self, e: n.Expr) -> tuple[Value, Taint]:
+        """The value of an expression and the reasons it is uncertain: the handler of its node type."""
+        return self.expressions[type(e)](self, e)
+
+    def exec(self, s: n.Stmt) -> None:
+        """Run one statement; an error of a value's type or geometry is refused in one line there."""
+        try:
+            self._exec(s)
+        except RapidError:
+            raise
+        except (ValueError, TypeErrorRapid, ZeroDivisionError, IndexError, OverflowError) as err:
+            text = " ".join(str(err).split())[:160]
+            raise RapidError(f"{s.pos}: {text}; correct the statement") from None
+
+    def _exec(self, s: n.Stmt) -> None:
+        self.tick(s.pos)
+        self.statements[type(s)](self, s)
+
+    def exec_body(self, body: tuple[n.Stmt, ...]) -> None:
+        k = 0
+        while k < len(body):
+            s = body[k]
+            try:
+                self.exec(s)
+            except GotoLabel as g:
+                idx = next(
+                    (
+                        j
+                        for j, t in enumerate(body)
+                        if isinstance(t, n.Label) and t.name.lower() == g.label.lower()
+                    ),
+                    None,
+                )
+                if idx is None:
+                    raise
+                k = idx + 1
+                continue
+            k += 1
+
+    # ---- values
+    def unfinished(self, p: n.Placeholder) -> RapidError:
+        return RapidError(
+            f"{p.pos}: {p.text} is a placeholder of unfinished code, and the cycle runs it; write it "
+            "(or give --routine NAME to run another routine)"
+        )
+
+    def conditionals(self, args: tuple[n.Arg, ...]) -> tuple[n.Arg, ...]:
+        """``\\Arg?Par`` resolved: passed as ``\\Arg:=Par`` where the caller's optional ``Par`` is
+        present, else left out (RAPID's conditional argument)."""
+        if not any(a.kind == "cond" for a in args):
+            return args
+        present = self.stack[-1].present if self.stack else set()
+        out = []
+        for a in args:
+            if a.kind != "cond":
+                out.append(a)
+            elif isinstance(a.value, n.Name) and a.value.name.lower() in present:
+                out.append(n.Arg(a.pos, "opt", a.name, a.value))
+        return tuple(out)
+
+    def as_num(self, v: Value, pos: n.Pos) -> float:
+        try:
+            return num(v)
+        except TypeErrorRapid as err:
+            raise RapidError(f"{pos}: {err}; correct the expression") from None
+
+    def signal_value(self, v: Value, pos: n.Pos) -> Value:
+        return self.read_signal(v, pos)[0] if isinstance(v, Signal) else v
+
+    def read_signal(self, sig: Signal, pos: n.Pos) -> tuple[Value, Taint]:
+        key = sig.name.lower()
+        if key in self.io:
+            self.io_used.add(key)
+            v = self.io[key]
+            return (float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else v), CLEAN
+        if key in self.outputs:
+            return self.outputs[key], CLEAN
+        kind = sig.kind or signal_kind(sig.name)
+        if kind in ("do", "go", "ao"):
+            return 0.0, CLEAN  # an output the program has not set: its value at start, 0
+        why = f"{pos}: {sig.name} is read at run time (not in the scenario; 0 assumed)"
+        return 0.0, frozenset({why})
+
+    def ref(self, e: n.Expr) -> Cell | Ref:
+        if isinstance(e, n.Name):
+            return self.lookup(e.name, e.pos)
+        if isinstance(e, (n.Index, n.Field)):
+            base = self.ref(e.base)
+            r = base if isinstance(base, Ref) else Ref(base)
+            if r.cell.type == UNTYPED:  # an element or component of a value declared nowhere: as unknown
+                return r
+            if isinstance(e, n.Index):
+                idx = []
+                for i in e.indices:
+                    v, _ = self.ev(i)
+                    f = self.as_num(v, e.pos)
+                    if f != int(f):
+                        raise RapidError(f"{e.pos}: the index {f:g} is not a whole number; correct it")
+                    idx.append(int(f))
+                cur = r.get()
+                if not isinstance(cur, Array):
+                    raise RapidError(f"{e.pos}: {describe(cur)} is not an array; remove the index")
+                try:
+                    cur.offset(tuple(idx))
+                except IndexError as err:
+                    if not any(self.ev(i)[1] for i in e.indices):
+                        raise RapidError(f"{e.pos}: {err}; correct the index") from None
+                    self.note(
+                        f"{e.pos}: an index from run-time data ({err} for its stand-in): element 1 assumed"
+                    )
+                    idx = [1] * len(cur.dims)
+                return Ref(r.cell, (*r.path, ("idx", tuple(idx))))
+            cur = r.get()
+            if not isinstance(cur, Record) or e.name.lower() not in cur.names:
+                raise RapidError(f"{e.pos}: {describe(cur)} has no component {e.name}; correct the name")
+            return Ref(r.cell, (*r.path, ("fld", e.name.lower())))
+        raise RapidError(f"{e.pos}: this expression cannot be assigned to; assign to a variable")
+
+    def ev_raw(self, e: n.Expr) -> tuple[Value, Taint]:
+        """As :meth:`ev`, but a signal named is the signal, not its value (``SetDO do1, 1``)."""
+        if isinstance(e, (n.Name, n.Index, n.Field)):
+            ref = self.ref(e)
+            value = ref.get() if isinstance(ref, Ref) else ref.value
+            if isinstance(value, Signal):
+                return value, CLEAN
+        return self.ev(e)
+
+    def args_of(
+        self, args: tuple[n.Arg, ...], *, raw_first: bool = False
+    ) -> tuple[list[tuple[Value, Taint]], dict[str, tuple[Value, Taint]]]:
+        pos: list[tuple[Value, Taint]] = []
+        opt: dict[str, tuple[Value, Taint]] = {}
+        for a in args:
+            if a.kind == "pos":
+                assert a.value is not None
+                pos.append(self.ev_raw(a.value) if raw_first and not pos else self.ev(a.value))
+            else:
+                assert a.name is not None
+                opt[a.name.lower()] = self.ev(a.value) if a.value is not None else (True, CLEAN)
+        return pos, opt
+
+    def give(self, r: Ref) -> bool:
+        """Set a datum the outside world writes to the scenario's value for it, where it gives one."""
+        given = self.given.get(r.cell.name.lower())
+        if given is None:
+            return False
+        cur = r.get()
+        try:
+            if isinstance(given, str) and not isinstance(cur, str):
+                given, _ = self.ev(parse_literal(given))
+            value = self.types.coerce(given, cur.type) if isinstance(cur, Record) else given
+        except (RapidError, TypeErrorRapid) as err:
+            raise RapidError(f"the scenario's {r.cell.name}: {err}; give a value of its type") from None
+        self.io_used.add(r.cell.name.lower())
+        r.set(value, CLEAN)
+        return True
