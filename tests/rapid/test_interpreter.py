@@ -345,3 +345,45 @@ def test_confdata_as_the_controller_checks_it():
     decl = "  CONST robtarget pX := [[400,0,300],[0,0,1,0],[0,0,0,5],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
     with pytest.raises(RapidError, match="controller stops here"):
         _kinematic_run("    MoveJ p10, v100, fine, tG;\n    MoveJ pX, v100, fine, tG;", decl=decl)
+
+
+HANDSHAKE = """  PERS bool bReq := FALSE;
+  PERS num nJob := 0;
+  CONST robtarget pA := [[400,-100,300],[0,0,1,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  CONST robtarget pB := [[400,100,300],[0,0,1,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+"""
+HANDSHAKE_LOOP = (
+    "    WHILE TRUE DO\n      IF bReq THEN\n        bReq := FALSE;\n        TEST nJob\n"
+    "        CASE 1:\n          MoveJ pA, v1000, fine, tG;\n"
+    "        CASE 2:\n          MoveJ pB, v1000, z10, tG;\n          MoveL p10, v500, fine, tG;\n"
+    "        ENDTEST\n        nJob := 0;\n      ENDIF\n      WaitTime 0.05;\n    ENDWHILE"
+)
+
+
+def _targets(trace) -> list[str]:
+    return [m.stmt.args[0].value.name for m in trace.motions]  # type: ignore[attr-defined]
+
+
+def test_data_the_task_only_clears_is_a_handshake_set_outside_it():
+    """A request flag and a job number the task only sets back to their declared values (after it acts
+    on them) are set by a PLC, a PC or the HMI: the production turn is the job that moves most, said;
+    `--io` gives them, on every read (the PLC sets them again each turn)."""
+    interp, trace = run(HANDSHAKE_LOOP, decl=HANDSHAKE)
+    assert interp.handshake == {"breq", "njob"}
+    assert _targets(trace) == ["pB", "p10"]  # CASE 2 moves most
+    said = [line for line in trace.notes if "which this task only sets back to its declared value" in line]
+    assert len(said) == 2 and all("--io NAME=VALUE" in line for line in said)
+    _, given = run(HANDSHAKE_LOOP, decl=HANDSHAKE, io={"nJob": 1.0, "bReq": True})
+    assert _targets(given) == ["pA"]
+    assert not any("only sets back" in line for line in given.notes)
+
+
+def test_data_the_task_also_sets_otherwise_is_not_a_handshake():
+    # the task itself raises the request (TRUE) and picks the job: its values are the task's
+    raised = "    WHILE TRUE DO\n      bReq := TRUE;\n      nJob := 1;\n"
+    body = HANDSHAKE_LOOP.replace("    WHILE TRUE DO\n", raised)
+    interp, trace = run(body, decl=HANDSHAKE)
+    assert interp.handshake == set()
+    assert _targets(trace) == ["pA"]
+    with pytest.raises(RapidError, match="bReq is a bool; give TRUE or FALSE"):
+        run(HANDSHAKE_LOOP, decl=HANDSHAKE, io={"bReq": 3.0})

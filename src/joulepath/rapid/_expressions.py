@@ -56,6 +56,10 @@ def _datum(ip: Machine, e: n.Name | n.Index | n.Field) -> tuple[Value, Taint]:
     except (IndexError, KeyError) as err:
         raise RapidError(f"{e.pos}: {err}; correct the index or component") from None
     cell = ref.cell if isinstance(ref, Ref) else ref
+    if isinstance(e, n.Name) and not isinstance(ref, Ref):
+        given = ip.outside_value(cell, e.pos)
+        if given is not None:
+            return given, CLEAN
     taint = cell.taint | index_taint(ip, e)
     if isinstance(value, Signal) and value.name:
         return ip.read_signal(value, e.pos)

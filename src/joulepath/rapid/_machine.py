@@ -23,7 +23,7 @@ from joulepath.errors import RapidError
 from joulepath.rapid import _standins as standins
 from joulepath.rapid import geometry as geo
 from joulepath.rapid import nodes as n
-from joulepath.rapid._scan import assigned_names, set_names, signal_names
+from joulepath.rapid._scan import assigned_names, handshake_names, set_names, signal_names
 from joulepath.rapid._state import (
     MAX_SECONDS,
     MAX_STEPS,
@@ -133,6 +133,8 @@ class Machine:
         self.signals_used = signal_names(task, self.globals)
         self.roles = standins.name_roles(self.task.modules, PROCESS_LINEAR, PROCESS_CIRCULAR)
         self.set_names = set_names(task, self.routines)
+        self.handshake = handshake_names(task, self.routines, self.globals)
+        """Data the task only sets back to its declared value: its other values come from outside."""
         self._initialising: set[tuple[str, str]] = set()
 
     # ---- setup
@@ -458,6 +460,30 @@ class Machine:
 
     def signal_value(self, v: Value, pos: n.Pos) -> Value:
         return self.read_signal(v, pos)[0] if isinstance(v, Signal) else v
+
+    def outside_value(self, cell: Cell, pos: n.Pos) -> Value | None:
+        """The scenario's value (``--io NAME=VALUE``) of a global ``bool``, ``num`` or ``string`` that
+        the world outside the task sets (this task never sets it, or only back to its declared value:
+        a handshake the PLC sets again each turn), on every read; None where the scenario gives none."""
+        key = cell.name.lower()
+        found = self.globals.get(key)
+        if key not in self.io or found is None or found[0].pos != cell.pos or cell.storage == "CONST":
+            return None
+        if cell.type not in ("bool", "num", "dnum", "string"):
+            return None
+        if key in self.set_names and key not in self.handshake:
+            return None
+        v = self.io[key]
+        self.io_used.add(key)
+        if cell.type == "bool":
+            if isinstance(v, bool) or v in (0.0, 1.0):
+                return bool(v)
+            raise RapidError(f"{pos}: --io {cell.name}={v!r}: {cell.name} is a bool; give TRUE or FALSE")
+        if cell.type == "string":
+            return v if isinstance(v, str) else f"{v:g}"
+        if isinstance(v, str):
+            raise RapidError(f"{pos}: --io {cell.name}={v!r}: {cell.name} is a {cell.type}; give a number")
+        return float(v)
 
     def read_signal(self, sig: Signal, pos: n.Pos) -> tuple[Value, Taint]:
         key = sig.name.lower()

@@ -36,11 +36,63 @@ def assigned_names(task: Task) -> set[str]:
 def set_names(task: Task, routines: Mapping[str, object]) -> set[str]:
     """Data the task's statements set: assigned, passed to a routine of the task, or written by an
     instruction that writes its argument (``Incr``, ``TPReadNum``, ``SocketReceive`` ...)."""
-    out: set[str] = set()
+    out = _written_by_calls(task, routines)
     for s in walk_statements(task):
         if isinstance(s, n.Assign):
             out.add(n.base_name(s.target) or "")
-        elif isinstance(s, n.Call):
+    return out
+
+
+_DEFAULTS: dict[str, tuple[str, object]] = {
+    "bool": ("Bool", False),
+    "num": ("Num", 0.0),
+    "dnum": ("Num", 0.0),
+    "string": ("Str", ""),
+}
+"""The literal a ``VAR`` of a plain type holds before it is assigned."""
+
+
+def handshake_names(
+    task: Task, routines: Mapping[str, object], declared: Mapping[str, tuple[n.DataDecl, n.Module]]
+) -> set[str]:
+    """Data the task only ever sets back to its declared value (a ``bool``, ``num`` or ``string``
+    ``VAR``/``PERS``: a start flag it clears once it acts on it, a job number it resets): its other
+    values come from outside the task (a PLC, a PC, the HMI or another task)."""
+    rest: set[str] = set()
+    other = _written_by_calls(task, routines)
+    for s in walk_statements(task):
+        if not isinstance(s, n.Assign):
+            continue
+        key = (n.base_name(s.target) or "").lower()
+        found = declared.get(key)
+        initial = _initial(found[0]) if found is not None and isinstance(s.target, n.Name) else None
+        (rest if initial is not None and _literal(s.value) == initial else other).add(key)
+    return rest - other
+
+
+def _initial(decl: n.DataDecl) -> tuple[str, object] | None:
+    """The literal a ``VAR``/``PERS`` of a plain type is declared with (its type's default without one)."""
+    if decl.storage == "CONST" or decl.dims or decl.type.lower() not in _DEFAULTS:
+        return None
+    return _DEFAULTS[decl.type.lower()] if decl.init is None else _literal(decl.init)
+
+
+def _literal(e: n.Expr) -> tuple[str, object] | None:
+    if isinstance(e, n.Bool):
+        return "Bool", e.value
+    if isinstance(e, n.Num):
+        return "Num", float(e.value)
+    if isinstance(e, n.Str):
+        return "Str", e.value
+    return None
+
+
+def _written_by_calls(task: Task, routines: Mapping[str, object]) -> set[str]:
+    """Data the task's calls may write: passed to a routine of the task (or one declared nowhere), or
+    to an argument an instruction writes."""
+    out: set[str] = set()
+    for s in walk_statements(task):
+        if isinstance(s, n.Call):
             key = s.name.lower()
             documented = builtins.lookup(key) if key not in routines else None
             if documented is None:  # a routine of the task (or declared nowhere): it may write any

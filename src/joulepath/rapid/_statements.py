@@ -374,22 +374,24 @@ def has_motion(ip: Machine, body: tuple[n.Stmt, ...], depth: int) -> bool:
 
 def _shared(ip: Machine, e: object) -> Taint:
     """Why a condition may turn at run time though the task decides none of it: the ``PERS`` and
-    ``VAR`` ``bool``, ``num`` and ``string`` data it reads that this task never sets (another task,
-    a PC through the robot's interfaces or the HMI sets them). Empty where it reads none."""
+    ``VAR`` ``bool``, ``num`` and ``string`` data it reads that this task never sets, or only sets back
+    to its declared value (a handshake: another task, a PLC or a PC through the robot's interfaces,
+    or the HMI sets its other values). Empty where it reads none."""
     out: set[str] = set()
     for node in n.walk_nodes(e):
         if not isinstance(node, n.Name):
             continue
         key = node.name.lower()
         found = ip.globals.get(key)
-        if found is None or key in ip.set_names:
+        if found is None or (key in ip.set_names and key not in ip.handshake):
             continue
         decl = found[0]
-        if decl.storage != "CONST" and ip.types.resolve(decl.type) in ("bool", "num", "dnum", "string"):
-            out.add(
-                f"{decl.pos}: {decl.name} is data this task never sets (another task, a PC or the HMI "
-                "sets it)"
-            )
+        if decl.storage == "CONST" or ip.types.resolve(decl.type) not in ("bool", "num", "dnum", "string"):
+            continue
+        if key in ip.handshake:
+            out.add(f"{decl.name} ({decl.pos}), which this task only sets back to its declared value")
+        else:
+            out.add(f"{decl.name} ({decl.pos}), which this task never sets")
     return frozenset(out)
 
 
@@ -422,10 +424,13 @@ def _production_turn(
     """A branch decided by data set outside the task, whose value now runs no move: the production
     turn is taken to be the branch that moves most; said, with how to name another."""
     body, label = _most_moving(ip, options, "assumed")
-    names = "; ".join(sorted(shared))
+    reasons = sorted(shared)
+    while len(reasons) > 1 and len("; ".join(reasons)) > 200:
+        reasons = reasons[:-1]
+    names = "; ".join(reasons) + ("; ..." if len(reasons) < len(shared) else "")
     ip.note(
-        f"{pos}: {what} on data set outside the task ({names[:160]}) -> {label}; give the data's value "
-        "(--io NAME=VALUE) to optimize another turn"
+        f"{pos}: {what} on data a PLC, a PC, the HMI or another task sets: {names} -> {label}; give "
+        "its value (--io NAME=VALUE) to optimize another turn"
     )
     return body, label
 
