@@ -158,3 +158,32 @@ def test_training_range_of_a_table(two_run_tables):
     np.testing.assert_allclose(covered["q_max_rad"], q.max(axis=0))
     energy = table.frame.groupby("move_id")["E"].sum()
     assert covered["move_energy_J"] == [energy.min(), energy.max()]
+
+
+def test_the_optimizer_states_the_share_of_a_path_outside_the_models_training_range():
+    """optimize_move's summary flags a learned model's extrapolation on the optimized path."""
+    from joulepath.optimize._run import outside_training_range_pct
+    from joulepath.trajectory import Trajectory
+
+    covered = {
+        "q_min_rad": [-1.0] * 6,
+        "q_max_rad": [1.0] * 6,
+        "speed_max_rad_s": [1.0] * 6,
+        "acceleration_max_rad_s2": [5.0] * 6,
+        "move_duration_s": [0.5, 2.0],
+    }
+    model = EnergyModel.__new__(EnergyModel)  # only the card is read
+    model.card = {"training_range": covered}
+    t = np.arange(41) * 0.025  # a 1 s move: within the trained durations
+    q = np.zeros((41, 6))
+    qd = np.zeros((41, 6))
+    qd[:10, 2] = 1.5  # a quarter of the samples faster than any trained on
+    path = Trajectory(t=t, q=q, qd=qd, qdd=np.zeros((41, 6)))
+    assert outside_training_range_pct([model], path) == pytest.approx(100.0 * 10 / 41)
+    longer = Trajectory(t=3.0 * t, q=q, qd=np.zeros((41, 6)), qdd=np.zeros((41, 6)))  # a 3 s move
+    assert outside_training_range_pct([model], longer) == 100.0
+    inside = Trajectory(t=t, q=q, qd=np.zeros((41, 6)), qdd=np.zeros((41, 6)))
+    assert outside_training_range_pct([model], inside) == 0.0
+    bare = EnergyModel.__new__(EnergyModel)
+    bare.card = {}
+    assert outside_training_range_pct([bare], path) is None
