@@ -102,6 +102,7 @@ def test_ur5_end_to_end_through_the_cli(ur5, tmp_path, capsys):
     e = ur5.path_energy(*(path[c].to_numpy() for c in cols), 0.025).total
     assert e == pytest.approx(summary["energy_optimized_J"], rel=1e-6)
     assert summary["energy_optimized_surrogate_J"] is not None
+    assert 0.0 <= summary["surrogate_outside_range_pct"] <= 100.0  # the path against the model's range
     text = (run / "path.script").read_text()
     assert text.startswith("def joulepath_path():") and text.count("servoj(") == 1500
     ros = tmp_path / "ros"

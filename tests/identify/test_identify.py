@@ -213,3 +213,51 @@ def test_generic_log_with_accelerations_recovers_the_sim_plant_exactly(irb120, t
     result = identify(data, irb120, IdentifyOptions(gear_efficiency=1.0))
     truth = base_parameters(irb120).project(true_parameters(irb120))
     assert _relative_error(result.beta_ls, truth) < 1e-9
+
+
+def test_viscous_level_per_direction_is_recovered_and_round_trips(irb120, tmp_path):
+    """A plant whose viscous slope differs by direction (viscous_offset): identified exactly with the
+    option, missed without it; the friction file keeps it, and a file without it reads as 0."""
+    import json
+
+    from joulepath.dynamics import Calibration
+    from joulepath.dynamics._calibration import read_calibration
+
+    n = irb120.n_joints
+    zero = (0.0,) * n
+    friction = IdentifiedFriction(
+        coulomb=tuple(NOMINAL_COULOMB),
+        viscous=tuple(NOMINAL_VISCOUS),
+        offset=zero,
+        stribeck=zero,
+        viscous_offset=tuple(0.4 * np.asarray(NOMINAL_VISCOUS)),
+    )
+    plant = Plant(name="viscous-by-direction", robot=irb120, friction=friction)
+    data = _exact_data(irb120, plant, 12, seed=5)
+    with_it = identify(data, irb120, IdentifyOptions(gear_efficiency=1.0, viscous_offset=True))
+    np.testing.assert_allclose(with_it.friction.viscous, NOMINAL_VISCOUS, atol=1e-6)
+    np.testing.assert_allclose(with_it.friction.viscous_offset, friction.viscous_offset, atol=1e-6)
+    assert min(with_it.fit.torque_r2) > 1 - 1e-9
+    without = identify(data, irb120, IdentifyOptions(gear_efficiency=1.0, consistent=False))
+    assert min(without.fit.torque_r2) < 1 - 1e-6 and without.friction.viscous_offset == ()
+    # derivative of the new term, and the friction file both ways
+    qd = np.random.default_rng(0).normal(scale=0.2, size=(40, n))
+    h = 1e-7
+    np.testing.assert_allclose(
+        friction.derivative(qd),
+        (friction.torque(qd + h) - friction.torque(qd - h)) / (2 * h),
+        rtol=1e-5,
+        atol=1e-4,
+    )
+    path = tmp_path / "friction.json"
+    path.write_text(json.dumps(Calibration(friction=with_it.friction).to_json()))
+    back = read_calibration(path, n).friction
+    np.testing.assert_allclose(back.torque(qd), with_it.friction.torque(qd), rtol=1e-12)
+    doc = json.loads(path.read_text())
+    del doc["friction"]["viscous_offset"]
+    path.write_text(json.dumps(doc))
+    old = read_calibration(path, n).friction
+    assert old.viscous_offset == ()
+    np.testing.assert_allclose(
+        old.torque(qd) - back.torque(qd), -np.asarray(back.viscous_offset) * qd * np.tanh(qd / old.smoothing)
+    )

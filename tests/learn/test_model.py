@@ -10,7 +10,7 @@ from joulepath.errors import InvalidModel
 from joulepath.learn import EnergyModel
 
 
-@pytest.mark.parametrize("family", ["mlp", "svr", "par", "xgb"])
+@pytest.mark.parametrize("family", ["mlp", "svr", "par", "xgb", "bases"])
 def test_round_trip_gives_identical_predictions(trained, lab_tables, family, tmp_path):
     _, test = lab_tables
     folder = trained.models[f"{family}-E"]

@@ -74,7 +74,7 @@ def test_thesis_grid_sizes():
     from joulepath.learn import THESIS_GRIDS
 
     sizes = {f: len(ParameterGrid(g)) for f, g in THESIS_GRIDS.items()}
-    assert sizes == {"mlp": 3456, "svr": 384, "par": 192, "xgb": 58320}
+    assert sizes == {"mlp": 3456, "svr": 384, "par": 192, "xgb": 58320, "bases": 3}  # bases: not thesis
     assert np.prod([len(v) for v in THESIS_GRIDS["xgb"].values()]) == 58320
 
 

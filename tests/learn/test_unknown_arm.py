@@ -66,9 +66,18 @@ def test_kinematic_features_refuse_columns_without_speeds(rng):
 
 def test_cv_groups_are_the_runs_of_a_table_of_several_logs(two_run_tables, lab_tables):
     table = two_run_tables[0]
-    groups, kind = cv_groups(table)
+    groups, kind = cv_groups(table, 2)
     assert kind == "run" and set(np.unique(groups)) == {0, 1}
     runs = run_ids(table)
+    # fewer runs than folds: each run cut into contiguous spans of whole moves
+    spans, kind = cv_groups(table, 5)
+    assert kind == "run spans" and np.unique(spans).size == 6
+    moves = table.frame["move_id"].to_numpy()
+    for g in np.unique(spans):
+        in_span = np.unique(moves[spans == g])
+        assert np.unique(runs[spans == g]).size == 1  # a span lies in one run
+        assert np.array_equal(in_span, np.arange(in_span.min(), in_span.max() + 1))  # contiguous
+        assert not np.isin(in_span, moves[spans != g]).any()  # no move split between spans
     # every move lies in one run, and the runs follow the moves' order
     per_move = pd.Series(runs).groupby(table.frame["move_id"].to_numpy()).nunique()
     assert (per_move == 1).all() and np.all(np.diff(runs) >= 0)
@@ -83,14 +92,14 @@ def test_default_training_of_an_unknown_arm_is_cross_validated_by_run(two_run_ta
     train_table, test_table = two_run_tables
     report = train(train_table, test_table, TrainConfig(families=("par",), cv=5), tmp_path / "m")
     card = json.loads((tmp_path / "m" / "par-E" / "card.json").read_text())
-    assert card["cv_grouped"]["groups"] == "run" and card["cv_grouped"]["folds"] == 2
+    assert card["cv_grouped"]["groups"] == "run spans" and card["cv_grouped"]["folds"] == 5
     assert card["inputs"] == "kinematic" and card["inputs_reason"] == "default: no robot known"
     row = report.results.iloc[0]
-    assert row["inputs"] == card["inputs"] and row["cv_groups"] == "run"
+    assert row["inputs"] == card["inputs"] and row["cv_groups"] == "run spans"
     side = card["cv_vs_held_out"]
     assert side == {
         "cv_r2": card["cv_grouped"]["r2_mean"],
-        "cv_groups": "run",
+        "cv_groups": "run spans",
         "held_out_r2": card["test"]["r2"],
         "held_out_moves": card["test"]["n_moves"],
     }
@@ -149,3 +158,32 @@ def test_training_range_of_a_table(two_run_tables):
     np.testing.assert_allclose(covered["q_max_rad"], q.max(axis=0))
     energy = table.frame.groupby("move_id")["E"].sum()
     assert covered["move_energy_J"] == [energy.min(), energy.max()]
+
+
+def test_the_optimizer_states_the_share_of_a_path_outside_the_models_training_range():
+    """optimize_move's summary flags a learned model's extrapolation on the optimized path."""
+    from joulepath.optimize._run import outside_training_range_pct
+    from joulepath.trajectory import Trajectory
+
+    covered = {
+        "q_min_rad": [-1.0] * 6,
+        "q_max_rad": [1.0] * 6,
+        "speed_max_rad_s": [1.0] * 6,
+        "acceleration_max_rad_s2": [5.0] * 6,
+        "move_duration_s": [0.5, 2.0],
+    }
+    model = EnergyModel.__new__(EnergyModel)  # only the card is read
+    model.card = {"training_range": covered}
+    t = np.arange(41) * 0.025  # a 1 s move: within the trained durations
+    q = np.zeros((41, 6))
+    qd = np.zeros((41, 6))
+    qd[:10, 2] = 1.5  # a quarter of the samples faster than any trained on
+    path = Trajectory(t=t, q=q, qd=qd, qdd=np.zeros((41, 6)))
+    assert outside_training_range_pct([model], path) == pytest.approx(100.0 * 10 / 41)
+    longer = Trajectory(t=3.0 * t, q=q, qd=np.zeros((41, 6)), qdd=np.zeros((41, 6)))  # a 3 s move
+    assert outside_training_range_pct([model], longer) == 100.0
+    inside = Trajectory(t=t, q=q, qd=np.zeros((41, 6)), qdd=np.zeros((41, 6)))
+    assert outside_training_range_pct([model], inside) == 0.0
+    bare = EnergyModel.__new__(EnergyModel)
+    bare.card = {}
+    assert outside_training_range_pct([bare], path) is None

@@ -296,7 +296,7 @@ def _robot_number(card):
         ("mlp-E", _duplicate_column, r"duplicates: 1"),
         ("par-E", _no_cv_grouped, r"the card lacks 'cv_grouped'; train the model again"),
         ("xgb-E", _cv_grouped_text, r"cv_grouped must be an object with a number r2_mean"),
-        ("par-E", _family_unknown, r"family is 'knn', expected one of mlp, svr, par, xgb"),
+        ("par-E", _family_unknown, r"family is 'knn', expected one of mlp, svr, par, xgb, bases"),
         ("par-E", _family_other, r"holds a SGDRegressor, but the card says family 'mlp'"),
         ("par-E", _target_number, r"target is 7, expected one of"),
         ("par-E", _feature_set_unknown, r"feature_set is 'full41'"),

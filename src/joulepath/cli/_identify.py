@@ -31,6 +31,11 @@ def identify(
         0.0, "--stribeck-speed", min=0.0, help="rad/s: also identify a Stribeck term of this speed (0: none)."
     ),
     offset: bool = typer.Option(True, "--offset/--no-offset", help="Identify a friction offset per joint."),
+    viscous_offset: bool = typer.Option(
+        False,
+        "--viscous-per-direction/--no-viscous-per-direction",
+        help="Identify the viscous friction level per direction of motion (a viscous offset per joint).",
+    ),
     gear_efficiency: float = typer.Option(
         0.0,
         "--gear-efficiency",
@@ -109,6 +114,7 @@ def identify(
         )
     options = IdentifyOptions(
         offset=offset,
+        viscous_offset=viscous_offset,
         stribeck_speed=stribeck_speed or None,
         gear_efficiency=gear_efficiency or None,
         max_condition=max_condition,

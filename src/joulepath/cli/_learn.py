@@ -46,7 +46,7 @@ def _progress_lines(label: str) -> Iterator[Callable[[str], None]]:
 def train(
     data: Path = typer.Option(..., "--data", help="Training energy table (.parquet)."),
     test: Path = typer.Option(..., "--test", help="Test table of other moves (.parquet)."),
-    family: str = typer.Option("all", help="mlp, svr, par, xgb (comma separated) or all."),
+    family: str = typer.Option("all", help="mlp, svr, par, xgb, bases (comma separated) or all."),
     target: str = typer.Option("E", help="Targets: E, E1..En (comma separated) or all."),
     grid: str = typer.Option("quick", help="quick, or thesis (Tables 2.2-2.5)."),
     cv: int = typer.Option(5, min=2, help="Folds."),
@@ -54,7 +54,8 @@ def train(
         "",
         help="physics (raw + nominal model terms), kinematic (raw + robot-free energy bases) or thesis "
         "(raw); default: physics with a robot known (--robot or the table's), else kinematic. The grid "
-        "search's CV is grouped by run (the logs of the table; by move for a table of one log).",
+        "search's CV is grouped by run (the logs of the table), by contiguous spans of each run's moves "
+        "when there are fewer runs than folds, by move for a table of one log.",
     ),
     out: Path = typer.Option(..., "--out", help="Folder for models and reports."),
     seed: int = typer.Option(0, min=0, max=2**32 - 1, help="Random seed."),

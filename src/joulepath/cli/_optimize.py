@@ -237,6 +237,14 @@ def optimize(
         console.print(f"the plan: {plan}")
     else:
         console.print(plan)
+    if s.surrogate_outside_range_pct:
+        console.print(
+            f"learned model: {s.surrogate_outside_range_pct:.1f} % of the optimized path's samples lie "
+            "outside "
+            "its training data (positions, speeds, accelerations or move duration; the card's "
+            "training_range): its energies there are extrapolations",
+            markup=False,
+        )
     _state_over_uncertainty(r, result, seed=seed, measure=energy)
     if r.friction is None:
         console.print(f"physics: no friction modelled for {r.name}; friction: {r.friction_note}")

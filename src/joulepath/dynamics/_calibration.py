@@ -42,10 +42,14 @@ class IdentifiedFriction:
     """Per-joint friction as identified (joint side, N·m), linear in its parameters::
 
         tau_f = coulomb * s + viscous * qd + offset * |s| + stribeck * exp(-(qd / stribeck_speed)²) * s
+                + viscous_offset * qd * s
 
     with ``s = tanh(qd / smoothing)``. ``offset`` is a torque that adds in both
     directions of motion (a direction asymmetry of the Coulomb level) and vanishes at
-    rest; ``stribeck`` is the extra break-away torque at low speed (0 when not identified).
+    rest; ``stribeck`` is the extra break-away torque at low speed (0 when not identified);
+    ``viscous_offset`` the same asymmetry of the viscous level (``qd * s`` is ``|qd|``,
+    smoothed at rest): the viscous slope is ``viscous + viscous_offset`` turning one way
+    and ``viscous - viscous_offset`` the other (empty: 0, a friction without it).
     """
 
     coulomb: tuple[float, ...]
@@ -54,13 +58,16 @@ class IdentifiedFriction:
     stribeck: tuple[float, ...]
     stribeck_speed: float = 0.05
     smoothing: float = 0.005
+    viscous_offset: tuple[float, ...] = ()
     _p: FloatArray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        arr = np.array([self.coulomb, self.viscous, self.offset, self.stribeck], dtype=float)
+        vo = self.viscous_offset if len(self.viscous_offset) else (0.0,) * len(self.coulomb)
+        arr = np.array([self.coulomb, self.viscous, self.offset, self.stribeck, vo], dtype=float)
         if arr.ndim != 2 or not np.all(np.isfinite(arr)):
             raise InvalidRobotDescription(
-                "friction: coulomb, viscous, offset and stribeck must be finite, one value per joint each"
+                "friction: coulomb, viscous, offset, stribeck and viscous_offset must be finite, one value "
+                "per joint each"
             )
         if not (self.stribeck_speed > 0 and self.smoothing > 0):
             raise InvalidRobotDescription("friction: stribeck_speed and smoothing must be positive (rad/s)")
@@ -71,20 +78,22 @@ class IdentifiedFriction:
         return int(self._p.shape[1])
 
     def torque(self, qd: FloatArray) -> FloatArray:
-        fc, fv, fo, fs = self._p
+        fc, fv, fo, fs, fvo = self._p
         s = np.tanh(qd / self.smoothing)
         bump = np.exp(-((qd / self.stribeck_speed) ** 2))
-        out: FloatArray = (fc + fs * bump) * s + fv * qd + fo * np.abs(s)
+        out: FloatArray = (fc + fs * bump) * s + fv * qd + fo * np.abs(s) + fvo * qd * s
         return out
 
     def derivative(self, qd: FloatArray) -> FloatArray:
         """``d tau_f / d qd`` per joint (analytic)."""
-        fc, fv, fo, fs = self._p
+        fc, fv, fo, fs, fvo = self._p
         s = np.tanh(qd / self.smoothing)
         ds = (1.0 - s * s) / self.smoothing
         bump = np.exp(-((qd / self.stribeck_speed) ** 2))
         dbump = -2.0 * qd / self.stribeck_speed**2 * bump
-        out: FloatArray = (fc + fs * bump) * ds + fs * dbump * s + fv + fo * np.sign(s) * ds
+        out: FloatArray = (
+            (fc + fs * bump) * ds + fs * dbump * s + fv + fo * np.sign(s) * ds + fvo * (s + qd * ds)
+        )
         return out
 
     def to_json(self) -> dict[str, Any]:
@@ -95,6 +104,7 @@ class IdentifiedFriction:
             "stribeck": list(self.stribeck),
             "stribeck_speed": self.stribeck_speed,
             "smoothing": self.smoothing,
+            **({"viscous_offset": list(self.viscous_offset)} if len(self.viscous_offset) else {}),
         }
 
 
@@ -180,6 +190,11 @@ def read_calibration(path: str | os.PathLike[str], n_joints: int) -> Calibration
         stribeck=_floats(fr.get("stribeck"), f"{p}: friction.stribeck", n_joints),
         stribeck_speed=float(speeds["stribeck_speed"]),  # type: ignore[arg-type]
         smoothing=float(speeds["smoothing"]),  # type: ignore[arg-type]
+        viscous_offset=(
+            _floats(fr["viscous_offset"], f"{p}: friction.viscous_offset", n_joints)
+            if "viscous_offset" in fr
+            else ()
+        ),
     )
     return Calibration(friction=friction, gear_efficiency=float(eta), twin_of=twin_of, folder=str(p.parent))
 

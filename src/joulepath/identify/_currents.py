@@ -239,7 +239,11 @@ class CurrentIdentification:
 def _regressor(robot: Robot, data: IdentificationData, options: IdentifyOptions) -> FloatArray:
     """``[Y_b | F]`` of shape ``(N, n, p)`` (the columns :func:`identify` fits)."""
     F, _ = friction_regressor(
-        data.qd, smoothing=options.smoothing, offset=options.offset, stribeck_speed=options.stribeck_speed
+        data.qd,
+        smoothing=options.smoothing,
+        offset=options.offset,
+        stribeck_speed=options.stribeck_speed,
+        viscous_offset=options.viscous_offset,
     )
     Y = inertial_regressor(robot, data.q, data.qd, data.qdd)[:, :, base_parameters(robot).independent]
     return np.concatenate([Y, F], axis=2)

@@ -117,6 +117,10 @@ class IdentifyOptions:
         Identify a per-joint friction offset (a torque added in both directions of motion).
     stribeck_speed : float or None
         rad/s: identify a Stribeck term of this characteristic speed (None: none).
+    viscous_offset : bool
+        Identify the viscous level per direction of motion (a ``viscous_offset`` term,
+        ``|qd|`` smoothed at rest, beside ``viscous * qd``). On the KUKA KR300 logs the
+        largest single gain in held-out torque R² (``benchmarks/identify_real.py``).
     smoothing : float
         rad/s: the ``tanh`` width standing for ``sign(qd)`` in the friction terms.
     gear_efficiency : float or None
@@ -148,6 +152,7 @@ class IdentifyOptions:
 
     offset: bool = True
     stribeck_speed: float | None = None
+    viscous_offset: bool = False
     smoothing: float = 0.005
     gear_efficiency: float | None = None
     weighted: bool = True
@@ -476,6 +481,7 @@ def _friction_of(
         offset=blocks.get("offset", zero),
         stribeck=blocks.get("stribeck", zero),
         stribeck_speed=options.stribeck_speed or 0.05,
+        viscous_offset=tuple(blocks["viscous_offset"]) if "viscous_offset" in blocks else (),
         smoothing=options.smoothing,
     )
 
@@ -648,7 +654,11 @@ def identify(
     base = base_parameters(robot)
     n = robot.n_joints
     F, terms = friction_regressor(
-        fit_data.qd, smoothing=options.smoothing, offset=options.offset, stribeck_speed=options.stribeck_speed
+        fit_data.qd,
+        smoothing=options.smoothing,
+        offset=options.offset,
+        stribeck_speed=options.stribeck_speed,
+        viscous_offset=options.viscous_offset,
     )
     _check_motion(fit_data, base.n + F.shape[2])
     Y = inertial_regressor(robot, fit_data.q, fit_data.qd, fit_data.qdd)
@@ -703,7 +713,9 @@ def identify(
     phi = _lift(base, beta_ls, prior)
     f = f_ls
     if options.consistent:
-        lower_f = np.concatenate([np.full(n, -np.inf if t == "offset" else 0.0) for t in terms])
+        lower_f = np.concatenate(
+            [np.full(n, -np.inf if t in ("offset", "viscous_offset") else 0.0) for t in terms]
+        )
         phi, f = _consistent(
             Y,
             F,

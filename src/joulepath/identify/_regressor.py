@@ -58,9 +58,19 @@ def true_parameters(robot: Robot) -> FloatArray:
 
 
 def friction_regressor(
-    qd: FloatArray, *, smoothing: float, offset: bool, stribeck_speed: float | None
+    qd: FloatArray,
+    *,
+    smoothing: float,
+    offset: bool,
+    stribeck_speed: float | None,
+    viscous_offset: bool = False,
 ) -> tuple[FloatArray, tuple[str, ...]]:
-    """Friction columns ``(N, n, n_terms * n)`` and the term of each block of ``n`` columns."""
+    """Friction columns ``(N, n, n_terms * n)`` and the term of each block of ``n`` columns.
+
+    The terms of :class:`joulepath.dynamics.IdentifiedFriction`: ``coulomb``, ``viscous``,
+    then as asked ``offset``, ``stribeck`` and ``viscous_offset`` (``qd * tanh(qd /
+    smoothing)``, the viscous level's direction asymmetry).
+    """
     s = np.tanh(qd / smoothing)
     cols = [s, qd]
     terms = ["coulomb", "viscous"]
@@ -70,6 +80,9 @@ def friction_regressor(
     if stribeck_speed is not None:
         cols.append(np.exp(-((qd / stribeck_speed) ** 2)) * s)
         terms.append("stribeck")
+    if viscous_offset:
+        cols.append(qd * s)
+        terms.append("viscous_offset")
     N, n = qd.shape
     out = np.zeros((N, n, len(cols) * n))
     idx = np.arange(n)

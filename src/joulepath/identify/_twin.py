@@ -208,6 +208,11 @@ def parameter_report(
                 if options.stribeck_speed
                 else {"status": "not modelled", "value": 0.0}
             ),
+            "viscous_offset": (
+                term(j, "viscous_offset", f.viscous_offset[j])
+                if options.viscous_offset
+                else {"status": "not modelled", "value": 0.0}
+            ),
             "gear_efficiency": {"status": eta_status, "value": ident.gear_efficiency},
         }
         if gains is not None:

@@ -1,5 +1,6 @@
 """Energy models (thesis §2.2, §4.3): pipelines, resumable grid search, safe files, importance."""
 
+from joulepath.learn._bases import JointEnergyBases, joint_bases
 from joulepath.learn._evaluate import Scores, path_errors, physics_baseline, physics_predict, score
 from joulepath.learn._families import (
     FAMILIES,
@@ -42,6 +43,7 @@ __all__ = [
     "FAMILIES",
     "GRIDS",
     "INPUTS",
+    "JointEnergyBases",
     "KERNEL_SVR_MAX_ROWS",
     "KinematicFeatures",
     "NO_ROBOT_NOTE",
@@ -65,6 +67,7 @@ __all__ = [
     "grid_for",
     "grid_search",
     "input_columns",
+    "joint_bases",
     "kinematic_transform",
     "load_models",
     "make_pipeline",

@@ -1,4 +1,9 @@
-"""The four model families of the thesis (§2.2), their pipelines and grids (Tables 2.2–2.5).
+"""The four model families of the thesis (§2.2) and joulepath's ``bases``; pipelines and grids.
+
+The thesis' grids are its Tables 2.2–2.5. ``bases`` (:class:`~joulepath.learn.JointEnergyBases`)
+is a least-squares model of each joint's energy on a few energy bases of its motion; it
+is not in the thesis, and its pipeline is [PhysicsFeatures or KinematicFeatures →] model
+(no scaling: it scales its own bases).
 
 SVR is :class:`~joulepath.learn.ScalableSVR`: the linear kernel is fitted with
 liblinear (``LinearSVR``, squared epsilon-insensitive loss) and the other kernels on at most
@@ -28,10 +33,11 @@ from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
 
 from joulepath.errors import InvalidInput, MissingDependency
+from joulepath.learn._bases import JointEnergyBases
 from joulepath.learn._features import KinematicFeatures, PhysicsFeatures
 from joulepath.learn._svr import ScalableSVR
 
-FAMILIES = ("mlp", "svr", "par", "xgb")
+FAMILIES = ("mlp", "svr", "par", "xgb", "bases")
 GRIDS = ("thesis", "quick")
 
 SUBSTITUTIONS = {
@@ -98,6 +104,7 @@ THESIS_GRIDS: dict[str, dict[str, list[Any]]] = {
         "model__reg_alpha": [0.0, 0.1, 0.5, 1.0],
         "model__reg_lambda": [0.0, 0.1, 0.5, 1.0],
     },
+    "bases": {"model__alpha": [0.0, 1e-4, 1e-2]},  # not in the thesis: the quick grid
 }
 
 QUICK_GRIDS: dict[str, dict[str, list[Any]]] = {
@@ -109,11 +116,14 @@ QUICK_GRIDS: dict[str, dict[str, list[Any]]] = {
     "svr": {"model__kernel": ["linear"], "model__C": [0.1, 1.0], "model__epsilon": [0.005]},
     "par": {"model__eta0": [0.01, 0.1], "model__learning_rate": ["pa1", "pa2"], "model__epsilon": [0.005]},
     "xgb": {"model__n_estimators": [500], "model__max_depth": [2, 3], "model__learning_rate": [0.1]},
+    "bases": {"model__alpha": [0.0, 1e-4, 1e-2]},
 }
 """Small grids for tests and the demo (chosen on simulated lab data, not from the thesis)."""
 
 
-def _estimator(family: str, seed: int) -> Any:
+def _estimator(family: str, seed: int, inputs: str = "thesis", columns: tuple[str, ...] | None = None) -> Any:
+    if family == "bases":
+        return JointEnergyBases(columns=columns, inputs=inputs)
     if family == "mlp":
         return MLPRegressor(max_iter=500, early_stopping=True, random_state=seed)
     if family == "svr":
@@ -157,9 +167,9 @@ def make_pipeline(
         steps.append(("kinematic", KinematicFeatures(columns=columns)))
     elif inputs != "thesis":
         raise InvalidInput(f"inputs must be 'thesis', 'physics' or 'kinematic', got {inputs!r}")
-    if family != "xgb":
+    if family not in ("xgb", "bases"):
         steps.append(("scale", StandardScaler()))
-    steps.append(("model", _estimator(family, seed)))
+    steps.append(("model", _estimator(family, seed, inputs, columns)))
     return Pipeline(steps)
 
 

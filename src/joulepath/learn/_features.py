@@ -50,10 +50,10 @@ def n_kinematic_terms(n_joints: int) -> int:
     return 3 * n_joints
 
 
-def input_columns(feature_set: str, inputs: str, n_joints: int) -> tuple[str, ...]:
-    """Table columns a model reads, in order."""
+def input_columns(feature_set: str, inputs: str, n_joints: int, family: str | None = None) -> tuple[str, ...]:
+    """Table columns a model reads, in order (a ``bases`` model reads ``dt`` on any inputs)."""
     base = feature_columns(feature_set, n_joints)
-    return (*base, "dt") if inputs in ("physics", "kinematic") else base
+    return (*base, "dt") if inputs in ("physics", "kinematic") or family == "bases" else base
 
 
 class PhysicsFeatures(TransformerMixin, BaseEstimator):  # type: ignore[misc]

@@ -55,6 +55,7 @@ from joulepath.learn._validate import (
 CARD_VERSION = 1
 TRUSTED_TYPES = frozenset(
     {
+        "joulepath.learn._bases.JointEnergyBases",
         "joulepath.learn._features.KinematicFeatures",
         "joulepath.learn._features.PhysicsFeatures",
         "joulepath.learn._svr.ScalableSVR",

@@ -44,7 +44,9 @@ class TrainConfig:
 
     Attributes
     ----------
-    families : tuple of {"mlp", "svr", "par", "xgb"}
+    families : tuple of {"mlp", "svr", "par", "xgb", "bases"}
+        ``bases``: each joint's energy by least squares on energy bases of its motion
+        (:class:`~joulepath.learn.JointEnergyBases`).
     targets : tuple of {"E", "E1", ..., "E6"}
     grid : {"quick", "thesis"}
         Hyperparameter grids (``thesis``: Tables 2.2–2.5).
@@ -178,18 +180,47 @@ def run_ids(table: EnergyTable) -> np.ndarray | None:
     return None if np.any(out < 0) else out
 
 
-def cv_groups(table: EnergyTable) -> tuple[np.ndarray, str]:
-    """The groups the grid search's CV keeps together, and their name: ``"run"`` or ``"move"``.
+def cv_groups(table: EnergyTable, n_splits: int = 5) -> tuple[np.ndarray, str]:
+    """The groups the grid search's CV keeps together, and their name.
 
-    By run (each log the table was ingested from) when the table holds at least two:
-    moves of one run follow one another and share its trajectory, so folds by move leak
-    (on the KUKA KR300 logs the CV by move said R² 0.95 for models that reach 0.36 to
-    0.83 on a run held out; ``benchmarks/learn_unknown_arm.py``). By move otherwise.
+    * ``"run"``: each log the table was ingested from, when the table holds at least
+      ``n_splits`` of them. Moves of one run follow one another and share its
+      trajectory, so folds by move leak: on the KUKA KR300 logs the CV by move said R²
+      0.86-0.93 for models that reached -0.17 to 0.86 on a run held out
+      (``benchmarks/unknown_arm.py``).
+    * ``"run spans"``: with two or more runs but fewer than ``n_splits``, each run cut
+      into contiguous spans of its moves (``ceil(n_splits / runs)`` a run, never a move
+      split). Holding out whole runs would leave each fold a run or two to learn from
+      (on those logs the CV by run said -0.20 to 0.78 for models that reached 0.73 to
+      0.86); spans keep every fold's training data from every run while no fold holds a
+      neighbouring move of its validation moves' span.
+    * ``"move"``: a table of one log, or of runs the table cannot tell apart.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from joulepath.data import EnergyTable
+    >>> frame = pd.DataFrame({"move_id": [0, 1, 2, 3, 4, 5, 6, 7]})
+    >>> sources = ({"first_move_id": 0, "moves": 4}, {"first_move_id": 4, "moves": 4})
+    >>> groups, kind = cv_groups(EnergyTable(frame=frame, feature_set="joint", sources=sources), 4)
+    >>> groups.tolist(), kind
+    ([0, 0, 1, 1, 2, 2, 3, 3], 'run spans')
     """
+    moves = table.frame["move_id"].to_numpy()
     runs = run_ids(table)
-    if runs is not None and np.unique(runs).size >= 2:
+    if runs is None or np.unique(runs).size < 2:
+        return moves, "move"
+    n_runs = int(np.unique(runs).size)
+    if n_runs >= n_splits:
         return runs, "run"
-    return table.frame["move_id"].to_numpy(), "move"
+    per_run = -(-n_splits // n_runs)
+    groups = np.empty(moves.shape, dtype=np.int64)
+    for k in np.unique(runs):
+        rows = runs == k
+        ids, rank = np.unique(moves[rows], return_inverse=True)
+        spans = min(per_run, ids.size)
+        groups[rows] = k * per_run + rank * spans // ids.size
+    return groups, "run spans"
 
 
 def training_range(table: EnergyTable) -> dict[str, Any]:
@@ -264,6 +295,21 @@ def _table_robot(
             "arm; give the robot of the data (--robot)"
         )
     return source, loaded
+
+
+def _fit_target(table: EnergyTable, family: str, target: str, pipeline: Any) -> np.ndarray:
+    """What a family is fitted to for ``target``: the column, or for ``bases`` and ``E`` the joints'.
+
+    The ``bases`` family fits each joint's energy on its own bases (``E1 .. En`` as a 2-D
+    target; it predicts their sum, scored as ``E``), and one joint's for ``E{i}``.
+    """
+    names: str | list[str] = target
+    if family == "bases" and target == "E":
+        names = [f"E{i}" for i in range(1, table.n_joints + 1)]
+    elif family == "bases":
+        pipeline.set_params(model__joint=int(target[1:]))
+    out: np.ndarray = np.asarray(table.frame[names].to_numpy(dtype=np.float64))
+    return out
 
 
 def _duration(seconds: float) -> str:
@@ -410,20 +456,20 @@ def train(
         connect_scheduler(config.scheduler).close()
     out = Path(out_dir)
     make_folder(out)
-    groups, group_kind = cv_groups(train_table)
+    groups, group_kind = cv_groups(train_table, config.cv)
     moves = train_table.frame["move_id"].to_numpy()
     n_splits = min(config.cv, int(np.unique(groups).size))
     covered = training_range(train_table)
-    cols = input_columns(train_table.feature_set, inputs, train_table.n_joints)
-    X = train_table.frame[list(cols)].to_numpy(dtype=np.float64)
     rows: list[dict[str, Any]] = []
     saved: dict[str, Path] = {}
     for family in config.families:
+        cols = input_columns(train_table.feature_set, inputs, train_table.n_joints, family)
+        X = train_table.frame[list(cols)].to_numpy(dtype=np.float64)
         for target in config.targets:
-            y = train_table.frame[target].to_numpy(dtype=np.float64)
             pipeline = make_pipeline(
                 family, seed=config.seed, inputs=inputs, columns=cols, robot=robot_source
             )
+            y = _fit_target(train_table, family, target, pipeline)
             grid = grid_for(family, config.grid)
             cache_dir = out / ".gridcache" / f"{family}-{target}"
             _announce(say, family, target, pipeline, grid, X, y, groups, config, cache_dir, n_splits)

@@ -98,7 +98,7 @@ def check_card(card: Any, card_path: Path) -> dict[str, Any]:
     cols = card["input_columns"]
     if not isinstance(cols, list) or not all(isinstance(c, str) for c in cols):
         raise InvalidModel(f"{card_path}: input_columns must be a list of column names, got {cols!r}")
-    expected = list(input_columns(card["feature_set"], card["inputs"], card_joints(cols)))
+    expected = list(input_columns(card["feature_set"], card["inputs"], card_joints(cols), card["family"]))
     stored = card.get("input_columns_sha256")
     if stored is not None and stored != input_columns_sha256(cols):
         raise InvalidModel(
@@ -345,7 +345,10 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
     names = [name for name, _ in pipeline.steps]
     physics = card["inputs"] == "physics"
     kinematic = card["inputs"] == "kinematic"
-    expected = (["physics"] if physics else ["kinematic"] if kinematic else []) + ["scale", "model"]
+    bases = card["family"] == "bases"
+    expected = (["physics"] if physics else ["kinematic"] if kinematic else []) + (
+        ["model"] if bases else ["scale", "model"]
+    )
     if names != expected:
         raise InvalidModel(
             f"{where}: pipeline steps {names}, but a {card['family']} model with {card['inputs']!r} "
@@ -383,6 +386,9 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
             f"{where}: the model reads {first.n_features_in_} input columns, the card lists {n_in}; "
             "the card and the model file do not belong together"
         )
+    if bases:
+        _check_bases(steps["model"], card, n, where)
+        return
     scaler = steps["scale"]
     shapes = (_shape(scaler, "mean_"), _shape(scaler, "scale_"))
     if not isinstance(scaler, StandardScaler) or shapes != ((n,), (n,)):
@@ -450,6 +456,40 @@ def check_pipeline(pipeline: Any, card: dict[str, Any], path: Path) -> None:
     if _shape(model, "coef_") != (n,) or _shape(model, "intercept_") not in ((1,), ()):
         raise InvalidModel(wrong)
     _finite(model, ("coef_", "intercept_"), where)
+
+
+def _check_bases(model: Any, card: dict[str, Any], n_features: int, where: str) -> None:
+    """Check a loaded :class:`~joulepath.learn.JointEnergyBases` against its card."""
+    from joulepath.learn._bases import N_KINEMATIC_BASES, JointEnergyBases
+
+    if not isinstance(model, JointEnergyBases):
+        raise InvalidModel(
+            f"{where}: holds a {type(model).__name__}, but the card says family 'bases'; "
+            "the card and the model file do not belong together"
+        )
+    cols = tuple(card["input_columns"])
+    if model.columns is None or tuple(model.columns) != cols or model.inputs != card["inputs"]:
+        raise InvalidModel(
+            f"{where}: the model was trained on other input columns than its card lists; "
+            "restore the card or train the model again"
+        )
+    n_joints = card_joints(cols)
+    per_joint = N_KINEMATIC_BASES + (2 if card["inputs"] == "physics" else 0)
+    joints = getattr(model, "joints_", None)
+    coef = getattr(model, "coef_", None)
+    wrong = f"{where}: the JointEnergyBases' fitted arrays do not fit a {n_joints}-joint arm"
+    if not isinstance(joints, np.ndarray) or joints.ndim != 1 or not isinstance(coef, np.ndarray):
+        raise InvalidModel(wrong)
+    total = joints.tolist() == [0]
+    ok = (
+        getattr(model, "n_features_in_", None) == n_features
+        and (total or (len(set(joints.tolist())) == joints.size and joints.min() >= 1))
+        and joints.max() <= n_joints
+        and coef.shape == (joints.size, per_joint * (n_joints if total else 1))
+    )
+    if not ok:
+        raise InvalidModel(wrong)
+    _finite(model, ("coef_",), where)
 
 
 # --------------------------------------------------------------------------- joints.json

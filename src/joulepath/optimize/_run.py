@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -204,6 +205,9 @@ class MoveSummary:
     metric (evolutionary searches only). ``jerk_limit_rad_s3`` is the jerk limit the
     search and the check used (None: none), ``max_jerk_rad_s3`` the optimized path's
     largest jerk on the fine grid (:func:`joulepath.optimize._verify.path_jerk`, any joint).
+    ``surrogate_outside_range_pct``: with learned models, the share of the optimized path's
+    samples outside their training data (:func:`outside_training_range_pct`; their energies
+    there are extrapolations), None without models or without a range on their cards.
     """
 
     robot: str
@@ -243,6 +247,7 @@ class MoveSummary:
     energy_lab_measure: str = "mechanical"
     energies: tuple[MeasureSummary, ...] = ()
     energies_unavailable: dict[str, str] = field(default_factory=dict)
+    surrogate_outside_range_pct: float | None = None
 
     def measure(self, name: str) -> MeasureSummary | None:
         """The summary of measure ``name``, or None when it was not computed."""
@@ -272,6 +277,33 @@ class MoveSummary:
         out["energy_figures"] = finite_json(figures_json(self.energy_measure, pairs))
         out["deprecated_keys"] = dict(RESULT_DEPRECATED)
         return out
+
+
+def outside_training_range_pct(models: Sequence[Any], path: Trajectory) -> float | None:
+    """Share (%) of ``path``'s samples outside the training data of any of ``models``.
+
+    A sample is outside when :meth:`joulepath.learn.EnergyModel.outside_training_range`
+    flags it for one of the models (a position, speed or acceleration beyond the trained
+    range, or a move longer or shorter than every trained one): the learned energy there is
+    an extrapolation. None when no model carries a training range on its card.
+    """
+    import pandas as pd
+
+    flagged = [m for m in models if isinstance(getattr(m, "card", {}).get("training_range"), dict)]
+    if not flagged:
+        return None
+    n = path.q.shape[1]
+    frame = pd.DataFrame({"move_id": np.zeros(path.t.size, dtype=np.int64), "t": path.t})
+    for i in range(n):
+        frame[f"q{i + 1}"], frame[f"dq{i + 1}"], frame[f"ddq{i + 1}"] = (
+            path.q[:, i],
+            path.qd[:, i],
+            path.qdd[:, i],
+        )
+    outside = np.zeros(path.t.size, dtype=bool)
+    for m in flagged:
+        outside |= m.outside_training_range(frame)
+    return 100.0 * float(outside.mean())
 
 
 @dataclass(frozen=True, slots=True)
@@ -444,7 +476,7 @@ def verify_move(
     report = check_limits(
         robot, outcome.fine_path, friction=friction, acceleration_limit=amax, jerk_limit=jmax
     )
-    e_sur_def = e_sur_opt = None
+    e_sur_def = e_sur_opt = outside_pct = None
     if task.models:
         stack = Trajectory(
             t=default.t,
@@ -467,6 +499,7 @@ def verify_move(
                 "--fitness physics"
             )
         e_sur_def, e_sur_opt = float(e_sur[0]), float(e_sur[1])
+        outside_pct = outside_training_range_pct(task.models, optimized)
     from joulepath.sim import make_plant
 
     lab = make_plant("lab", robot)  # a twin: the lab robot it twins
@@ -513,6 +546,7 @@ def verify_move(
         energy_measure=measure,
         energies=energies,
         energies_unavailable=unavailable,
+        surrogate_outside_range_pct=outside_pct,
     )
     return MoveResult(
         summary=summary,
