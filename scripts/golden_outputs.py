@@ -76,8 +76,9 @@ def run_one(src: Path, name: str, args: list[str], dest: Path) -> None:
         check=False,
     )
     lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    last = lines[-1].replace(str(dest.resolve()), "<out>") if lines else ""  # where it wrote: not compared
     (out / "exit.json").write_text(
-        json.dumps({"rc": proc.returncode, "last_line": lines[-1] if lines else ""}, indent=1),
+        json.dumps({"rc": proc.returncode, "last_line": last}, indent=1),
         encoding="utf-8",
     )
     print(f"{name}: exit {proc.returncode}", flush=True)
@@ -124,7 +125,9 @@ def _same_json(a: Any, b: Any, where: str, diffs: list[str], dests: tuple[Path, 
         diffs.append(f"{where}: {str(a)[:80]!r} before, {str(b)[:80]!r} after")
 
 
-def compare(before: Path, after: Path) -> int:
+def differences(before: Path, after: Path) -> list[str]:
+    """What differs between the outputs of every target written under ``before`` and under ``after``
+    (one line each; none: the same outputs)."""
     diffs: list[str] = []
     names = sorted({p.parent.relative_to(before) for p in before.rglob("exit.json")})
     for name in names:
@@ -150,8 +153,14 @@ def compare(before: Path, after: Path) -> int:
                 _same_json(ja, jb, f"{name}/{f}", diffs, dests)
             elif (a / f).read_bytes() != (b / f).read_bytes():
                 diffs.append(f"{name}/{f}: bytes differ")
+    return diffs
+
+
+def compare(before: Path, after: Path) -> int:
+    diffs = differences(before, after)
     for d in diffs:
         print(d)
+    names = {p.parent for p in before.rglob("exit.json")}
     print(f"{len(names)} targets compared, {len(diffs)} differences")
     return 1 if diffs else 0
 
