@@ -162,9 +162,9 @@ def shared_optimum(opt) -> tuple[float, float, str, float]:
 def plan_settings() -> CycleSettings:
     """The CLI's defaults; ``GRADIENT=hull``: with the single move's default search (hull rows,
     preconditioned SLSQP; issue 36) in place of the cycle's (``GRID_SEARCH``); ``FAST=1``: the
-    preset for interactive use (``joulepath.program._cycle.FAST_CYCLE``)."""
+    preset for interactive use (``joulepath.program.FAST_CYCLE``)."""
     if os.environ.get("FAST", "") == "1":
-        from joulepath.program._cycle import FAST_CYCLE
+        from joulepath.program import FAST_CYCLE
 
         return CycleSettings(**FAST_CYCLE)
     if os.environ.get("GRADIENT", "") == "hull":

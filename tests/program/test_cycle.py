@@ -12,6 +12,7 @@ from joulepath.dynamics import NOMINAL_FRICTION
 from joulepath.energy import path_energy
 from joulepath.optimize import GradientSettings
 from joulepath.program import (
+    FAST_CYCLE,
     CycleSettings,
     optimize_cycle,
     pareto,
@@ -21,7 +22,7 @@ from joulepath.program import (
     read_module,
     resolve_module,
 )
-from joulepath.program._cycle import FAST_CYCLE, CycleOptimizer
+from joulepath.program._cycle import CycleOptimizer
 from joulepath.sim import JERK_TIME, ControllerConfig
 from joulepath.sim._timing import FINE_DT, evaluate_cycle, standalone
 
@@ -444,7 +445,7 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot, reachable)
 def test_via_layout_of_a_gentle_move_is_run_as_planned(robot):
     """A minimum-jerk move (gentle at both ends) written as via points: the emulated controller keeps
     every corner, takes the planned time and stays on the path; the target is always a via point."""
-    from joulepath.program._cycle import _energy
+    from joulepath.program._cycle_model import trajectory_energy
     from joulepath.sim import make_plant
     from joulepath.sim._timing import _chain_profiles
     from joulepath.sim._via import _segment, layout
@@ -477,7 +478,9 @@ def test_via_layout_of_a_gentle_move_is_run_as_planned(robot):
     a, b = tcp(emu.q), tcp(plan.q)
     assert 1000 * max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max()) < 5.0
     plant = make_plant("lab", robot)
-    assert _energy(robot, plant, emu)[0] == pytest.approx(_energy(robot, plant, plan)[0], rel=0.05)
+    assert trajectory_energy(robot, plant, emu)[0] == pytest.approx(
+        trajectory_energy(robot, plant, plan)[0], rel=0.05
+    )
 
 
 def test_fast_preset_plans_within_limits(spec):

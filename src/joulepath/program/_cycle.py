@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -45,11 +45,9 @@ from scipy.interpolate import BPoly
 from joulepath._typing import FloatArray
 from joulepath._work import check_work, work_limit
 from joulepath.dynamics import NOMINAL_FRICTION, Robot
-from joulepath.energy import DEFAULT_MEASURE, MEASURES, energy_measure, measure_energy, measure_power
+from joulepath.energy import MEASURES, measure_energy
 from joulepath.errors import InvalidInput, LimitViolation
 from joulepath.optimize import (
-    ACCEL_TIME,
-    GRID_SEARCH,
     GradientSettings,
     MeasureSummary,
     SplineProblem,
@@ -64,12 +62,29 @@ from joulepath.optimize import (
     tcp_deviation_mm,
     tcp_velocity,
 )
-from joulepath.program._cell import Cell, clearance
+from joulepath.program._cell import clearance
+from joulepath.program._cycle_allocation import UnitEntries, fitted_share, least_energy_choice
+from joulepath.program._cycle_model import (
+    STEP,
+    Allocation,
+    Breakdown,
+    CycleMotion,
+    CycleResult,
+    CycleSettings,
+    MoveOutcome,
+    ParetoPoint,
+    Segment,
+    Solved,
+    TimeBudgetSpent,
+    sample_power,
+    segments,
+    trajectory_energy,
+    window_energy,
+)
 from joulepath.program._resolve import CycleSpec, Step, check_moves_arm
 from joulepath.sim import (
     FINE_DT,
     RAPID_ACCEL_SHARE,
-    ControllerConfig,
     PlannedCycle,
     PlannedMove,
     Plant,
@@ -81,135 +96,6 @@ from joulepath.sim import (
 )
 from joulepath.sim import tcp_pose as _tcp
 from joulepath.trajectory import SplineBasis, Trajectory, minimum_jerk
-from joulepath.units import SAMPLE_PERIOD
-
-STEP = SAMPLE_PERIOD
-"""s: optimized durations are whole numbers of 25 ms samples."""
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class CycleSettings:
-    """Settings of a cycle optimization.
-
-    ``gradient``: the single-move search's settings, by default
-    :data:`joulepath.optimize._gradient.GRID_SEARCH` (the rows on the fine grid, plain SLSQP: on the
-    bundled examples the single move's faster default saved less, payload_tool 12.0 % against 12.7 %,
-    palletizing 22.0 % against 22.3 %, in about the same CPU time; BENCHMARKS.md).
-    ``cycle_time``: s, or None for the default program's cycle time. ``use_waits``:
-    spend ``WaitTime`` slack on the moves. ``table_points``: durations solved per
-    move; ``via_every``: average spacing, in 25 ms samples, of the via points written per
-    optimized move (:func:`joulepath.sim._via.layout`). ``corridor_mm``: tool0 stays
-    within this distance of the joint-interpolated taught move (the path ``MoveJ`` itself
-    follows) at every sample (None: none). ``accel_time`` and ``jerk_time`` set the
-    optimized moves' acceleration and jerk limits (:mod:`joulepath.sim`'s; ``jerk_time``
-    0, the default for now: no jerk limit — under the controller's jerk limit,
-    :data:`joulepath.sim.JERK_TIME`, an optimized move starts from a minimum-jerk move, slower
-    than the controller's own ramps, and a program's own cycle time is out of reach).
-    ``cell``: obstacles every optimized move must clear (a move too close is solved
-    again in corridors of 1/2, 1/4, 1/8 of ``corridor_mm``, else not used).
-    ``warm_start``: start each solve of a move from its nearest solved duration
-    (time-scaled) and run only the last continuation stages; measured not faster and
-    slightly worse (BENCHMARKS.md), so off by default. ``fly_by``: consecutive
-    optimizable moves joined by a zone (a fly-by target) are solved as one chain through
-    those targets, at whatever speed saves most; False: only a move that runs from rest
-    to rest on its own is optimized (the taught chains are kept). ``zones``: a chain
-    passes each fly-by target within its zone (the controller's zone: its radius,
-    reduced to half of either move's TCP length), False: exactly. ``max_time_s``: a
-    bound on the wall time; when it is reached no further move is solved and the best
-    verified allocation of what was solved is returned (taught motion elsewhere).
-    ``retime_linear``: a ``MoveL`` that runs from rest to rest on its own is re-timed along
-    its line (:func:`joulepath.optimize.retime_on_path`; its speeddata's TCP speed a bound).
-    ``follow``: what the controller follows: ``"samples"`` (a streamed trajectory, EGM) or
-    ``"via-points"`` (RAPID via points: only the units from rest to rest of joint moves, planned
-    within :data:`joulepath.sim._via.RAPID_ACCEL_SHARE` of the acceleration limit, as for a
-    single move's ``path.mod``). ``rapid_plan``: with ``"samples"`` and a RAPID program, also
-    plan for via points (:attr:`CycleResult.rapid_plan`), the module written where the
-    emulation runs the plan itself as the checks ask. ``energy_every``: the gradient search of a
-    unit from rest to rest sums its objective on a grid this many times finer than the 25 ms
-    samples (a divisor of the ``gradient``'s ``check_factor``; on the samples alone it places power
-    peaks between them, and the verified energy, on 2.5 ms, is up to about 0.5 % higher than it
-    planned). A shape added to the taught motion keeps the ``gradient``'s own (measured: on the
-    bundled examples the finer grid there saved less, e.g. payload_tool 3.8 % against 4.2 %). ``pass_search``:
-    solves per inner target, at most, of the search for when a chain passes its targets
-    (:meth:`CycleOptimizer.tune_passes`; a long chain's probes, on wider knots, stop after
-    :data:`LONG_PROBES` per target in a row without a gain; 0: no search, the targets passed in
-    proportion to each move's shortest duration).
-    ``retime_segments``: with ``"samples"``, every segment with a ``MoveL`` is at last re-timed
-    along its own joint path in the chosen cycle (:meth:`CycleOptimizer.retime_segments`: the
-    lines, blends and zones as they are, the speeddata a bound, the segment's duration kept).
-    """
-
-    cycle_time: float | None = None
-    use_waits: bool = False
-    table_points: int = 4
-    via_every: int = 2
-    accel_time: float = ACCEL_TIME
-    jerk_time: float = 0.0
-    corridor_mm: float | None = 100.0
-    cell: Cell | None = None
-    warm_start: bool = False
-    fly_by: bool = True
-    zones: bool = True
-    retime_linear: bool = True
-    max_time_s: float | None = None
-    follow: str = "samples"
-    rapid_plan: bool = True
-    energy_every: int = 2
-    pass_search: int = 8
-    retime_segments: bool = True
-    gradient: GradientSettings = field(default_factory=lambda: GradientSettings(**GRID_SEARCH))
-    controller: ControllerConfig = field(default_factory=ControllerConfig)
-    seed: int = 0
-    energy: str = DEFAULT_MEASURE
-
-    def __post_init__(self) -> None:
-        energy_measure(self.energy)
-        if self.cycle_time is not None and not (np.isfinite(self.cycle_time) and 0 < self.cycle_time <= 3600):
-            raise InvalidInput(f"cycle time must be a positive number of seconds, got {self.cycle_time}")
-        if not 2 <= self.table_points <= 20:
-            raise InvalidInput(f"table_points must be 2..20, got {self.table_points}")
-        if not 1 <= self.via_every <= 40:
-            raise InvalidInput(f"via_every must be 1..40, got {self.via_every}")
-        if self.corridor_mm is not None and not (np.isfinite(self.corridor_mm) and self.corridor_mm > 0):
-            raise InvalidInput(f"corridor must be a positive number of mm, got {self.corridor_mm}")
-        if not 0 < self.accel_time <= 10:
-            raise InvalidInput(f"accel_time must be in (0, 10] s, got {self.accel_time}")
-        if not 0 <= self.jerk_time <= 10:
-            raise InvalidInput(f"jerk_time must be in [0, 10] s (0: no jerk limit), got {self.jerk_time}")
-        if self.energy_every < 1 or self.gradient.check_factor % self.energy_every:
-            raise InvalidInput(
-                f"energy_every must divide the gradient's check_factor ({self.gradient.check_factor}), "
-                f"got {self.energy_every}"
-            )
-        if not 0 <= self.pass_search <= 20:
-            raise InvalidInput(f"pass_search must be 0..20 solves per target, got {self.pass_search}")
-        if self.follow not in ("samples", "via-points"):
-            raise InvalidInput(f"follow must be samples or via-points, got {self.follow!r}")
-        if self.max_time_s is not None and not (np.isfinite(self.max_time_s) and self.max_time_s > 0):
-            raise InvalidInput(f"max_time_s must be a positive number of seconds, got {self.max_time_s}")
-
-
-FAST_CYCLE: dict[str, Any] = {"pass_search": 2, "table_points": 3, "retime_segments": False}
-""":class:`CycleSettings` for interactive use (``CycleSettings(**FAST_CYCLE)``; issue 36): at most 2 probes
-per inner target in the pass-time search, 3 durations per unit in the time table, and no re-timing of
-the segments with a ``MoveL`` along their paths. Measured on the bundled examples (one BLAS thread,
-CPU s and saving, default -> fast, one run each on the same code): pick_and_place 7.0 -> 2.3 s, 12.19 ->
-10.9 %; palletizing 8.4 -> 4.4 s, 22.37 -> 20.3 %; machine_tending 3.1 -> 1.4 s, 12.70 -> 11.2 %;
-inspection 3.7 -> 3.8 s, 17.46 % both; approach_depart 2.3 -> 0.7 s, 13.65 -> 12.7 %; payload_tool 2.9
--> 1.7 s, 12.66 -> 12.3 % (BENCHMARKS.md, benchmarks/cycle_examples.py with ``FAST=1``)."""
-
-
-class TimeBudgetSpent(Exception):
-    """Internal: the wall-time bound was reached before a solve (never leaves this module)."""
-
-
-def _window_energy(robot: Robot, plant: Plant, traj: Trajectory, measure: str) -> tuple[float, float]:
-    """Physics (on ``measure``) and lab J of a window of a cycle's motion, summed as
-    :meth:`CycleOptimizer.move_energies` sums them: each sample's power times the step to the next
-    (the last sample's weight 0)."""
-    w = np.append(np.diff(traj.t), 0.0)
-    p, p_lab = sample_power(robot, plant, traj, measure)
-    return float((p * w).sum()), float((p_lab * w).sum())
 
 
 def _reduced_zone_mm(zone_mm: float, into: PlannedMove, out: PlannedMove) -> float:
@@ -280,207 +166,6 @@ NO_SPEED_BOUND = 1e3
 """m/s: the TCP speed "bound" at a joint move's samples in a segment re-timed along its path (none)."""
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Solved:
-    """One optimized move at one duration, verified."""
-
-    duration: float
-    energy_J: float
-    energy_lab_J: float
-    limits_ok: bool
-    limit_excess: tuple[str, ...]
-    samples: Trajectory  # 25 ms
-    fine: Trajectory  # 2.5 ms
-    corridor_dev_mm: float  # tool0 from the joint-interpolated taught move, largest
-    clearance_mm: float | None = None  # smallest distance to the cell's obstacles (None: no cell)
-    corridor_used_mm: float | None = None
-    taught: bool = False  # the taught motion of the unit, as the controller runs it (not re-solved)
-    passes: tuple[float, ...] | None = None  # s: when it passes the inner targets (None: waypoints())
-    coefficients: FloatArray | None = None  # the gradient search's (flat), a warm start for its neighbours
-
-    @property
-    def usable(self) -> bool:
-        return self.limits_ok and (self.clearance_mm is None or self.clearance_mm >= 0.0)
-
-
-@dataclass(frozen=True, slots=True)
-class MoveOutcome:
-    """One move of the cycle: default against optimized (s, J)."""
-
-    line: int
-    label: str
-    optimized: bool
-    note: str
-    default_duration_s: float
-    optimized_duration_s: float
-    default_energy_J: float
-    optimized_energy_J: float
-    default_lab_J: float
-    optimized_lab_J: float
-    limits_ok: bool
-    limit_excess: tuple[str, ...]
-    via_points: int
-    via_max_joint_dev_deg: float
-    via_max_tcp_dev_mm: float
-    corridor_dev_mm: float
-    default_clearance_mm: float | None = None
-    optimized_clearance_mm: float | None = None
-
-
-@dataclass(frozen=True, slots=True)
-class Allocation:
-    """Durations (s) of the optimized moves, by step index, and the verified cycle energies (J)."""
-
-    durations: dict[int, float]
-    energy_J: float
-    energy_lab_J: float
-    cycle_time_s: float
-    choice: dict[int, Solved] = field(default_factory=dict)  # by unit: the entry chosen
-
-
-@dataclass(frozen=True, slots=True)
-class Breakdown:
-    """Where the saving comes from (J on physics): E0 default, E1 shapes at the default's
-    proportions of time, E2 re-allocated durations, E3 with the waits spent, E4 with the segments
-    that have a ``MoveL`` re-timed along their path (:meth:`CycleOptimizer.retime_segments`)."""
-
-    default_J: float
-    shape_J: float
-    allocation_J: float
-    waits_J: float | None
-    path_retimed_J: float | None = None
-
-    @property
-    def by_shape_pct(self) -> float:
-        return 100 * (self.default_J - self.shape_J) / self.default_J
-
-    @property
-    def by_allocation_pct(self) -> float:
-        return 100 * (self.shape_J - self.allocation_J) / self.default_J
-
-    @property
-    def by_waits_pct(self) -> float | None:
-        return None if self.waits_J is None else 100 * (self.allocation_J - self.waits_J) / self.default_J
-
-    @property
-    def by_path_retiming_pct(self) -> float | None:
-        if self.path_retimed_J is None:
-            return None
-        before = self.allocation_J if self.waits_J is None else self.waits_J
-        return 100 * (before - self.path_retimed_J) / self.default_J
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class CycleResult:
-    """A verified cycle optimization."""
-
-    moves: tuple[MoveOutcome, ...]
-    default_cycle_s: float
-    target_cycle_s: float
-    optimized_cycle_s: float
-    default_energy_J: float
-    optimized_energy_J: float
-    default_lab_J: float
-    optimized_lab_J: float
-    breakdown: Breakdown
-    waits: tuple[tuple[int, float, float], ...]  # (line, default s, optimized s)
-    fixed_lines: tuple[int, ...]
-    limits_ok: bool
-    corridor_mm: float | None
-    cell: dict[str, object] | None
-    shortest_cycle_s: float
-    wall_s: float
-    n_solves: int
-    paths: dict[int, Solved]  # by step index: the optimized moves
-    spec: CycleSpec
-    chains: dict[int, tuple[int, ...]] = field(default_factory=dict)  # fly-by chains (step indices)
-    vias: dict[int, tuple[int, ...]] = field(default_factory=dict)  # per optimized move: indices into .fine
-    planned: Trajectory | None = None  # the whole optimized cycle, 2.5 ms grid
-    taught_units: tuple[int, ...] = ()  # first lines of the units kept as taught
-    long_units: tuple[int, ...] = ()  # first lines of units longer than the move_s limit, kept as taught
-    timed_out: bool = False  # max_time_s was reached before every solve
-    zone_miss_mm: float = 0.0  # largest TCP distance beyond a fly-by target's zone (0: within all)
-    open_ends: frozenset[int] = frozenset()  # optimized moves whose piece ends blended into a kept move
-    rapid_plan: CycleResult | None = None  # the same with the units inside MoveL segments as taught
-    path_retimed: tuple[int, ...] = ()  # step indices re-timed along their segment's path (retime_segments)
-    unretimed: CycleResult | None = None  # the same plan before that (what RAPID's own moves can follow)
-    energy_measure: str = DEFAULT_MEASURE  # the measure of the *_energy_J figures (motion, no standby)
-    energies: tuple[MeasureSummary, ...] = ()  # every measure the robot has data for, whole cycle
-    energies_unavailable: dict[str, str] = field(default_factory=dict)  # why not, for the others
-
-    @property
-    def saved_pct(self) -> float:
-        return 100 * (self.default_energy_J - self.optimized_energy_J) / self.default_energy_J
-
-    @property
-    def saved_lab_pct(self) -> float:
-        return 100 * (self.default_lab_J - self.optimized_lab_J) / self.default_lab_J
-
-
-@dataclass(frozen=True, slots=True)
-class ParetoPoint:
-    """Energy at one cycle time (every move a verified solve of the table)."""
-
-    cycle_time_s: float
-    energy_J: float
-    energy_lab_J: float
-    durations: tuple[float, ...]
-
-
-def sample_power(robot: Robot, plant: Plant, traj: Trajectory, measure: str) -> tuple[FloatArray, FloatArray]:
-    """Per-sample power (W) of ``traj``: on the physics model (nominal rigid body with the tool's load
-    and NOMINAL_FRICTION, the robot's gears and drives) on ``measure``, standby excluded; and the lab
-    plant's logged power ``Σ |drive torque · qd|`` (its ``mechanical`` energy, gears included)."""
-    tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
-    p = measure_power(measure, tau, traj.qd, robot.drivetrain).value
-    lab = plant.joint_torque(traj.q, traj.qd, traj.qdd)
-    return p, measure_power(LAB_MEASURE, lab, traj.qd, plant.drivetrain).value
-
-
-LAB_MEASURE = "mechanical"
-"""The lab plant's energies are what its torque log integrates to: its drive torque times speed."""
-
-
-def _energy(
-    robot: Robot, plant: Plant, traj: Trajectory, measure: str = DEFAULT_MEASURE, *, half_open: bool = False
-) -> tuple[float, float]:
-    """Physics (on ``measure``) and lab J of ``traj``; ``half_open``: without its last sample (a window
-    that the rest of the cycle continues from, so that windows and their surroundings add up)."""
-    if half_open:
-        k = traj.t.size - 1
-        traj = Trajectory(t=traj.t[:k], q=traj.q[:k], qd=traj.qd[:k], qdd=traj.qdd[:k])
-    p, p_lab = sample_power(robot, plant, traj, measure)
-    return float(p.sum() * traj.dt), float(p_lab.sum() * traj.dt)
-
-
-@dataclass(frozen=True, slots=True)
-class Segment:
-    """Moves of the default cycle from rest to rest: the robot stands still before the first
-    (at the cycle's start, or after a stop point's dwell or a wait) and after the last."""
-
-    moves: tuple[int, ...]  # step indices, in order
-    t0: float  # s, in the default cycle
-    t1: float
-
-    @property
-    def span(self) -> float:
-        return self.t1 - self.t0
-
-
-def segments(plan: PlannedCycle) -> list[Segment]:
-    """The default cycle cut at every stop of the robot (:class:`Segment`)."""
-    out: list[Segment] = []
-    run: list[PlannedMove] = []
-    for m in plan.moves:
-        run.append(m)
-        if m.stops:
-            out.append(Segment(tuple(x.index for x in run), run[0].t0, max(x.t_end for x in run)))
-            run = []
-    if run:
-        out.append(Segment(tuple(x.index for x in run), run[0].t0, max(x.t_end for x in run)))
-    return out
-
-
 ON_TAUGHT_KNOTS = 0.1
 """s between knots, at least, of a shape added to the taught motion: the taught motion runs at the
 joints' speed limits, so nearly every speed row is active, and SLSQP's cost grows with their number."""
@@ -522,9 +207,6 @@ started from that solve (:meth:`CycleOptimizer.solve_on_taught`), is also solved
 motion. Measured on the long fly-by chain of issue 36 (one BLAS thread): from the taught motion
 43.375 J in 10.0 s, from the solve (42.277 J) 43.556 J in 5.0 s, 0.4 % above the one from the
 taught motion and 3.0 % above the solve."""
-
-TIME_UNIT = FINE_DT
-"""s: the resolution at which the time budget is shared (taught durations are not whole samples)."""
 
 
 class CycleOptimizer:
@@ -1214,7 +896,7 @@ class CycleOptimizer:
             fine = self._taught_after(window, win.t0, win.span)
         else:
             fine = window
-        e, e_lab = _window_energy(robot, self.plant(robot), fine, self.settings.energy)
+        e, e_lab = window_energy(robot, self.plant(robot), fine, self.settings.energy)
         samples = problem.path(x)
         samples = Trajectory(
             t=np.append(samples.t, win.span),
@@ -1254,7 +936,7 @@ class CycleOptimizer:
             qdd=np.vstack([sm.qdd, fine.qdd[-1:]]),
         )
         robot = self._robot(m)
-        e, e_lab = _window_energy(robot, self.plant(robot), fine, self.settings.energy)
+        e, e_lab = window_energy(robot, self.plant(robot), fine, self.settings.energy)
         return replace(
             piece,
             duration=round(float(fine.t[-1]), 9),
@@ -1596,7 +1278,7 @@ class CycleOptimizer:
         report = check_limits(
             robot, fine, friction=NOMINAL_FRICTION, acceleration_limit=amax, jerk_limit=self._jmax(robot)
         )
-        e, e_lab = _energy(robot, self.plant(robot), fine, self.settings.energy, half_open=inner)
+        e, e_lab = trajectory_energy(robot, self.plant(robot), fine, self.settings.energy, half_open=inner)
         samples = problem.path(x)
         # the taught move: the joint-interpolated move, or through a chain's targets the smoothest path
         taught = problem.path(problem.origin)
@@ -1630,7 +1312,7 @@ class CycleOptimizer:
             energy_measure=self.settings.energy,
         )
         self.n_solves += 1
-        e, e_lab = _energy(robot, self.plant(robot), r.fine, self.settings.energy)
+        e, e_lab = trajectory_energy(robot, self.plant(robot), r.fine, self.settings.energy)
         return Solved(
             T,
             e,
@@ -1669,7 +1351,7 @@ class CycleOptimizer:
         every = self.gradient.check_factor
         samples = Trajectory(t=fine.t[::every], q=fine.q[::every], qd=fine.qd[::every], qdd=fine.qdd[::every])
         robot = self._robot(self.by_index[i])
-        e, e_lab = _energy(robot, self.plant(robot), fine, self.settings.energy, half_open=True)
+        e, e_lab = trajectory_energy(robot, self.plant(robot), fine, self.settings.energy, half_open=True)
         out = Solved(
             win.span,
             e,
@@ -1767,101 +1449,36 @@ class CycleOptimizer:
                 out[i].append(reshaped)
         return True
 
+    def entries(self, table: dict[int, list[Solved]]) -> tuple[UnitEntries, ...]:
+        """The time table as :func:`~joulepath.program._cycle_allocation.least_energy_choice` and
+        :func:`~joulepath.program._cycle_allocation.fitted_share` read it (units in order)."""
+        return tuple(
+            UnitEntries(
+                durations=np.array([s.duration for s in table[i]], dtype=float),
+                energies=np.array([s.energy_J for s in table[i]], dtype=float),
+                usable=np.array([s.usable for s in table[i]], dtype=bool),
+                taught=np.array([s.taught for s in table[i]], dtype=bool),
+            )
+            for i in self.optimizable
+        )
+
     def dp(self, table: dict[int, list[Solved]], budget: float) -> dict[int, Solved] | None:
-        """The least-energy choice of one usable entry per unit with Σ durations ≤ budget, on a
-        grid of :data:`TIME_UNIT` (each duration rounded up; the choice is checked in exact time)."""
-        idx = self.optimizable
-        if not idx:
-            return {}
-        cap = int(np.floor(budget / TIME_UNIT + 1e-9)) + len(idx)
-        while cap >= 0:
-            best = np.full(cap + 1, np.inf)
-            best[0] = 0.0
-            choice: list[np.ndarray] = []
-            for i in idx:
-                new = np.full(cap + 1, np.inf)
-                pick = np.full(cap + 1, -1)
-                for k, s in enumerate(table[i]):
-                    if not s.usable:
-                        continue
-                    u = int(np.ceil(s.duration / TIME_UNIT - 1e-6))
-                    if u > cap:
-                        continue
-                    cand = np.full(cap + 1, np.inf)
-                    cand[u:] = best[: cap + 1 - u] + s.energy_J
-                    better = cand < new
-                    new[better] = cand[better]
-                    pick[better] = k
-                choice.append(pick)
-                best = new
-            end = int(np.argmin(best))
-            if not np.isfinite(best[end]):
-                return None
-            out: dict[int, Solved] = {}
-            u = end
-            for i, pick in zip(reversed(idx), reversed(choice), strict=True):
-                s = table[i][int(pick[u])]
-                out[i] = s
-                u -= int(np.ceil(s.duration / TIME_UNIT - 1e-6))
-            if sum(s.duration for s in out.values()) <= budget + 1e-9:
-                return out
-            cap = end - 1  # the rounding let it over the budget: a tighter grid budget
-        return None
+        """The least-energy choice of one usable entry per unit with Σ durations ≤ budget
+        (:func:`~joulepath.program._cycle_allocation.least_energy_choice`)."""
+        picks = least_energy_choice(self.entries(table), budget)
+        if picks is None:
+            return None
+        return {i: table[i][k] for i, k in zip(reversed(self.optimizable), reversed(picks), strict=True)}
 
     def continuous(self, table: dict[int, list[Solved]], budget: float) -> dict[int, Solved] | None:
-        """Share the budget on the fitted curves ``a + b/T + c/T²`` of the solved entries (SLSQP), in
-        25 ms steps, then solve at the shares; None when a unit has no usable solved entry or the
-        budget does not reach every unit's shortest."""
-        from scipy.optimize import minimize, nnls
-
+        """Share the budget on the fitted curves ``a + b/T + c/T²`` of the solved entries
+        (:func:`~joulepath.program._cycle_allocation.fitted_share`), then solve at the shares; None
+        when a unit has no usable solved entry or the budget does not reach every unit's shortest."""
         idx = self.optimizable
-        coef = []
-        for i in idx:
-            pts = [(s.duration, s.energy_J) for s in table[i] if s.usable and not s.taught]
-            if not pts:
-                return None
-            T = np.array([p[0] for p in pts])
-            E = np.array([p[1] for p in pts])
-            A = np.column_stack([np.ones_like(T), 1 / T, 1 / T**2])
-            c, _ = nnls(A, E) if T.size >= 2 else (np.array([E[0], 0.0, 0.0]), 0.0)
-            coef.append(c)
-        if not idx:
-            return None
-        C = np.array(coef)
-        lo = np.array([self.t_lo[i] for i in idx])
-        if lo.sum() > budget + 1e-9:
-            return None
-        hi = np.array([max(s.duration for s in table[i] if not s.taught) for i in idx])
-        hi = np.maximum(hi, lo)
-
-        def f(T: FloatArray) -> tuple[float, FloatArray]:
-            e = C[:, 0] + C[:, 1] / T + C[:, 2] / T**2
-            g = -C[:, 1] / T**2 - 2 * C[:, 2] / T**3
-            return float(e.sum()), g
-
-        x0 = np.clip(lo + (budget - lo.sum()) * (hi - lo) / max((hi - lo).sum(), 1e-9), lo, hi)
-        res = minimize(
-            f,
-            x0,
-            jac=True,
-            method="SLSQP",
-            bounds=list(zip(lo, hi, strict=True)),
-            constraints=[
-                {"type": "ineq", "fun": lambda T: budget - T.sum(), "jac": lambda T: -np.ones_like(T)}
-            ],
-            options={"maxiter": 200, "ftol": 1e-10},
-        )
-        T = np.clip(np.asarray(res.x, dtype=float), lo, hi)
-        units = np.maximum(np.floor(T / STEP + 1e-9), np.ceil(lo / STEP - 1e-9)).astype(int)
-        fixed = np.array([i in self.within for i in idx])
-        units[fixed] = np.round(lo[fixed] / STEP).astype(int)  # their duration stays
-        spare = int(np.floor(budget / STEP + 1e-9)) - int(units.sum())
-        while spare > 0 and not fixed.all():  # hand the remaining 25 ms steps to the steepest curves
-            _, g = f(units * STEP)
-            k = int(np.argmin(np.where(fixed, np.inf, g)))
-            units[k] += 1
-            spare -= 1
-        if units.sum() * STEP > budget + 1e-9:
+        lo = np.array([self.t_lo[i] for i in idx], dtype=float)
+        fixed = np.array([i in self.within for i in idx], dtype=bool)
+        units = fitted_share(self.entries(table), lo, fixed, budget, step=STEP)
+        if units is None:
             return None
         try:
             return {i: self.solve(i, float(u * STEP)) for i, u in zip(idx, units, strict=True)}
@@ -2064,7 +1681,7 @@ class CycleOptimizer:
             plant = self.plant(robot)
             old = Trajectory(t=tt, q=q, qd=qd, qdd=qdd)
             new = replace(r.fine, t=r.fine.t + tt[0])
-            e_new, e_old = (_window_energy(robot, plant, x, st.energy)[0] for x in (new, old))
+            e_new, e_old = (window_energy(robot, plant, x, st.energy)[0] for x in (new, old))
             if e_new >= e_old * (1.0 - RETIME_GAIN):
                 continue
             s_new = np.maximum.accumulate(r.s) + np.arange(r.s.size) * 1e-15
@@ -2134,7 +1751,7 @@ class CycleOptimizer:
                     continue
                 tt = traj.t[sel]
                 fine = Trajectory(t=tt - tt[0], q=traj.q[sel], qd=traj.qd[sel], qdd=traj.qdd[sel])
-                e, e_lab = _window_energy(robot, plant, fine, self.settings.energy)
+                e, e_lab = window_energy(robot, plant, fine, self.settings.energy)
                 grid = np.append(np.arange(0.0, fine.t[-1] - 1e-9, STEP), fine.t[-1])
 
                 def at(x: FloatArray, f: Trajectory = fine, g: FloatArray = grid) -> FloatArray:
@@ -2229,16 +1846,6 @@ class CycleOptimizer:
                 )
             )
         return tuple(out), unavailable
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class CycleMotion:
-    """A cycle's motion (``t`` from 0, strictly increasing, pieces 2.5 ms apart inside), where each
-    move starts in it (s, by step index) and its cycle time (s)."""
-
-    trajectory: Trajectory
-    starts: dict[int, float]
-    cycle_time: float
 
 
 def check_cycle(spec: CycleSpec, settings: CycleSettings) -> None:

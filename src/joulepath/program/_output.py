@@ -21,7 +21,7 @@ from joulepath._io import (
 )
 from joulepath.errors import LimitViolation
 from joulepath.program._cell import Cell, clearance
-from joulepath.program._cycle import LAB_MEASURE, CycleResult, ParetoPoint
+from joulepath.program._cycle_model import LAB_MEASURE, CycleResult, ParetoPoint
 from joulepath.program._model import RapidError
 from joulepath.program._rapid_write import (
     WrittenModule,
@@ -129,7 +129,7 @@ def check_written(result: CycleResult, text: str, cell: Cell | None = None) -> d
     """
     from scipy.spatial import cKDTree
 
-    from joulepath.program._cycle import _energy
+    from joulepath.program._cycle_model import trajectory_energy
     from joulepath.program._task import as_sequence, read_written
     from joulepath.sim import FINE_DT, ControllerConfig, evaluate_cycle, make_plant, plan_cycle
     from joulepath.sim import tcp_pose as _tcp
@@ -142,7 +142,9 @@ def check_written(result: CycleResult, text: str, cell: Cell | None = None) -> d
     traj = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
     first = plan.moves[0].step
     assert first.robot is not None and first.tcp is not None
-    energy, energy_lab = _energy(first.robot, make_plant("lab", first.robot), traj, result.energy_measure)
+    energy, energy_lab = trajectory_energy(
+        first.robot, make_plant("lab", first.robot), traj, result.energy_measure
+    )
     assert result.planned is not None
     p_plan, _ = _tcp(first.robot, result.planned.q, first.tcp)
     p_emu, _ = _tcp(first.robot, traj.q, first.tcp)

@@ -30,7 +30,8 @@ from typing import Any, Literal
 
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
-from joulepath.program._cycle import CycleResult, CycleSettings, ParetoPoint, optimize_cycle, pareto
+from joulepath.program._cycle import optimize_cycle, pareto
+from joulepath.program._cycle_model import CycleResult, CycleSettings, ParetoPoint
 from joulepath.program._resolve import CycleSpec, read_cycle_program
 from joulepath.trajectory import Trajectory
 
