@@ -67,12 +67,12 @@ class CycleSettings:
     planned). A shape added to the taught motion keeps the ``gradient``'s own (measured: on the
     bundled examples the finer grid there saved less, e.g. payload_tool 3.8 % against 4.2 %). ``pass_search``:
     solves per inner target, at most, of the search for when a chain passes its targets
-    (:meth:`CycleOptimizer.tune_passes`; a long chain's probes, on wider knots, stop after
+    (:func:`~joulepath.program._cycle_passes.tune_passes`; a long chain's probes, on wider knots, stop after
     :data:`LONG_PROBES` per target in a row without a gain; 0: no search, the targets passed in
     proportion to each move's shortest duration).
     ``retime_segments``: with ``"samples"``, every segment with a ``MoveL`` is at last re-timed
-    along its own joint path in the chosen cycle (:meth:`CycleOptimizer.retime_segments`: the
-    lines, blends and zones as they are, the speeddata a bound, the segment's duration kept).
+    along its own joint path in the chosen cycle (:func:`~joulepath.program._cycle_motion.retime_segments`:
+    the lines, blends and zones as they are, the speeddata a bound, the segment's duration kept).
     """
 
     cycle_time: float | None = None
@@ -201,7 +201,8 @@ class Allocation:
 class Breakdown:
     """Where the saving comes from (J on physics): E0 default, E1 shapes at the default's
     proportions of time, E2 re-allocated durations, E3 with the waits spent, E4 with the segments
-    that have a ``MoveL`` re-timed along their path (:meth:`CycleOptimizer.retime_segments`)."""
+    that have a ``MoveL`` re-timed along their path
+    (:func:`~joulepath.program._cycle_motion.retime_segments`)."""
 
     default_J: float
     shape_J: float
@@ -266,6 +267,9 @@ class CycleResult:
     energy_measure: str = DEFAULT_MEASURE  # the measure of the *_energy_J figures (motion, no standby)
     energies: tuple[MeasureSummary, ...] = ()  # every measure the robot has data for, whole cycle
     energies_unavailable: dict[str, str] = field(default_factory=dict)  # why not, for the others
+    optimizable: tuple[int, ...] = ()  # the units reshaped or kept (step index of each one's first move)
+    default_planned: Trajectory | None = None  # the taught cycle as the controller runs it, 2.5 ms grid
+    pareto: tuple[ParetoPoint, ...] = ()  # energy against cycle time (optimize_cycle's pareto_points)
 
     @property
     def saved_pct(self) -> float:
@@ -352,8 +356,8 @@ def segments(plan: PlannedCycle) -> list[Segment]:
 
 def window_energy(robot: Robot, plant: Plant, traj: Trajectory, measure: str) -> tuple[float, float]:
     """Physics (on ``measure``) and lab J of a window of a cycle's motion, summed as
-    :meth:`CycleOptimizer.move_energies` sums them: each sample's power times the step to the next
-    (the last sample's weight 0)."""
+    :func:`~joulepath.program._cycle_motion.move_energies` sums them: each sample's power times the step to
+    the next (the last sample's weight 0)."""
     w = np.append(np.diff(traj.t), 0.0)
     p, p_lab = sample_power(robot, plant, traj, measure)
     return float((p * w).sum()), float((p_lab * w).sum())
