@@ -93,8 +93,8 @@ def cycle_optimum_of(opt) -> tuple[float, float, list[str], float]:
                 seg.robot,
                 [seg.segment],
                 seg.span,
-                acceleration_limit=opt._amax(seg.robot),
-                jerk_limit=opt._jmax(seg.robot),
+                acceleration_limit=opt.units.amax(seg.robot),
+                jerk_limit=opt.units.jmax(seg.robot),
                 friction=NOMINAL_FRICTION,
                 intervals=intervals,
                 initial=[seg.taught],
@@ -137,8 +137,8 @@ def shared_optimum(opt) -> tuple[float, float, str, float]:
                 seg.robot,
                 [seg.segment],
                 share * seg.span,
-                acceleration_limit=opt._amax(seg.robot),
-                jerk_limit=opt._jmax(seg.robot),
+                acceleration_limit=opt.units.amax(seg.robot),
+                jerk_limit=opt.units.jmax(seg.robot),
                 friction=NOMINAL_FRICTION,
                 intervals=INTERVALS,
                 initial=[seg.taught],
@@ -162,9 +162,9 @@ def shared_optimum(opt) -> tuple[float, float, str, float]:
 def plan_settings() -> CycleSettings:
     """The CLI's defaults; ``GRADIENT=hull``: with the single move's default search (hull rows,
     preconditioned SLSQP; issue 36) in place of the cycle's (``GRID_SEARCH``); ``FAST=1``: the
-    preset for interactive use (``joulepath.program._cycle.FAST_CYCLE``)."""
+    preset for interactive use (``joulepath.program.FAST_CYCLE``)."""
     if os.environ.get("FAST", "") == "1":
-        from joulepath.program._cycle import FAST_CYCLE
+        from joulepath.program import FAST_CYCLE
 
         return CycleSettings(**FAST_CYCLE)
     if os.environ.get("GRADIENT", "") == "hull":
@@ -184,7 +184,9 @@ def plan_only(name: str) -> None:
     The child process of ``--before``: it runs on whatever ``joulepath`` its PYTHONPATH gives."""
     spec, _ = read_cycle_program(program_path(name), load_robot("irb120"))
     t0, w0 = time.process_time(), time.perf_counter()
-    result, _ = optimize_cycle(spec, plan_settings())
+    result = optimize_cycle(spec, plan_settings())
+    if isinstance(result, tuple):  # the code before issue 46 returned (result, optimizer)
+        result = result[0]
     cpu, wall = time.process_time() - t0, time.perf_counter() - w0
     print(json.dumps({"cpu_s": cpu, "wall_s": wall, "saved_pct": result.saved_pct}))
 
@@ -216,7 +218,7 @@ def main(argv: list[str] | None = None) -> None:
         child = None if args.before is None else start_before(name, args.before.resolve())
         t0 = time.process_time()
         w0 = time.perf_counter()
-        result, opt = optimize_cycle(spec, plan_settings())
+        result = optimize_cycle(spec, plan_settings())
         cpu = time.process_time() - t0
         wall = time.perf_counter() - w0
         if child is not None:

@@ -6,9 +6,9 @@ import pytest
 import joulepath
 from joulepath.errors import InvalidInput
 from joulepath.optimize import GradientSettings
-from joulepath.program import CycleSettings, optimize_cycle, parse_module, resolve_module
+from joulepath.program import CycleSettings, parse_module, resolve_module
 from joulepath.program._cell import Cell, Obstacle, clearance, read_cell
-from joulepath.program._cycle import CycleOptimizer
+from joulepath.program._cycle import CycleOptimizer, _optimize_cycle
 
 pytest.importorskip("coal")
 
@@ -74,10 +74,10 @@ def test_clearance_agrees_with_a_point_sampled_distance(robot):
 def test_result_goes_around_an_obstacle_on_the_free_optimum(robot):
     spec = resolve_module(parse_module(TWO, path="two.mod"), robot)
     free = CycleOptimizer(spec, CycleSettings(gradient=FAST, corridor_mm=None))
-    i = free.optimizable[0]
-    m = free.by_index[i]
-    T = free.t_lo[i] + 0.3
-    s = free.solve(i, T)
+    i = free.units.optimizable[0]
+    m = free.units.by_index[i]
+    T = free.solver.t_lo[i] + 0.3
+    s = free.solver.solve(i, T)
     # the sample where the free optimum's tool0 is farthest from the taught (joint-interpolated) move
     from joulepath.trajectory import minimum_jerk
 
@@ -97,14 +97,14 @@ def test_result_goes_around_an_obstacle_on_the_free_optimum(robot):
     for k in np.argsort(-dev)[:10]:
         box = Obstacle("block", "box", tuple(a[k]), (0.01, 0.01, 0.01))
         trial = Cell((box,), 0.01, 0.055, 0.04, 0.025, "test")
-        if CycleOptimizer(spec, CycleSettings(gradient=FAST, cell=trial)).default_clearance[i] >= 0:
+        if CycleOptimizer(spec, CycleSettings(gradient=FAST, cell=trial)).units.default_clearance[i] >= 0:
             cell = trial
             break
     assert cell is not None
     assert clearance(cell, robot, s.fine.q, tcp).distance < 0  # the free optimum hits it
     settings = CycleSettings(gradient=FAST, table_points=2, corridor_mm=None, cell=cell, use_waits=True)
-    result, opt = optimize_cycle(spec, settings)
-    assert opt.default_clearance[i] >= 0  # the taught move clears it
+    result, opt = _optimize_cycle(spec, settings)
+    assert opt.units.default_clearance[i] >= 0  # the taught move clears it
     moved = next(mo for mo in result.moves if mo.line == m.step.line)
     assert moved.optimized and moved.optimized_clearance_mm >= 0.0
     assert result.limits_ok
@@ -112,7 +112,7 @@ def test_result_goes_around_an_obstacle_on_the_free_optimum(robot):
     written = result.paths[i]
     assert clearance(cell, robot, written.fine.q, tcp).distance >= cell.margin - 1e-9
     # at the duration where the free optimum hits the block, the cell's result goes around it
-    around = opt.solve(i, T)
+    around = opt.solver.solve(i, T)
     assert around.usable and around.corridor_used_mm is not None
     assert clearance(cell, robot, around.fine.q, tcp).distance >= cell.margin - 1e-9
 

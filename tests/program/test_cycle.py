@@ -12,16 +12,16 @@ from joulepath.dynamics import NOMINAL_FRICTION
 from joulepath.energy import path_energy
 from joulepath.optimize import GradientSettings
 from joulepath.program import (
+    FAST_CYCLE,
     CycleSettings,
     optimize_cycle,
-    pareto,
     parse_module,
     plan_cycle,
     read_cycle_toml,
     read_module,
     resolve_module,
 )
-from joulepath.program._cycle import FAST_CYCLE, CycleOptimizer
+from joulepath.program._cycle import CycleOptimizer, _optimize_cycle
 from joulepath.sim import JERK_TIME, ControllerConfig
 from joulepath.sim._timing import FINE_DT, evaluate_cycle, standalone
 
@@ -63,7 +63,7 @@ def spec(robot):
 @pytest.fixture(scope="module")
 def reachable(spec):
     """SMALL optimized at REACHABLE with its waits spent (zones and fly-by on): (result, optimizer)."""
-    return optimize_cycle(
+    return _optimize_cycle(
         spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, cycle_time=REACHABLE)
     )
 
@@ -108,7 +108,7 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
     settings = CycleSettings(
         gradient=FAST, table_points=3, use_waits=True, cycle_time=REACHABLE, jerk_time=JERK_TIME
     )
-    result, opt = optimize_cycle(spec, settings)
+    result = optimize_cycle(spec, settings, pareto_points=4)
     assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
     assert result.limits_ok
     units = {"MoveAbsJ jA", "MoveJ pUp", "MoveAbsJ jB"}
@@ -153,10 +153,10 @@ def test_optimized_cycle_invariants(spec, robot, tmp_path):
     assert "optimized.mod" not in files and not (tmp_path / "optimized.mod").exists()
     assert json.loads((tmp_path / "cycle.json").read_text())["rapid_refused"]
     # more cycle time never costs energy (each point: best combination within a larger budget)
-    front = pareto(opt, points=4)
+    front = result.pareto
     e = [p.energy_J for p in front]
-    assert all(b <= a + 1e-9 for a, b in zip(e, e[1:], strict=False))
-    assert front[0].cycle_time_s == pytest.approx(opt.shortest_cycle + opt.wait_total)
+    assert len(front) == 4 and all(b <= a + 1e-9 for a, b in zip(e, e[1:], strict=False))
+    assert front[0].cycle_time_s == pytest.approx(result.shortest_cycle_s)
 
 
 def test_jerk_limits_lengthen_the_shortest_cycle(spec):
@@ -166,16 +166,17 @@ def test_jerk_limits_lengthen_the_shortest_cycle(spec):
 
     loose = CycleOptimizer(spec, CycleSettings(gradient=FAST, jerk_time=0))
     tight = CycleOptimizer(spec, CycleSettings(gradient=FAST, jerk_time=JERK_TIME))
-    assert all(tight.t_lo[i] >= loose.t_lo[i] - 1e-9 for i in loose.t_lo)
-    assert loose.shortest_cycle <= tight.shortest_cycle + 1e-9 <= tight.plan.cycle_time + 2e-9
-    r, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, jerk_time=JERK_TIME))
+    assert all(tight.solver.t_lo[i] >= loose.solver.t_lo[i] - 1e-9 for i in loose.solver.t_lo)
+    assert loose.solver.shortest_cycle <= tight.solver.shortest_cycle + 1e-9 <= tight.plan.cycle_time + 2e-9
+    r = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, jerk_time=JERK_TIME))
     assert r.optimized_cycle_s <= r.default_cycle_s + 1e-9
     assert r.optimized_energy_J <= r.default_energy_J * (1 + 1e-9)
     with pytest.raises(
         LimitViolation, match=r"shorter than the shortest .*optimized moves at their shortest"
     ):
         optimize_cycle(
-            spec, CycleSettings(gradient=FAST, jerk_time=JERK_TIME, cycle_time=0.9 * tight.shortest_cycle)
+            spec,
+            CycleSettings(gradient=FAST, jerk_time=JERK_TIME, cycle_time=0.9 * tight.solver.shortest_cycle),
         )
     # the default (no jerk limit yet for whole cycles) reaches the program's own cycle time
     assert CycleSettings().jerk_time == 0.0
@@ -196,7 +197,7 @@ def test_cycle_time_too_short_refused(spec):
 
     opt = CycleOptimizer(spec, CycleSettings(gradient=FAST))
     with pytest.raises(LimitViolation, match="shorter than the shortest"):
-        optimize_cycle(spec, CycleSettings(gradient=FAST, cycle_time=0.5 * opt.shortest_cycle))
+        optimize_cycle(spec, CycleSettings(gradient=FAST, cycle_time=0.5 * opt.solver.shortest_cycle))
 
 
 def test_cli_writes_a_program_that_reads_back(tmp_path, robot):
@@ -286,7 +287,7 @@ def test_plain_cycle_file(tmp_path, robot):
     spec = read_cycle_toml(f, robot)
     plan = plan_cycle(spec, ControllerConfig())
     assert [round(m.profile.duration, 9) for m in plan.moves] == [1.2, 1.0]
-    result, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
+    result = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
     assert result.limits_ok and result.optimized_cycle_s <= result.target_cycle_s + 1e-9
     # every measure of the whole cycle, the optimized one (thesis) agreeing with the headline
     thesis = {e.measure: e for e in result.energies}["thesis"]
@@ -294,7 +295,7 @@ def test_plain_cycle_file(tmp_path, robot):
     assert thesis.optimized_J == pytest.approx(result.optimized_energy_J, rel=1e-9)
     # the cycle optimized on the electrical energy: the meter-level figure includes the standby
     # power over the cycle time; the reshaped motion never costs more than the taught one
-    electric, _ = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, energy="electrical"))
+    electric = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2, energy="electrical"))
     by = {e.measure: e for e in electric.energies}
     assert electric.energy_measure == "electrical" and set(by) == {"thesis", "mechanical", "electrical"}
     meter = by["electrical"]
@@ -310,12 +311,12 @@ def test_plain_cycle_file(tmp_path, robot):
 
 def test_warm_start_solves_within_limits(spec):
     opt = CycleOptimizer(spec, CycleSettings(gradient=FAST, warm_start=True))
-    i = opt.optimizable[0]
-    first = opt.solve(i, opt.t_lo[i] + 0.2)
-    assert opt._neighbour(i, opt.t_lo[i]) is first
-    second = opt.solve(i, opt.t_lo[i])  # warm-started from the first
+    i = opt.units.optimizable[0]
+    first = opt.solver.solve(i, opt.solver.t_lo[i] + 0.2)
+    assert opt.solver._neighbour(i, opt.solver.t_lo[i]) is first
+    second = opt.solver.solve(i, opt.solver.t_lo[i])  # warm-started from the first
     assert second.usable and second.corridor_dev_mm <= 100.0 + 1e-6
-    assert opt.n_solves == 2
+    assert opt.solver.n_solves == 2
 
 
 CHAIN = """MODULE Chain
@@ -402,7 +403,7 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot, reachable)
     from joulepath.program import optimized_module
 
     settings = CycleSettings(gradient=FAST, table_points=3, use_waits=True, cycle_time=REACHABLE, zones=False)
-    result, opt = optimize_cycle(spec, settings)
+    result = optimize_cycle(spec, settings)
     assert result.limits_ok
     labels = {tuple(spec.steps[j].label for j in c) for c in result.chains.values()}
     assert ("MoveAbsJ jA", "MoveJ pUp") in labels
@@ -428,15 +429,15 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot, reachable)
     # passed exactly: the chain's piece ends with the program's own target, in its own zone
     assert moves and moves[-1].startswith("MoveAbsJ jA, v7000") and moves[-1].endswith("z20, tool0;")
     resolve_module(parse_module(text, path="o.mod"), robot)  # reads back
-    rest, opt_rest = optimize_cycle(
+    rest = optimize_cycle(
         spec, CycleSettings(gradient=FAST, table_points=3, use_waits=True, fly_by=False, cycle_time=REACHABLE)
     )
     assert rest.chains == {}
-    assert opt.shortest_cycle <= opt_rest.shortest_cycle + 1e-9
+    assert result.shortest_cycle_s <= rest.shortest_cycle_s + 1e-9
     # within its zone: the TCP passes within the zone of jA (reduced as the controller reduces it)
     zoned, opt_z = reachable
     assert opt_z.settings == replace(settings, zones=True)
-    assert opt_z.zone_mm(first) > 0.0
+    assert opt_z.units.zone_mm(first) > 0.0
     assert zoned.zone_miss_mm <= 1e-3
     assert zoned.optimized_energy_J <= result.optimized_energy_J * 1.02  # more freedom, not much worse
 
@@ -444,7 +445,7 @@ def test_moves_joined_by_a_zone_fly_through_their_target(spec, robot, reachable)
 def test_via_layout_of_a_gentle_move_is_run_as_planned(robot):
     """A minimum-jerk move (gentle at both ends) written as via points: the emulated controller keeps
     every corner, takes the planned time and stays on the path; the target is always a via point."""
-    from joulepath.program._cycle import _energy
+    from joulepath.program._cycle_model import trajectory_energy
     from joulepath.sim import make_plant
     from joulepath.sim._timing import _chain_profiles
     from joulepath.sim._via import _segment, layout
@@ -477,14 +478,16 @@ def test_via_layout_of_a_gentle_move_is_run_as_planned(robot):
     a, b = tcp(emu.q), tcp(plan.q)
     assert 1000 * max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max()) < 5.0
     plant = make_plant("lab", robot)
-    assert _energy(robot, plant, emu)[0] == pytest.approx(_energy(robot, plant, plan)[0], rel=0.05)
+    assert trajectory_energy(robot, plant, emu)[0] == pytest.approx(
+        trajectory_energy(robot, plant, plan)[0], rel=0.05
+    )
 
 
 def test_fast_preset_plans_within_limits(spec):
     """The preset for interactive use (FAST_CYCLE): fewer solves, the same checks on its plan."""
     settings = CycleSettings(**FAST_CYCLE, gradient=FAST, use_waits=True, cycle_time=REACHABLE)
     assert settings.table_points == 3 and settings.pass_search == 2 and not settings.retime_segments
-    result, _ = optimize_cycle(spec, settings)
+    result = optimize_cycle(spec, settings)
     assert result.limits_ok
     assert result.optimized_cycle_s <= result.target_cycle_s + 1e-9
     assert result.optimized_energy_J <= result.default_energy_J + 1e-9

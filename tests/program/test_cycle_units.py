@@ -12,7 +12,9 @@ import joulepath
 from joulepath.dynamics import NOMINAL_FRICTION
 from joulepath.optimize import GradientSettings
 from joulepath.program import CycleSettings, optimize_cycle, parse_module, read_cycle_program, resolve_module
-from joulepath.program._cycle import CycleOptimizer, segments
+from joulepath.program._cycle import CycleOptimizer, _optimize_cycle
+from joulepath.program._cycle_model import segments
+from joulepath.program._cycle_passes import tune_passes
 from joulepath.program._output import cycle_path_csv, write_cycle_run
 from joulepath.sim._timing import _tcp, evaluate_cycle
 
@@ -59,7 +61,7 @@ def blended(robot):
 
 @pytest.fixture(scope="module")
 def solved(blended):
-    return optimize_cycle(blended, CycleSettings(gradient=FAST, table_points=2))
+    return _optimize_cycle(blended, CycleSettings(gradient=FAST, table_points=2))
 
 
 def test_segments_partition_the_default_cycle(blended):
@@ -74,19 +76,25 @@ def test_segments_partition_the_default_cycle(blended):
     for s in segs:  # at rest at the end of every segment
         k = int(np.argmin(np.abs(motion.t - s.t1)))
         assert np.abs(motion.qd[k]).max() < 0.05
-    assert opt.fixed_time + sum(opt.span.values()) + opt.wait_total == pytest.approx(opt.plan.cycle_time)
+    assert opt.units.fixed_time + sum(opt.units.span.values()) + opt.units.wait_total == pytest.approx(
+        opt.plan.cycle_time
+    )
 
 
 def test_units_inside_moveL_segments_keep_the_taught_ends(blended, solved):
     """The MoveJ between two blended MoveL is a unit over its own motion and the blends at its ends;
     its optimized motion starts and ends in the taught motion's states, so the cycle stays continuous."""
     result, opt = solved
-    inner = [i for i in opt.within]
+    inner = [i for i in opt.units.within]
     assert inner, "the MoveJ between the MoveL moves is a unit"
     for i in inner:
-        base = opt.base(i)
-        for (unit, _), s in opt.cache.items():
-            if unit != i or s.taught or int(round(s.duration / 0.025)) != int(round(opt.span[i] / 0.025)):
+        base = opt.solver.base(i)
+        for (unit, _), s in opt.solver.cache.items():
+            if (
+                unit != i
+                or s.taught
+                or int(round(s.duration / 0.025)) != int(round(opt.units.span[i] / 0.025))
+            ):
                 continue
             if s.fine.t.size != base.t.size:
                 continue
@@ -108,26 +116,26 @@ def test_units_inside_moveL_segments_reshape_their_blends_within_the_zones(blend
     result, opt = solved
     robot = blended.robot
     covered = 0
-    for i in opt.within:
-        win = opt.segment_of[i]
-        seg = next(g for g in opt.segments if i in g.moves)
-        moving = [j for j in seg.moves if opt.by_index[j].profile.duration > 0]
-        run = opt.chains[i]
+    for i in opt.units.within:
+        win = opt.units.segment_of[i]
+        seg = next(g for g in opt.units.segments if i in g.moves)
+        moving = [j for j in seg.moves if opt.units.by_index[j].profile.duration > 0]
+        run = opt.units.chains[i]
         k0, k1 = moving.index(run[0]), moving.index(run[-1])
         ends = []
         if k0 > 0:
-            ends.append((win.t0, opt.by_index[moving[k0 - 1]], opt.by_index[run[0]]))
-            covered += win.t0 < opt.by_index[moving[k0 - 1]].t_end - 1e-9
+            ends.append((win.t0, opt.units.by_index[moving[k0 - 1]], opt.units.by_index[run[0]]))
+            covered += win.t0 < opt.units.by_index[moving[k0 - 1]].t_end - 1e-9
         if k1 + 1 < len(moving):
-            ends.append((win.t1, opt.by_index[run[-1]], opt.by_index[moving[k1 + 1]]))
-            covered += win.t1 > opt.by_index[moving[k1 + 1]].t0 + 1e-9
+            ends.append((win.t1, opt.units.by_index[run[-1]], opt.units.by_index[moving[k1 + 1]]))
+            covered += win.t1 > opt.units.by_index[moving[k1 + 1]].t0 + 1e-9
         for t, into, out in ends:
             step = into.step
             p, _ = _tcp(robot, evaluate_cycle(opt.plan, np.array([t])).q, step.tcp)
             corner, _ = _tcp(robot, into.path.q1[None, :], step.tcp)
             radius = min(step.zone_mm, 0.5 * into.path.length_mm, 0.5 * out.path.length_mm)
             assert 1000 * np.linalg.norm(p - corner) <= radius + 1e-6
-        last = opt.by_index[run[-1]]
+        last = opt.units.by_index[run[-1]]
         if last.stops and run[-1] in (result.unretimed or result).paths:
             piece = (result.unretimed or result).paths[run[-1]].fine
             np.testing.assert_allclose(piece.q[-1], last.path.q1, atol=1e-9)
@@ -156,33 +164,35 @@ def test_reported_energies_are_the_planned_motion_s(blended, solved):
     step = np.append(np.diff(tr.t), 0.0)[:, None]
     assert float((np.abs(tau * tr.qd) * step).sum()) == pytest.approx(result.optimized_energy_J, rel=1e-9)
     # the allocation's sum of entries agrees with the motion's energy
-    alloc = opt.evaluate(opt.at_taught_durations(opt.table(opt.budget(result.target_cycle_s, False))), 0.0)
+    alloc = opt.evaluate(
+        opt.at_taught_durations(opt.table(opt.units.budget(result.target_cycle_s, False))), 0.0
+    )
     assert alloc.energy_J > 0
-    default = opt.evaluate({i: opt.taught(i) for i in opt.optimizable}, opt.wait_total)
+    default = opt.evaluate({i: opt.solver.taught(i) for i in opt.units.optimizable}, opt.units.wait_total)
     assert default.energy_J == pytest.approx(result.default_energy_J, rel=1e-9)
 
 
 def test_max_time_returns_the_taught_cycle_when_nothing_was_solved(blended):
     """A wall-time bound spent before the first solve: the taught cycle, 0 % saved, stated."""
-    result, opt = optimize_cycle(blended, CycleSettings(gradient=FAST, max_time_s=1e-9))
+    result = optimize_cycle(blended, CycleSettings(gradient=FAST, max_time_s=1e-9))
     assert result.timed_out
-    assert opt.n_solves == 0
+    assert result.n_solves == 0
     assert result.saved_pct == pytest.approx(0.0, abs=1e-9)
     assert result.optimized_cycle_s == pytest.approx(result.default_cycle_s)
-    assert len(result.taught_units) == len(opt.optimizable)
+    assert len(result.taught_units) == len(result.optimizable)
     assert not result.paths
 
 
 def test_waits_are_process_time_unless_declared_idle(blended):
     """--use-waits spends only the waits declared idle; the others keep their length."""
     settings = CycleSettings(gradient=FAST, table_points=2, use_waits=True)
-    plain, _ = optimize_cycle(blended, settings)
+    plain = optimize_cycle(blended, settings)
     assert [w[1] for w in plain.waits] == [w[2] for w in plain.waits]  # nothing is idle
     steps = tuple(
         replace(s, idle=True) if s.kind == "wait" and s.seconds == 1.0 else s for s in blended.steps
     )
     idle_spec = replace(blended, steps=steps)
-    idle, opt = optimize_cycle(idle_spec, settings)
+    idle = optimize_cycle(idle_spec, settings)
     kept = {line: after for line, _, after in idle.waits}
     assert sorted(kept.values()) == [0.0, 0.3]
     assert idle.optimized_cycle_s <= idle.target_cycle_s + 1e-9
@@ -205,21 +215,21 @@ ENDMODULE
 """
     spec = resolve_module(parse_module(text, path="z.mod"), robot)
     base = CycleSettings(gradient=FAST, table_points=2, cycle_time=3.0)
-    exact, _ = optimize_cycle(spec, replace(base, zones=False))
-    zoned, opt = optimize_cycle(spec, base)
-    chain = next(i for i, c in opt.chains.items() if len(c) == 2)
-    j = opt.chains[chain][0]
-    assert 0 < opt.zone_mm(j) <= 50.0
+    exact = optimize_cycle(spec, replace(base, zones=False))
+    zoned, opt = _optimize_cycle(spec, base)
+    chain = next(i for i, c in opt.units.chains.items() if len(c) == 2)
+    j = opt.units.chains[chain][0]
+    assert 0 < opt.units.zone_mm(j) <= 50.0
     assert zoned.zone_miss_mm <= 1e-3
     assert zoned.optimized_energy_J <= exact.optimized_energy_J * 1.01
     # the radius is a joint box that keeps the TCP within the zone to first order
-    (r,) = opt.zone_radius(chain)
+    (r,) = opt.units.zone_radius(chain)
     step = spec.steps[j]
     rng = np.random.default_rng(0)
     corners = step.q + r[0] * rng.choice([-1.0, 1.0], size=(64, step.q.size))
     p, _ = _tcp(robot, corners, step.tcp)
     p0, _ = _tcp(robot, step.q[None, :], step.tcp)
-    assert 1000 * np.linalg.norm(p - p0, axis=1).max() <= opt.zone_mm(j)
+    assert 1000 * np.linalg.norm(p - p0, axis=1).max() <= opt.units.zone_mm(j)
 
 
 def test_cycle_folder_streams_the_plan(blended, solved, tmp_path):
@@ -267,10 +277,10 @@ def test_streamed_cycle_executes_its_planned_saving(blended, solved, tmp_path, b
 def test_bundled_example_at_its_own_cycle_time(robot):
     """The bundled example is optimized at its own cycle time, never slower, and saves energy."""
     spec, _ = read_cycle_program(EXAMPLE, robot)
-    result, opt = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
+    result, opt = _optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
     assert result.optimized_cycle_s <= result.default_cycle_s + 1e-9
     assert result.saved_pct > 0.0
-    assert opt.within  # its MoveJ transfers blended into MoveL approaches are units
+    assert opt.units.within  # its MoveJ transfers blended into MoveL approaches are units
 
 
 LINES = """MODULE Lin
@@ -291,11 +301,11 @@ def test_moveL_from_rest_to_rest_is_re_timed_on_its_line(robot):
     speeddata's TCP speed holds, the cycle is no longer and the energy no higher than taught."""
     pytest.importorskip("toppra")
     spec = resolve_module(parse_module(LINES, path="lin.mod"), robot)
-    result, opt = optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
-    assert opt.linear and set(opt.linear) <= set(result.paths)
+    result, opt = _optimize_cycle(spec, CycleSettings(gradient=FAST, table_points=2))
+    assert opt.units.linear and set(opt.units.linear) <= set(result.paths)
     assert result.optimized_cycle_s <= result.default_cycle_s + 1e-9
     assert result.optimized_energy_J < result.default_energy_J
-    for i in opt.linear:
+    for i in opt.units.linear:
         step, s = spec.steps[i], result.paths[i]
         p, _ = _tcp(robot, s.fine.q, step.tcp)
         a, b = p[0], p[-1]
@@ -328,34 +338,36 @@ ENDMODULE
 """
     spec = resolve_module(parse_module(text, path="z.mod"), robot)
     opt = CycleOptimizer(spec, CycleSettings(gradient=FAST))
-    i = next(k for k, c in opt.chains.items() if len(c) == 2)
-    units = int(np.floor(opt.span[i] / 0.025 + 1e-9))
+    i = next(k for k, c in opt.units.chains.items() if len(c) == 2)
+    units = int(np.floor(opt.units.span[i] / 0.025 + 1e-9))
     T = units * 0.025
-    m = opt.by_index[i]
-    start = opt._solve_once(m, T, units, opt.settings.corridor_mm)  # in proportion to each leg's shortest
-    opt.tune_passes(i, T)
-    plan = opt.solve(i, T)
+    m = opt.units.by_index[i]
+    start = opt.solver.solve_once(
+        m, T, units, opt.settings.corridor_mm
+    )  # in proportion to each leg's shortest
+    tune_passes(opt.solver, i, T)
+    plan = opt.solver.solve(i, T)
     assert start.usable and plan.usable
     assert plan.energy_J <= start.energy_J + 1e-9
-    assert opt.zone_miss_mm(i, plan) <= 1e-3
+    assert opt.solver.zone_miss_mm(i, plan) <= 1e-3
     best = cycle_optimum(
         m.step.robot,
         [
             CycleLeg(
                 m.path.q0,
-                opt.by_index[opt.chains[i][-1]].path.q1,
+                opt.units.by_index[opt.units.chains[i][-1]].path.q1,
                 via=(m.path.q1,),
-                via_radius=opt.zone_radius(i),
+                via_radius=opt.units.zone_radius(i),
             )
         ],
         T,
-        acceleration_limit=opt._amax(m.step.robot),
-        jerk_limit=opt._jmax(m.step.robot),
+        acceleration_limit=opt.units.amax(m.step.robot),
+        jerk_limit=opt.units.jmax(m.step.robot),
         intervals=8,
         continuation=(0.03,),  # one smoothing stage: within 0.2 % of three here, ten times faster
     )
     assert best.feasible, best.status
-    taught = opt.taught(i).energy_J
+    taught = opt.solver.taught(i).energy_J
     assert best.energy_J < taught
     assert (taught - plan.energy_J) >= 0.9 * (taught - best.energy_J)
 
@@ -390,22 +402,24 @@ def test_for_every_move_kind_the_optimizer_moves_as_fast_as_the_controller(robot
     spec = resolve_module(parse_module(KINDS, path="kinds.mod"), robot)
     opt = CycleOptimizer(spec, CycleSettings(gradient=FAST))
     kinds = {"chain": 0, "single": 0, "linear": 0, "within": 0}
-    for i, members in opt.chains.items():
-        span = opt.span[i]
-        if i in opt.linear:
+    for i, members in opt.units.chains.items():
+        span = opt.units.span[i]
+        if i in opt.units.linear:
             kinds["linear"] += 1
-            assert opt.t_lo[i] <= span + 0.025  # TOPP-RA's shortest, whole samples, within the speeddata
-            assert opt.solve(i, float(np.ceil(span / 0.025 - 1e-9) * 0.025)).usable
-        elif i in opt.within:
+            assert (
+                opt.solver.t_lo[i] <= span + 0.025
+            )  # TOPP-RA's shortest, whole samples, within the speeddata
+            assert opt.solver.solve(i, float(np.ceil(span / 0.025 - 1e-9) * 0.025)).usable
+        elif i in opt.units.within:
             kinds["within"] += 1
-            assert opt.solve(i, round(span / 0.025) * 0.025).usable  # its window is whole samples
+            assert opt.solver.solve(i, round(span / 0.025) * 0.025).usable  # its window is whole samples
         else:
             kinds["chain" if len(members) > 1 else "single"] += 1
-            own = opt.solve_on_taught(i)  # the optimizer's shape at the taught duration
+            own = opt.solver.solve_on_taught(i)  # the optimizer's shape at the taught duration
             assert own is not None and own.usable, own.limit_excess if own else "under 0.15 s"
             assert own.duration == pytest.approx(span)
     assert all(kinds.values()), kinds
-    assert opt.shortest_cycle <= opt.plan.cycle_time + 1e-9
+    assert opt.solver.shortest_cycle <= opt.plan.cycle_time + 1e-9
 
 
 def test_ordered_closest_agrees_with_every_ordered_choice():
@@ -413,13 +427,13 @@ def test_ordered_closest_agrees_with_every_ordered_choice():
     ``gap`` apart, as found by trying every such choice."""
     import itertools
 
-    from joulepath.program._cycle import _ordered_closest
+    from joulepath.program._cycle_geometry import ordered_closest
 
     rng = np.random.default_rng(3)
     for _ in range(150):
         m, n = int(rng.integers(1, 4)), int(rng.integers(8, 14))
         d = rng.random((m, n))
-        ks = _ordered_closest(d, lo=2, hi=n - 3, gap=2)
+        ks = ordered_closest(d, lo=2, hi=n - 3, gap=2)
         choices = [
             c
             for c in itertools.combinations(range(2, n - 2), m)
@@ -444,14 +458,14 @@ def test_a_chain_through_the_same_target_twice_passes_each_in_turn(robot):
     )
     spec = resolve_module(parse_module(text, path="back_and_forth.mod"), robot)
     opt = CycleOptimizer(spec, CycleSettings(gradient=FAST))
-    chains = [i for i, c in opt.chains.items() if len(c) > 2]
+    chains = [i for i, c in opt.units.chains.items() if len(c) > 2]
     assert chains
     for i in chains:
-        n = int(np.floor(opt.segment_of[i].span / 0.025 + 1e-9))
-        base = opt.base(i, n)
-        passes = opt._taught_passes(i, base)
+        n = int(np.floor(opt.units.segment_of[i].span / 0.025 + 1e-9))
+        base = opt.solver.base(i, n)
+        passes = opt.solver.taught_passes(i, base)
         times = [t for t, _ in passes]
-        assert len(passes) == len(opt.chains[i]) - 1
+        assert len(passes) == len(opt.units.chains[i]) - 1
         assert all(b > a for a, b in zip(times, times[1:], strict=False))
         for t, q in passes:
             k = int(np.argmin(np.abs(base.t - t)))
@@ -498,7 +512,7 @@ def test_segments_with_moveL_are_re_timed_along_their_own_path(blended, solved):
             in_zone |= np.linalg.norm(new - target, axis=1) < st.zone_mm / 1000 + 1e-3
     assert lines
     for j in lines:
-        m = opt.by_index[j]
+        m = opt.units.by_index[j]
         p0, p1 = (_tcp(robot, q[None, :], tcp)[0][0] for q in (m.path.q0, m.path.q1))
         u = (p1 - p0) / np.linalg.norm(p1 - p0)
         w = (new - p0) @ u / np.linalg.norm(p1 - p0)
@@ -565,22 +579,22 @@ def test_pass_times_of_a_run_between_moveL_are_searched_never_to_its_loss(robot)
     spec = resolve_module(parse_module(TRANSFER, path="transfer.mod"), robot)
     for shift in (0.0, 0.1):
         opt = CycleOptimizer(spec, CycleSettings(gradient=FAST, pass_search=4))
-        (i,) = [u for u in opt.within if len(opt.chains[u]) == 2]
-        taught = opt._taught_passes(i)
-        opt._taught_passes = lambda *_, w=taught, d=shift: tuple((t + d, q) for t, q in w)  # type: ignore[method-assign]
-        units = int(round(opt.span[i] / 0.025))
+        (i,) = [u for u in opt.units.within if len(opt.units.chains[u]) == 2]
+        taught = opt.solver.taught_passes(i)
+        opt.solver.taught_passes = lambda *_, w=taught, d=shift: tuple((t + d, q) for t, q in w)  # type: ignore[method-assign]
+        units = int(round(opt.units.span[i] / 0.025))
         T = units * 0.025
-        m = opt.by_index[i]
-        untuned = opt._solve_once(m, T, units, opt.settings.corridor_mm)
-        opt.tune_passes(i, T)
-        tuned = opt.cache[(i, units)]
+        m = opt.units.by_index[i]
+        untuned = opt.solver.solve_once(m, T, units, opt.settings.corridor_mm)
+        tune_passes(opt.solver, i, T)
+        tuned = opt.solver.cache[(i, units)]
         assert tuned.usable
         assert tuned.energy_J <= untuned.energy_J * (1 + 1e-12)
-        assert opt.zone_miss_mm(i, tuned) <= 1e-6
+        assert opt.solver.zone_miss_mm(i, tuned) <= 1e-6
         if shift:
-            assert i in opt.shares and tuned.energy_J < untuned.energy_J
-        if i in opt.shares:  # a better pass time was found: the kept result is solved at it
-            (t_pass,) = [t for t, _ in opt.waypoints(i, T)]
+            assert i in opt.solver.shares and tuned.energy_J < untuned.energy_J
+        if i in opt.solver.shares:  # a better pass time was found: the kept result is solved at it
+            (t_pass,) = [t for t, _ in opt.solver.waypoints(i, T)]
             assert tuned.passes == (pytest.approx(t_pass),)
 
 
@@ -589,13 +603,13 @@ def test_hermite_path_is_the_quintic_hermite_interpolation():
     for every interval at once) is :func:`joulepath.trajectory.quintic_hermite`'s interpolation (one
     interval at a time), in ``s`` on [0, 1]: the same positions and derivatives to the bit (the
     re-timing's search is sensitive to the last bit), and the samples' at the samples."""
-    from joulepath.program._cycle import _hermite_path
+    from joulepath.program._cycle_motion import hermite_path
     from joulepath.trajectory import quintic_hermite
 
     rng = np.random.default_rng(3)
     t = 0.4 + np.cumsum(0.002 + 0.01 * rng.random(300))
     q, qd, qdd = rng.normal(size=(3, t.size, 6))
-    at = _hermite_path(t, q, qd, qdd)
+    at = hermite_path(t, q, qd, qdd)
     span = t[-1] - t[0]
     ref = quintic_hermite((t - t[0]) / span, q, qd * span, qdd * span * span)
     s = np.linspace(0.0, 1.0, 4001)

@@ -15,7 +15,7 @@ import pytest
 from joulepath import load_robot
 from joulepath.errors import InvalidInput
 from joulepath.program import parse_module, read_cycle_program, resolve_module
-from joulepath.program._cycle import _energy
+from joulepath.program._cycle_model import trajectory_energy
 from joulepath.program._levers import _slots, levers_module, write_levers
 from joulepath.sim import ControllerConfig, make_plant, tcp_pose
 from joulepath.sim import _timing as timing
@@ -241,7 +241,7 @@ def _executed(text: str, robot, measure: str) -> tuple[float, float]:
     n = int(np.ceil(plan.cycle_time / FINE_DT)) + 1
     traj = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
     first = plan.moves[0].step
-    return plan.cycle_time, _energy(first.robot, make_plant("lab", first.robot), traj, measure)[0]
+    return plan.cycle_time, trajectory_energy(first.robot, make_plant("lab", first.robot), traj, measure)[0]
 
 
 def _changed_lines(before: str, after: str) -> tuple[list[str], list[str]]:

@@ -55,14 +55,14 @@ def robot():
 @pytest.fixture(scope="module")
 def palletizing(robot):
     spec, _ = read_cycle_program(EXAMPLES / "palletizing.mod", robot)
-    result, _ = optimize_cycle(spec, WRITE)
+    result = optimize_cycle(spec, WRITE)
     return result
 
 
 @pytest.fixture(scope="module")
 def twice(robot):
     spec = resolve_module(parse_module(TWICE, path="twice.mod"), robot)
-    result, _ = optimize_cycle(spec, replace(WRITE, cycle_time=4.5))
+    result = optimize_cycle(spec, replace(WRITE, cycle_time=4.5))
     return result
 
 
@@ -266,7 +266,7 @@ def test_payload_tool_procedure_with_arguments_reads_back(robot):
     written module keeps the procedure and its arguments, ends the stops at the program's own targets
     (with their work object), shows only optimized moves and additions in a diff, and reads back."""
     spec, _ = read_cycle_program(EXAMPLES / "payload_tool.mod", robot)
-    result, _ = optimize_cycle(spec, WRITE)
+    result = optimize_cycle(spec, WRITE)
     source = (EXAMPLES / "payload_tool.mod").read_text()
     layout = written_rapid(result)
     assert "PROC Transfer(robtarget pFrom, robtarget pTo" in layout.text
@@ -359,7 +359,7 @@ def test_move_inside_a_for_loop_gets_its_runs_by_the_loop_variable(robot):
     """A move directly inside a FOR loop: its optimized procedure receives the loop variable (for its
     Offs target) and the run number computed from it; it reads back and restores to the program."""
     spec = resolve_module(parse_module(LOOP, path="loop.mod"), robot)
-    result, _ = optimize_cycle(spec, WRITE)
+    result = optimize_cycle(spec, WRITE)
     layout = written_rapid(result)
     assert reads_back(result, layout.text) is None
     assert restore_program(layout.text) == LOOP

@@ -91,7 +91,7 @@ def test_moves_known_only_at_run_time_are_never_changed(name):
     kept = [s.kept != () for s in spec.steps if s.kind == "move"]
     assert any(kept)
     settings = CycleSettings(table_points=2, gradient=GradientSettings(knot_spacing=0.2), max_time_s=60)
-    result, _ = optimize_cycle(spec, settings)
+    result = optimize_cycle(spec, settings)
     assert len(result.moves) == len(kept)
     for m, k in zip(result.moves, kept, strict=True):
         if k:

@@ -52,7 +52,7 @@ def planned(robot):
     spec = resolve_module(parse_module(PROGRAM, path="cell.mod"), robot)
     settings = CycleSettings(table_points=2, pass_search=0)
     settings = replace(settings, gradient=replace(settings.gradient, knot_spacing=0.1))
-    result, _ = optimize_cycle(spec, settings)
+    result = optimize_cycle(spec, settings)
     return result, via_levers(result, robot, energy="thesis", max_seconds=60, timed_chains=False)
 
 
@@ -217,7 +217,7 @@ def test_a_bundled_program_keeps_its_structure_and_saves_as_executed(robot):
     spec, _ = read_cycle_program(path, robot)
     settings = CycleSettings(table_points=2, pass_search=0)
     settings = replace(settings, gradient=replace(settings.gradient, knot_spacing=0.1))
-    result, _ = optimize_cycle(spec, settings)
+    result = optimize_cycle(spec, settings)
     via = via_levers(result, robot, energy="thesis", max_seconds=10)
     assert via.levers is not None, via.note
     text = via.levers.written_text

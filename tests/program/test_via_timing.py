@@ -49,7 +49,7 @@ def dense(irb120):
     spec = resolve_module(parse_module(PROGRAM, path="views.mod"), irb120)
     settings = CycleSettings(table_points=2, pass_search=0)
     settings = replace(settings, gradient=replace(settings.gradient, knot_spacing=0.1))
-    result, _ = optimize_cycle(spec, settings)
+    result = optimize_cycle(spec, settings)
     plan = result.unretimed or result
     text = _plain(written_rapid(replace(plan, vias=dense_vias(plan, spacing=0.1))).text)
     return spec, text, resolve_module(parse_module(text, path="views (via points)"), irb120)

@@ -2,17 +2,14 @@
 controller does, optimize it."""
 
 from joulepath.program._cell import Cell, read_cell
-from joulepath.program._cycle import (
+from joulepath.program._cycle import CycleOptimizer, check_cycle, optimize_cycle, pareto
+from joulepath.program._cycle_model import (
     FAST_CYCLE,
     Breakdown,
-    CycleOptimizer,
     CycleResult,
     CycleSettings,
     MoveOutcome,
     ParetoPoint,
-    check_cycle,
-    optimize_cycle,
-    pareto,
 )
 from joulepath.program._levers import LeverResult, MoveLever, levers_module
 from joulepath.program._model import Module, RapidError

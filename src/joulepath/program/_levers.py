@@ -424,13 +424,13 @@ class _Evaluator:
 
     def energies(self, plan: PlannedCycle) -> tuple[float, float]:
         """Physics and lab J of the cycle, as the written-program check computes them."""
-        from joulepath.program._cycle import _energy
+        from joulepath.program._cycle_model import trajectory_energy
 
         robot = plan.moves[0].step.robot
         assert robot is not None
         if self._plant is None:
             self._plant = make_plant("lab", robot)
-        return _energy(robot, self._plant, cycle_motion(plan), self.measure)
+        return trajectory_energy(robot, self._plant, cycle_motion(plan), self.measure)
 
 
 def cycle_motion(plan: PlannedCycle) -> Trajectory:

@@ -2,7 +2,7 @@
 
 A ``MoveL``'s speed data is the programmer's bound on the TCP speed along its line (an approach
 to a part at ``v200``, a retreat at ``v500``). The cycle's plan keeps it (between the blends at the
-line's ends, :meth:`joulepath.program.CycleOptimizer._line_bounds`); a via-point module written
+line's ends, :func:`joulepath.program._cycle_motion.line_bounds`); a via-point module written
 from the plan replaces such a line by joint moves with ``\\T``, which the controller runs at
 whatever speed their times give. This module finds each line's interior on the taught cycle as
 the controller emulation runs it (from the end of the blend into the ``MoveL`` to the start of

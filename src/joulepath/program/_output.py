@@ -21,7 +21,7 @@ from joulepath._io import (
 )
 from joulepath.errors import LimitViolation
 from joulepath.program._cell import Cell, clearance
-from joulepath.program._cycle import LAB_MEASURE, CycleResult, ParetoPoint
+from joulepath.program._cycle_model import LAB_MEASURE, CycleResult, ParetoPoint
 from joulepath.program._model import RapidError
 from joulepath.program._rapid_write import (
     WrittenModule,
@@ -129,7 +129,7 @@ def check_written(result: CycleResult, text: str, cell: Cell | None = None) -> d
     """
     from scipy.spatial import cKDTree
 
-    from joulepath.program._cycle import _energy
+    from joulepath.program._cycle_model import trajectory_energy
     from joulepath.program._task import as_sequence, read_written
     from joulepath.sim import FINE_DT, ControllerConfig, evaluate_cycle, make_plant, plan_cycle
     from joulepath.sim import tcp_pose as _tcp
@@ -142,7 +142,9 @@ def check_written(result: CycleResult, text: str, cell: Cell | None = None) -> d
     traj = evaluate_cycle(plan, np.linspace(0.0, plan.cycle_time, n))
     first = plan.moves[0].step
     assert first.robot is not None and first.tcp is not None
-    energy, energy_lab = _energy(first.robot, make_plant("lab", first.robot), traj, result.energy_measure)
+    energy, energy_lab = trajectory_energy(
+        first.robot, make_plant("lab", first.robot), traj, result.energy_measure
+    )
     assert result.planned is not None
     p_plan, _ = _tcp(first.robot, result.planned.q, first.tcp)
     p_emu, _ = _tcp(first.robot, traj.q, first.tcp)
@@ -557,34 +559,21 @@ def _export_choice(
     return f"{rapid_part}; {egm_part}"
 
 
-def write_cycle_run(
-    out: Path,
-    result: CycleResult,
-    *,
-    pareto: list[ParetoPoint] | None,
-    write_rapid: bool,
-    cell: Cell | None = None,
-    write_anyway: bool = False,
-    egm: str = "never",
-    levers: Any | None = None,
-    via_levers: Any | None = None,
-) -> dict[str, Path]:
-    """Write the run folder; the module only when every limit holds, the controller emulation
-    runs it as the checks ask (:data:`CHECK_TOLERANCES`; ``write_anyway``: written all the same,
-    with a warning in its header) and, with a cell, its emulated motion keeps the margin
-    (else cycle.json says why). Always ``cycle_path.csv`` (the planned cycle); ``egm``
-    "always", or "fallback": also ``egm.mod`` and ``EGM_SETUP.md`` to stream it (``joulepath
-    stream``) where no RAPID module is written or the written one saves, as executed, less than
-    half of what the EGM plan saves; "never": not.
+RAPID_FOLLOWS_NOTE = (
+    "which plan optimized.mod's via points follow: the plan, or (where the controller emulation does "
+    "not run it as the checks ask) the plan for via points: only the units from rest to rest of joint "
+    "moves, planned within 3/(2π) of the acceleration limit (rapid_plan_saved_pct: its planned saving); "
+    "cycle_path.csv and --export egm always stream the plan"
+)
+"""``cycle.json``'s ``rapid_follows_note``."""
 
-    ``levers`` (a :class:`~joulepath.program.LeverResult`): the program with the controller's own
-    levers (``AccSet``, speed data, zones), read back and run by the controller emulation;
-    ``via_levers`` (a :class:`~joulepath.program.ViaLevers`): the plan's via-point module with the
-    levers of its via points, searched on the controller emulation. The RAPID module written is
-    the best of them and the via-point module kept to the plan, as executed."""
-    if egm not in ("always", "fallback", "never"):
-        raise ValueError(f"egm must be always, fallback or never, got {egm!r}")
-    files: dict[str, Path] = {}
+
+def _via_point_module(
+    result: CycleResult, cell: Cell | None, write_rapid: bool, write_anyway: bool
+) -> tuple[str | None, dict[str, Any] | None, str | None, Any, str | None]:
+    """The via-point module of the first plan the controller emulation runs as the checks ask (the
+    plan, else the plan for via points; ``write_anyway``: the last written all the same): its text,
+    check, why it was refused, layout, and which plan it follows (all None where none is written)."""
     text = refused = check = layout = None
     follows = None
     if write_rapid and result.spec.module is None:
@@ -616,9 +605,13 @@ def write_cycle_run(
             if text is not None:
                 follows = name
                 break
-    via_saved = None
-    if text is not None and check is not None and result.default_energy_J > 0:
-        via_saved = 100.0 * (1.0 - check["emulated_energy_J"] / result.default_energy_J)
+    return text, check, refused, layout, follows
+
+
+def _chosen_levers(result: CycleResult, levers: Any | None, via_levers: Any | None) -> Any | None:
+    """The program with levers that saves most of those offered (the controller's own levers where
+    they read back, change something and save within the taught cycle time; the via-point module's
+    levers), or None; none where the plan breaks a limit."""
     lever_ok = (
         levers is not None
         and levers.reads_back is None
@@ -630,10 +623,74 @@ def write_cycle_run(
     offered: list[Any] = [levers] if lever_ok else []
     if via_levers is not None and via_levers.levers is not None and result.limits_ok:
         offered.append(via_levers.levers)
+    return max(offered, key=lambda lv: lv.saved_pct, default=None)
+
+
+def _levers_check(chosen: Any, levers_of_via: bool) -> dict[str, Any]:
+    """``cycle.json``'s check of a program written with levers (as the controller emulation ran it)."""
+    return {
+        "emulated_cycle_s": chosen.cycle_s,
+        "emulated_energy_J": chosen.energy_J,
+        "emulated_energy_lab_J": chosen.energy_lab_J,
+        "within_tolerances": True,
+        "written_by": (
+            "via points + levers: the plan's via-point module with the controller's levers of its via "
+            "points (AccSet, \\T, zones), searched on the controller emulation; the written text read "
+            "again by the RAPID interpreter and run again by the emulation"
+            if levers_of_via
+            else "levers: the controller's own plan of the written program (AccSet, speed data, "
+            "zones), read back and run by the controller emulation"
+        ),
+    }
+
+
+def _remove_written_task(task_dir: Path) -> None:
+    """Remove a task folder joulepath wrote here before (marked by :data:`TASK_MARK`)."""
+    if task_dir.is_dir() and not task_dir.is_symlink() and (task_dir / TASK_MARK).is_file():
+        for old in sorted(task_dir.rglob("*"), reverse=True):
+            if old.is_file() or old.is_symlink():
+                old.unlink()
+            else:
+                old.rmdir()
+        task_dir.rmdir()
+
+
+def write_cycle_run(
+    out: Path,
+    result: CycleResult,
+    *,
+    pareto: list[ParetoPoint] | None,
+    write_rapid: bool,
+    cell: Cell | None = None,
+    write_anyway: bool = False,
+    egm: str = "never",
+    levers: Any | None = None,
+    via_levers: Any | None = None,
+) -> dict[str, Path]:
+    """Write the run folder; the module only when every limit holds, the controller emulation
+    runs it as the checks ask (:data:`CHECK_TOLERANCES`; ``write_anyway``: written all the same,
+    with a warning in its header) and, with a cell, its emulated motion keeps the margin
+    (else cycle.json says why). Always ``cycle_path.csv`` (the planned cycle); ``egm``
+    "always", or "fallback": also ``egm.mod`` and ``EGM_SETUP.md`` to stream it (``joulepath
+    stream``) where no RAPID module is written or the written one saves, as executed, less than
+    half of what the EGM plan saves; "never": not.
+
+    ``levers`` (a :class:`~joulepath.program.LeverResult`): the program with the controller's own
+    levers (``AccSet``, speed data, zones), read back and run by the controller emulation;
+    ``via_levers`` (a :class:`~joulepath.program.ViaLevers`): the plan's via-point module with the
+    levers of its via points, searched on the controller emulation. The RAPID module written is
+    the best of them and the via-point module kept to the plan, as executed."""
+    if egm not in ("always", "fallback", "never"):
+        raise ValueError(f"egm must be always, fallback or never, got {egm!r}")
+    files: dict[str, Path] = {}
+    text, check, refused, layout, follows = _via_point_module(result, cell, write_rapid, write_anyway)
+    via_saved = None
+    if text is not None and check is not None and result.default_energy_J > 0:
+        via_saved = 100.0 * (1.0 - check["emulated_energy_J"] / result.default_energy_J)
     written_from = None if text is None else "via points"
     data_bytes: bytes | None = None
     task_files: tuple[tuple[str, bytes], ...] = ()
-    chosen = max(offered, key=lambda lv: lv.saved_pct, default=None)
+    chosen = _chosen_levers(result, levers, via_levers)
     if chosen is not None and (via_saved is None or chosen.saved_pct > via_saved):
         levers_of_via = chosen.base == "via points"
         written_from = "via points + levers" if levers_of_via else "levers"
@@ -641,31 +698,12 @@ def write_cycle_run(
             task_files = chosen.written_files
         else:
             data_bytes = chosen.written_bytes()
-        check = {
-            "emulated_cycle_s": chosen.cycle_s,
-            "emulated_energy_J": chosen.energy_J,
-            "emulated_energy_lab_J": chosen.energy_lab_J,
-            "within_tolerances": True,
-            "written_by": (
-                "via points + levers: the plan's via-point module with the controller's levers of its via "
-                "points (AccSet, \\T, zones), searched on the controller emulation; the written text read "
-                "again by the RAPID interpreter and run again by the emulation"
-                if levers_of_via
-                else "levers: the controller's own plan of the written program (AccSet, speed data, "
-                "zones), read back and run by the controller emulation"
-            ),
-        }
+        check = _levers_check(chosen, levers_of_via)
         layout = None
     make_folder(out)
     stale = out / "optimized.mod"
     task_dir = out / OPTIMIZED_TASK
-    if task_dir.is_dir() and not task_dir.is_symlink() and (task_dir / TASK_MARK).is_file():
-        for old in sorted(task_dir.rglob("*"), reverse=True):  # a task joulepath wrote here before
-            if old.is_file() or old.is_symlink():
-                old.unlink()
-            else:
-                old.rmdir()
-        task_dir.rmdir()
+    _remove_written_task(task_dir)
     if task_files:
         files[OPTIMIZED_TASK] = _write_task(task_dir, task_files)
     if data_bytes is not None:
@@ -720,12 +758,7 @@ def write_cycle_run(
     )
     data["rapid_follows"] = follows
     data["rapid_plan_saved_pct"] = None if result.rapid_plan is None else result.rapid_plan.saved_pct
-    data["rapid_follows_note"] = (
-        "which plan optimized.mod's via points follow: the plan, or (where the controller emulation does "
-        "not run it as the checks ask) the plan for via points: only the units from rest to rest of joint "
-        "moves, planned within 3/(2π) of the acceleration limit (rapid_plan_saved_pct: its planned saving); "
-        "cycle_path.csv and --export egm always stream the plan"
-    )
+    data["rapid_follows_note"] = RAPID_FOLLOWS_NOTE
     data["rapid_structure"] = None if layout is None or text is None else layout.summary()
     files["cycle.json"] = atomic_write_text(
         out / "cycle.json", json.dumps(finite_json(data), indent=2, allow_nan=False)

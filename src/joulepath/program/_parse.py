@@ -744,105 +744,137 @@ def _evaluate(
         pos = m.end()
         kind = m.lastgroup or ""
         tokens.append((kind, m.group(kind)))
-    k = 0
+    expr = _Expression(path, line, text, names, what, seen, tokens)
+    if not tokens:
+        raise expr.fail("it is empty")
+    out = expr.disjunction()
+    if expr.k != len(tokens):
+        raise expr.fail(f"unexpected {tokens[expr.k][1]!r}")
+    if not isinstance(out, bool) and not math.isfinite(out):
+        raise expr.fail("its value is not a finite number; write numbers RAPID can hold (at most 3.4E38)")
+    return out
 
-    def fail(msg: str) -> RapidError:
-        shown = text.strip() if len(text.strip()) <= 60 else text.strip()[:57] + "..."
-        return RapidError(f"{path}:{line}: {what} {shown!r}: {msg}")
 
-    def peek() -> str:
-        return tokens[k][1].upper() if k < len(tokens) else ""
+class _Expression:
+    """One tokenised num or bool expression read by recursive descent (:func:`_evaluate`): from
+    :meth:`disjunction` (``OR``, ``XOR``) through ``AND``, comparisons, sums and products down to
+    :meth:`unary`; ``k`` the next token, ``level`` the depth of brackets and signs."""
 
-    def take() -> tuple[str, str]:
-        nonlocal k
-        if k >= len(tokens):
-            raise fail("it ends too early")
-        k += 1
-        return tokens[k - 1]
+    def __init__(
+        self,
+        path: str,
+        line: int,
+        text: str,
+        names: Names,
+        what: str,
+        seen: dict[str, str] | None,
+        tokens: list[tuple[str, str]],
+    ) -> None:
+        self.path = path
+        self.line = line
+        self.text = text
+        self.names = names
+        self.what = what
+        self.seen = seen
+        self.tokens = tokens
+        self.k = 0
+        self.level = 0
 
-    def num(v: float | bool) -> float:
+    def fail(self, msg: str) -> RapidError:
+        shown = self.text.strip() if len(self.text.strip()) <= 60 else self.text.strip()[:57] + "..."
+        return RapidError(f"{self.path}:{self.line}: {self.what} {shown!r}: {msg}")
+
+    def peek(self) -> str:
+        return self.tokens[self.k][1].upper() if self.k < len(self.tokens) else ""
+
+    def take(self) -> tuple[str, str]:
+        if self.k >= len(self.tokens):
+            raise self.fail("it ends too early")
+        self.k += 1
+        return self.tokens[self.k - 1]
+
+    def num(self, v: float | bool) -> float:
         if isinstance(v, bool):
-            raise fail("a truth value where a number is needed")
+            raise self.fail("a truth value where a number is needed")
         return v
 
-    def name_value(word: str) -> float | bool:
+    def name_value(self, word: str) -> float | bool:
         low = word.lower()
         if "{" in word:
-            return _number(path, line, word, names, what)
+            return _number(self.path, self.line, word, self.names, self.what)
         if low in ("true", "false"):
             return low == "true"
-        if low in names.loop:
-            return float(names.loop[low])
-        if low in names.params:
-            bound = names.params[low]
+        if low in self.names.loop:
+            return float(self.names.loop[low])
+        if low in self.names.params:
+            bound = self.names.params[low]
             if isinstance(bound, float | bool):
                 return bound
-            raise fail(f"{word} is a {type(bound).__name__} argument, not a num or bool")
-        if low in names.nums:
-            return names.nums[low]
-        if low in names.bools:
-            return names.bools[low]
-        if low in names.assigned:
-            at, stmt = names.assigned[low]
-            raise fail(
+            raise self.fail(f"{word} is a {type(bound).__name__} argument, not a num or bool")
+        if low in self.names.nums:
+            return self.names.nums[low]
+        if low in self.names.bools:
+            return self.names.bools[low]
+        if low in self.names.assigned:
+            at, stmt = self.names.assigned[low]
+            raise self.fail(
                 f"{word} is assigned at line {at} ({stmt[:40]!r}), so its value is known only while the "
                 "program runs; use a CONST or PERS value no statement changes"
             )
-        raise fail(
+        raise self.fail(
             f"{word} is not a CONST or PERS num or bool of the module (a VAR, a function or unknown); "
             "declare it CONST"
         )
 
-    level = 0
-
-    def primary() -> float | bool:
-        nonlocal level
-        level += 1
+    def primary(self) -> float | bool:
+        self.level += 1
         try:
-            return unary()
+            return self.unary()
         finally:
-            level -= 1
+            self.level -= 1
 
-    def unary() -> float | bool:
-        if level > MAX_NESTING:
-            raise fail(f"brackets or signs nested more than {MAX_NESTING} deep")
-        kind, tok = take()
+    def unary(self) -> float | bool:
+        if self.level > MAX_NESTING:
+            raise self.fail(f"brackets or signs nested more than {MAX_NESTING} deep")
+        kind, tok = self.take()
         if kind == "num":
             return float(tok)
         if kind == "name":
             if tok.upper() == "NOT":
-                v = primary()
+                v = self.primary()
                 if not isinstance(v, bool):
-                    raise fail("NOT needs a truth value")
+                    raise self.fail("NOT needs a truth value")
                 return not v
-            if peek() == "(":
-                raise fail(f"the function {tok} is evaluated only while the program runs")
-            value = name_value(tok)
-            if seen is not None and tok.lower() not in ("true", "false"):
-                seen[tok] = _show(value)
+            if self.peek() == "(":
+                raise self.fail(f"the function {tok} is evaluated only while the program runs")
+            value = self.name_value(tok)
+            if self.seen is not None and tok.lower() not in ("true", "false"):
+                self.seen[tok] = _show(value)
             return value
         if tok == "(":
-            v = disjunction()
-            if take()[1] != ")":
-                raise fail("')' expected")
+            v = self.disjunction()
+            if self.take()[1] != ")":
+                raise self.fail("')' expected")
             return v
         if tok in "+-":
-            v = num(primary())
+            v = self.num(self.primary())
             return v if tok == "+" else -v
-        raise fail(f"unexpected {tok!r}")
+        raise self.fail(f"unexpected {tok!r}")
 
-    def product() -> float | bool:
-        v = primary()
-        while peek() in ("*", "/", "DIV", "MOD"):
-            op = take()[1].upper()
-            r = num(primary())
-            a = num(v)
+    def product(self) -> float | bool:
+        v = self.primary()
+        while self.peek() in ("*", "/", "DIV", "MOD"):
+            op = self.take()[1].upper()
+            r = self.num(self.primary())
+            a = self.num(v)
             if not (math.isfinite(a) and math.isfinite(r)):
-                raise fail("a value is not a finite number; write numbers RAPID can hold (at most 3.4E38)")
+                raise self.fail(
+                    "a value is not a finite number; write numbers RAPID can hold (at most 3.4E38)"
+                )
             if op in ("DIV", "MOD") and (a != round(a) or r != round(r)):
-                raise fail(f"{op} needs whole numbers, got {a:g} {op} {r:g}")
+                raise self.fail(f"{op} needs whole numbers, got {a:g} {op} {r:g}")
             if op != "*" and r == 0:
-                raise fail("division by zero")
+                raise self.fail("division by zero")
             v = (
                 a * r
                 if op == "*"
@@ -854,56 +886,47 @@ def _evaluate(
             )
         return v
 
-    def total() -> float | bool:
-        v = product()
-        while peek() in ("+", "-"):
-            op = take()[1]
-            r = num(product())
-            v = num(v) + r if op == "+" else num(v) - r
+    def total(self) -> float | bool:
+        v = self.product()
+        while self.peek() in ("+", "-"):
+            op = self.take()[1]
+            r = self.num(self.product())
+            v = self.num(v) + r if op == "+" else self.num(v) - r
         return v
 
-    def comparison() -> float | bool:
-        v = total()
-        if peek() in ("=", "<>", "<", ">", "<=", ">="):
-            op = take()[1]
-            r = total()
+    def comparison(self) -> float | bool:
+        v = self.total()
+        if self.peek() in ("=", "<>", "<", ">", "<=", ">="):
+            op = self.take()[1]
+            r = self.total()
             if op in ("=", "<>"):
                 if isinstance(v, bool) != isinstance(r, bool):
-                    raise fail("compares a number with a truth value")
+                    raise self.fail("compares a number with a truth value")
                 same = v == r if isinstance(v, bool) else abs(float(v) - float(r)) <= 1e-9
                 return same if op == "=" else not same
-            a, b = num(v), num(r)
+            a, b = self.num(v), self.num(r)
             return {"<": a < b, ">": a > b, "<=": a <= b, ">=": a >= b}[op]
         return v
 
-    def conjunction() -> float | bool:
-        v = comparison()
-        while peek() == "AND":
-            take()
-            r = comparison()
+    def conjunction(self) -> float | bool:
+        v = self.comparison()
+        while self.peek() == "AND":
+            self.take()
+            r = self.comparison()
             if not isinstance(v, bool) or not isinstance(r, bool):
-                raise fail("AND needs truth values")
+                raise self.fail("AND needs truth values")
             v = v and r
         return v
 
-    def disjunction() -> float | bool:
-        v = conjunction()
-        while peek() in ("OR", "XOR"):
-            op = take()[1].upper()
-            r = conjunction()
+    def disjunction(self) -> float | bool:
+        v = self.conjunction()
+        while self.peek() in ("OR", "XOR"):
+            op = self.take()[1].upper()
+            r = self.conjunction()
             if not isinstance(v, bool) or not isinstance(r, bool):
-                raise fail(f"{op} needs truth values")
+                raise self.fail(f"{op} needs truth values")
             v = (v or r) if op == "OR" else (v != r)
         return v
-
-    if not tokens:
-        raise fail("it is empty")
-    out = disjunction()
-    if k != len(tokens):
-        raise fail(f"unexpected {tokens[k][1]!r}")
-    if not isinstance(out, bool) and not math.isfinite(out):
-        raise fail("its value is not a finite number; write numbers RAPID can hold (at most 3.4E38)")
-    return out
 
 
 def _show(value: float | bool) -> str:

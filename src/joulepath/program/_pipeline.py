@@ -30,7 +30,8 @@ from typing import Any, Literal
 
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
-from joulepath.program._cycle import CycleResult, CycleSettings, ParetoPoint, optimize_cycle, pareto
+from joulepath.program._cycle import optimize_cycle
+from joulepath.program._cycle_model import CycleResult, CycleSettings, ParetoPoint
 from joulepath.program._resolve import CycleSpec, read_cycle_program
 from joulepath.trajectory import Trajectory
 
@@ -181,11 +182,9 @@ def optimize_program(
         given=dict(settings.given) or None,
     )
     cycle_settings = replace(settings.cycle, cell=cell)
-    result, opt = optimize_cycle(spec, cycle_settings, progress=progress)
-    front: list[ParetoPoint] | None = None
-    if settings.pareto_points:
-        say("energy against cycle time...")
-        front = pareto(opt, points=settings.pareto_points, use_waits=cycle_settings.use_waits)
+    result = optimize_cycle(spec, cycle_settings, progress=progress, pareto_points=settings.pareto_points)
+    front = list(result.pareto) if settings.pareto_points else None
+    assert result.default_planned is not None
     searched: list[str] = []
     deadline = None if cycle_settings.max_time_s is None else t0 + cycle_settings.max_time_s
     levers, via = _search_levers(spec, rapid, result, robot, settings, cell, say, searched, deadline)
@@ -210,8 +209,8 @@ def optimize_program(
         rapid=rapid,
         files=files,
         summary=summary,
-        default_trajectory=opt.default_motion().trajectory,
-        optimizable_units=len(opt.optimizable),
+        default_trajectory=result.default_planned,
+        optimizable_units=len(result.optimizable),
         pareto=tuple(front or ()),
         lever_searches=tuple(searched),
         wall_s=time.perf_counter() - t0,

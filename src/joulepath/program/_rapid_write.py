@@ -255,6 +255,153 @@ def _short(name: str, suffix: str, prefix: str) -> str:
     return prefix + name[: max(keep, 1)] + suffix
 
 
+def _occurrence_of_steps(spec: Any, move_steps: Sequence[int], occ: Sequence[Any]) -> dict[int, Any]:
+    """Each move step of the cycle (its index) with its statement's occurrence in the module's walk;
+    refused where the cycle's moves do not match the module's statements."""
+    move_occ = [o for o in occ if isinstance(o.stmt, Move)]
+    if len(move_steps) != len(move_occ) or any(
+        spec.steps[i].line != o.stmt.line for i, o in zip(move_steps, move_occ, strict=True)
+    ):
+        raise LimitViolation(
+            "the cycle's moves do not match the module's statements; the program is not written"
+        )
+    return dict(zip(move_steps, move_occ, strict=True))
+
+
+def _needs_run(occ: Sequence[Any], entries: dict[str, int], own: set[str]) -> dict[str, bool]:
+    """Per procedure (lower-case name) met in the walk: whether it takes a run number, i.e. is entered
+    more than once per cycle and holds a line whose runs are written differently (``own``: those
+    procedures) or calls one that takes it."""
+    callees: dict[str, set[str]] = {}
+    for o in occ:
+        if isinstance(o.stmt, Call):
+            callees.setdefault(o.proc, set()).add(o.stmt.name.lower())
+    needs: dict[str, bool] = {}
+
+    def need(p: str) -> bool:
+        if p not in needs:
+            needs[p] = entries.get(p, 0) > 1 and (p in own or any(need(c) for c in callees.get(p, ())))
+        return needs[p]
+
+    for p in list(entries):
+        need(p)
+    return needs
+
+
+def _group_bodies(
+    groups: dict[tuple[tuple[str, ...], tuple[str, ...], str | None], list[int]],
+    original: str,
+    proc_name: str,
+    n: int,
+    base: str,
+    decls: list[str],
+) -> tuple[list[str], set[str]]:
+    """The written body of one move line from its runs' ``groups`` (one body for all of them, else a
+    ``CASE`` per group and the taught runs left to ``DEFAULT``), its arrays of via points added to
+    ``decls`` (several groups: in a ``TEST`` of the run number); and the final targets its bodies end at."""
+    body: list[str] = []
+    finals = set()
+    for g, (key, vals) in enumerate(groups.items(), start=1):
+        elements, moves_text, final = key
+        if final == "taught":
+            part = [original]
+        else:
+            name = base if len(groups) == 1 else _short(proc_name, f"_{n}_{g}", "jp_")
+            if elements:
+                decls.append(f"CONST jointtarget {name}{{{len(elements)}}} := [")
+                decls.extend(f"    {e}," for e in elements[:-1])
+                decls.append(f"    {elements[-1]}")
+                decls.append("];")
+            part = [t.replace("{ARR}", name) for t in moves_text]
+            if final is not None:
+                finals.add(final)
+        if len(groups) == 1:
+            body.extend(part)
+        elif final != "taught":  # the taught runs go to DEFAULT
+            body.append(f"CASE {', '.join(map(str, sorted(vals)))}:")
+            body.extend("    " + t for t in part)
+    if len(groups) > 1:
+        body = [f"TEST {CONTEXT_PARAM}", *body, "DEFAULT:", f"    {original}", "ENDTEST"]
+    return body, finals
+
+
+def _check_same_loops(ln: int, loops: Sequence[Any], others: Sequence[Any]) -> None:
+    """Refuse a move line whose runs (``others``, after the first) sit in FOR loops other than the
+    first run's ``loops``."""
+    for o in others:
+        other = [(f.line, f.values) for f, _ in o.loops]
+        if other != [(f.line, f.values) for f in loops]:
+            raise LimitViolation(
+                f"line {ln}: the FOR loops around the move run differently in its runs; "
+                "the program is not written"
+            )
+
+
+def _check_told_apart(ln: int, groups: dict[Any, list[int]]) -> None:
+    """Refuse a move line whose runs, written differently, share a run number."""
+    picked = {v: key for key, vs in groups.items() for v in vs}
+    if len(groups) > 1 and len(picked) != sum(len(vs) for vs in groups.values()):
+        raise LimitViolation(
+            f"line {ln}: the runs of this move cannot be told apart by their run number "
+            "(FOR loops whose bounds change between calls); the program is not written"
+        )
+
+
+def _refuse_name_clashes(
+    source: tuple[str, ...], written: Sequence[WrittenMove], decls: Sequence[str]
+) -> None:
+    """Refuse names joulepath adds that the module already uses (or that shorten to the same name)."""
+    taken = {w.lower() for w in re.findall(r"[A-Za-z]\w*", "\n".join(source))}  # any name the module uses
+    added = [m.call.lower() for m in written] + [
+        d.split()[2].split("{")[0].lower() for d in decls if d.startswith("CONST jointtarget")
+    ]
+    clash = sorted((set(added) & taken) | {a for a in added if added.count(a) > 1})
+    if clash:
+        raise LimitViolation(
+            f"the names joulepath adds ({', '.join(clash)}) are already used in the module (or shortened "
+            "to the same name); the program is not written (rename them in the module)"
+        )
+
+
+def _run_edits(
+    source: tuple[str, ...], proc: Any, sites: Sequence[tuple[int, Any]], needs: dict[str, bool]
+) -> dict[int, str]:
+    """The lines edited to give procedure ``proc`` its run number: its declaration and each call site
+    (``sites``: line, and the call's walk where it is in the cycle, else None: 0 runs the taught motion)."""
+    edits = {proc.line: _add_parameter(source[proc.line - 1], proc, f"num {RUN_PARAM}")}
+    site_lines = [s for s, _ in sites]
+    for k, (s_line, in_cycle) in enumerate(sites):
+        if in_cycle is None:  # outside the cycle: 0 runs the taught motion
+            arg = "0"
+        else:
+            arg = _site_argument(
+                _run_expression(list(in_cycle.loops_f), needs.get(in_cycle.proc, False)),
+                len(site_lines),
+                k,
+            )
+        edits[s_line] = _add_argument(source[s_line - 1], proc.name, arg, s_line)
+    return edits
+
+
+def _wait_edits(result: Any, module: Any, source: tuple[str, ...]) -> dict[int, tuple[int, list[str]]]:
+    """The ``WaitTime`` statements whose time was spent on the moves (``--use-waits``), replaced."""
+    out: dict[int, tuple[int, list[str]]] = {}
+    for wline, before, after in result.waits:
+        if after != before:
+            end = next(
+                s.end_line for s in _statements_of(module) if isinstance(s, WaitTime) and s.line == wline
+            )
+            out[wline] = (
+                end,
+                [
+                    f"! joulepath: WaitTime {_num(before)} s spent on the moves (--use-waits)",
+                    *_was(source, wline, end),
+                    f"WaitTime {_num(after)};",
+                ],
+            )
+    return out
+
+
 def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
     """The module of ``result`` (a :class:`~joulepath.program.CycleResult`) keeping its program.
 
@@ -271,14 +418,7 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
     source = module.source
     occ, entries, made_by = _walk(module)
     move_steps = [i for i, st in enumerate(spec.steps) if st.kind == "move"]
-    move_occ = [o for o in occ if isinstance(o.stmt, Move)]
-    if len(move_steps) != len(move_occ) or any(
-        spec.steps[i].line != o.stmt.line for i, o in zip(move_steps, move_occ, strict=True)
-    ):
-        raise LimitViolation(
-            "the cycle's moves do not match the module's statements; the program is not written"
-        )
-    occ_of_step = dict(zip(move_steps, move_occ, strict=True))
+    occ_of_step = _occurrence_of_steps(spec, move_steps, occ)
 
     through = {j for chain in result.chains.values() for j in chain[:-1]} | set(result.open_ends)
     # ---- each run of each optimized line: its written body (array name left open)
@@ -293,20 +433,7 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
     proc_of_line = {ln: occ_of_step[lines[ln][0]].proc for ln in optimized_lines}
     differs = {ln: len({bodies.get(i, ((), (), "taught")) for i in lines[ln]}) > 1 for ln in optimized_lines}
     procs = {p.name.lower(): p for p in module.procedures}
-    callees: dict[str, set[str]] = {}
-    for o in occ:
-        if isinstance(o.stmt, Call):
-            callees.setdefault(o.proc, set()).add(o.stmt.name.lower())
-    needs: dict[str, bool] = {}
-
-    def need(p: str) -> bool:
-        if p not in needs:
-            own = any(differs[ln] for ln in optimized_lines if proc_of_line[ln] == p)
-            needs[p] = entries.get(p, 0) > 1 and (own or any(need(c) for c in callees.get(p, ())))
-        return needs[p]
-
-    for p in list(entries):
-        need(p)
+    needs = _needs_run(occ, entries, {proc_of_line[ln] for ln in optimized_lines if differs[ln]})
     indexed = sorted(p for p, v in needs.items() if v)
 
     # ---- run values: the jpRun of every entry of an indexed procedure, from its call site
@@ -346,59 +473,24 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
         call_name = _short(proc.name, f"_{n}", "jp_opt_")
         base = _short(proc.name, f"_{n}", "jp_")
         loops = [f for f, _ in first.loops]
-        for i in steps_l[1:]:
-            other = [(f.line, f.values) for f, _ in occ_of_step[i].loops]
-            if other != [(f.line, f.values) for f in loops]:
-                raise LimitViolation(
-                    f"line {ln}: the FOR loops around the move run differently in its runs; "
-                    "the program is not written"
-                )
-        params = [f"{t} {nm}" for t, nm in proc.params]
-        args = [nm for _, nm in proc.params]
-        params += [f"num {f.variable}" for f in loops]
-        args += [f.variable for f in loops]
+        _check_same_loops(ln, loops, [occ_of_step[i] for i in steps_l[1:]])
+        params = [f"{t} {nm}" for t, nm in proc.params] + [f"num {f.variable}" for f in loops]
+        args = [nm for _, nm in proc.params] + [f.variable for f in loops]
         groups: dict[tuple[tuple[str, ...], tuple[str, ...], str | None], list[int]] = {}
         for i in steps_l:
             value = _run_value(occ_of_step[i].loops, entry_run(first.proc, occ_of_step[i].entry))
             groups.setdefault(bodies.get(i, ((), (), "taught")), []).append(value)
-        picked = {v: key for key, vs in groups.items() for v in vs}
-        if len(groups) > 1 and len(picked) != sum(len(vs) for vs in groups.values()):
-            raise LimitViolation(
-                f"line {ln}: the runs of this move cannot be told apart by their run number "
-                "(FOR loops whose bounds change between calls); the program is not written"
-            )
+        _check_told_apart(ln, groups)
         head, mv_args = _split_move(source, move, module.path)
         original = f"{head} {', '.join(mv_args)};"
-        body: list[str] = []
-        finals = set()
-        for g, (key, vals) in enumerate(groups.items(), start=1):
-            elements, moves_text, final = key
-            if final == "taught":
-                part = [original]
-            else:
-                name = base if len(groups) == 1 else _short(proc.name, f"_{n}_{g}", "jp_")
-                if elements:
-                    decls.append(f"CONST jointtarget {name}{{{len(elements)}}} := [")
-                    decls.extend(f"    {e}," for e in elements[:-1])
-                    decls.append(f"    {elements[-1]}")
-                    decls.append("];")
-                part = [t.replace("{ARR}", name) for t in moves_text]
-                if final is not None:
-                    finals.add(final)
-            if len(groups) == 1:
-                body.extend(part)
-            elif final != "taught":  # the taught runs go to DEFAULT
-                body.append(f"CASE {', '.join(map(str, sorted(vals)))}:")
-                body.extend("    " + t for t in part)
+        body, finals = _group_bodies(groups, original, proc.name, n, base, decls)
         if len(groups) > 1:
             if CONTEXT_PARAM.lower() in {a.lower() for a in args}:
                 raise LimitViolation(f"line {ln}: {CONTEXT_PARAM} is already a name here; not written")
-            body = [f"TEST {CONTEXT_PARAM}", *body, "DEFAULT:", f"    {original}", "ENDTEST"]
             params.append(f"num {CONTEXT_PARAM}")
             args.append(_run_expression(loops, needs.get(first.proc, False)))
         opt_runs = sum(1 for i in steps_l if i in result.paths)
         shapes = sum(1 for k in groups if k[2] != "taught")
-        selection = "shared" if len(groups) == 1 else "per run"
         how = "shared" if len(groups) == 1 else f"per run: TEST {CONTEXT_PARAM}"
         new_procs.append(f"PROC {call_name}({', '.join(params)})")
         new_procs.append(f"    ! joulepath: optimized {original} ({len(steps_l)} run(s) per cycle, {how})")
@@ -415,48 +507,15 @@ def written_module(result: Any, header: Sequence[str]) -> WrittenModule:
                 len(steps_l),
                 opt_runs,
                 shapes,
-                selection,
+                "shared" if len(groups) == 1 else "per run",
                 final_target,
                 tuple(sorted(k for k, v in reteach_of.items() if ln in v)),
             )
         )
-    taken = {w.lower() for w in re.findall(r"[A-Za-z]\w*", "\n".join(source))}  # any name the module uses
-    added = [m.call.lower() for m in written] + [
-        d.split()[2].split("{")[0].lower() for d in decls if d.startswith("CONST jointtarget")
-    ]
-    clash = sorted((set(added) & taken) | {a for a in added if added.count(a) > 1})
-    if clash:
-        raise LimitViolation(
-            f"the names joulepath adds ({', '.join(clash)}) are already used in the module (or shortened "
-            "to the same name); the program is not written (rename them in the module)"
-        )
+    _refuse_name_clashes(source, written, decls)
     for p in indexed:
-        proc = procs[p]
-        edits[proc.line] = _add_parameter(source[proc.line - 1], proc, f"num {RUN_PARAM}")
-        site_lines = [s for s, _ in sites[p]]
-        for k, (s_line, in_cycle) in enumerate(sites[p]):
-            if in_cycle is None:  # outside the cycle: 0 runs the taught motion
-                arg = "0"
-            else:
-                arg = _site_argument(
-                    _run_expression(list(in_cycle.loops_f), needs.get(in_cycle.proc, False)),
-                    len(site_lines),
-                    k,
-                )
-            edits[s_line] = _add_argument(source[s_line - 1], proc.name, arg, s_line)
-    for wline, before, after in result.waits:
-        if after != before:
-            end = next(
-                s.end_line for s in _statements_of(module) if isinstance(s, WaitTime) and s.line == wline
-            )
-            replace[wline] = (
-                end,
-                [
-                    f"! joulepath: WaitTime {_num(before)} s spent on the moves (--use-waits)",
-                    *_was(source, wline, end),
-                    f"WaitTime {_num(after)};",
-                ],
-            )
+        edits.update(_run_edits(source, procs[p], sites[p], needs))
+    replace.update(_wait_edits(result, module, source))
     text = _assemble(source, replace, edits, header, decls, new_procs)
     reteach = {k: tuple(sorted(v)) for k, v in reteach_of.items() if v}
     return WrittenModule(text, tuple(written), tuple(procs[p].name for p in indexed), reteach)

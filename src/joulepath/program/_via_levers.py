@@ -289,6 +289,278 @@ def _tool0_path(plan: PlannedCycle) -> FloatArray:
     return first.robot.fk(cycle_motion(plan).q).position_m
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class _Searched:
+    """:meth:`_ViaSearch.search`'s result: the best program with levers (None: none) and why not,
+    its corridor deviation and clearance (``kept``) and base; the last deviation and clearance
+    measured, and the last base searched (None: none)."""
+
+    found: LeverResult | None
+    why: str
+    kept: tuple[float | None, float | None]
+    found_base: Any
+    dev: float | None
+    clear: float | None
+    last: Any
+
+
+class _ViaSearch:
+    """The via-point modules of one :func:`via_levers` run on the controller emulation (each read and
+    planned once, checked against the taught cycle's time, its MoveL speed data and its tool0 path),
+    and the lever search on them."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        energy: str,
+        config: ControllerConfig,
+        path: str,
+        plan_t: PlannedCycle,
+        t_taught: float,
+        corridor_mm: float | None,
+    ) -> None:
+        self.robot = robot
+        self.energy = energy
+        self.config = config
+        self.path = path
+        self.plan_t = plan_t
+        self.t_taught = t_taught
+        self.corridor_mm = corridor_mm
+        self.lines = line_speeds(plan_t)
+        self.runs: dict[str, tuple[CycleSpec, PlannedCycle]] = {}  # per module run: read as, its plan
+        self.on_lines: dict[str, float] = {}  # per module asked: its fastest on a MoveL line (to its speed)
+        self._taught_tree: Any = None
+
+    def run(self, candidate: str) -> tuple[CycleSpec, float, float]:
+        spec_c = resolve_module(parse_module(candidate, path=self.path), self.robot)
+        plan_c, t_c, e_c = _Evaluator(spec_c, [], self.energy, self.config)(())
+        self.runs[candidate] = (spec_c, plan_c)
+        return spec_c, t_c, e_c
+
+    def line_ratio(self, candidate: str) -> float:
+        if candidate not in self.on_lines:  # the motion's TCP, only for the modules whose lines are asked
+            spec_c, plan_c = self.runs[candidate]
+            self.on_lines[candidate] = _fastest_on_lines(self.lines, plan_c, _added_lines(spec_c))[0]
+        return self.on_lines[candidate]
+
+    def keeps_lines(self, candidate: str) -> bool:
+        return self.line_ratio(candidate) <= 1.0 + SPEED_TOL
+
+    def in_time_first(self, t: float, e: float) -> tuple[bool, float]:  # within the taught time, least energy
+        return (t > self.t_taught + _TOL_S, e if t <= self.t_taught + _TOL_S else t)  # else the least over it
+
+    def fit(self, candidate: str) -> tuple[str, CycleSpec, float, float, int]:
+        """The module within the taught cycle time: its ``\\T`` shortened, else units put back as taught
+        (the cheapest that fits, else the one that saves most time)."""
+        spec_v, t_v, e_v = self.run(candidate)
+        back = 0
+        while not self.keeps_lines(candidate):  # units running a MoveL's line over its speed data go back
+            backs = [(_reverted(candidate, u), *self.run(_reverted(candidate, u))) for u in _units(candidate)]
+            if not backs:
+                break
+            keep = [x for x in backs if self.keeps_lines(x[0])]
+            candidate, spec_v, t_v, e_v = (
+                min(keep, key=lambda x: x[3]) if keep else min(backs, key=lambda x: self.line_ratio(x[0]))
+            )
+            back += 1
+        candidate, spec_v, t_v, e_v = _fitted(
+            candidate, spec_v, t_v, e_v, self.t_taught, self.run, self.keeps_lines
+        )
+        while t_v > self.t_taught + _TOL_S:
+            tries = [self.run(_reverted(candidate, u)) + (u,) for u in _units(candidate)]
+            if not tries:
+                break
+            fits = [x for x in tries if x[1] <= self.t_taught + _TOL_S]
+            spec_r, t_r, e_r, u = min(fits, key=lambda x: x[2]) if fits else min(tries, key=lambda x: x[1])
+            if t_r >= t_v - _TOL_S:
+                break
+            candidate, spec_v, t_v, e_v = _fitted(
+                _reverted(candidate, u), spec_r, t_r, e_r, self.t_taught, self.run, self.keeps_lines
+            )
+            back += 1
+        return candidate, spec_v, t_v, e_v, back
+
+    def farthest(self, plan_c: PlannedCycle) -> tuple[float, float]:
+        """The farthest the cycle's tool0 comes from the taught cycle's (mm), and when (s)."""
+        from scipy.spatial import cKDTree
+
+        if self._taught_tree is None:
+            self._taught_tree = cKDTree(_tool0_path(self.plan_t))
+        d = self._taught_tree.query(_tool0_path(plan_c))[0]
+        k = int(np.argmax(d))
+        return 1000.0 * float(d[k]), plan_c.cycle_time * k / max(1, d.size - 1)  # its 2.5 ms grid
+
+    def past_corridor(self, plan_c: PlannedCycle) -> tuple[float, float]:
+        """How far (mm) the cycle's tool0 comes past the corridor (negative: within it), and when (s)."""
+        dev_c, at_s = self.farthest(plan_c)
+        return dev_c - (np.inf if self.corridor_mm is None else self.corridor_mm), at_s
+
+    def bases(
+        self, plan: Any, plan_t: PlannedCycle, text: str, *, timed_chains: bool, max_seconds: float | None
+    ) -> tuple[list[Any], int]:
+        """The via-point modules the levers are searched on: ``text`` (the plan's via points, fitted into
+        the taught cycle time; its levers searched on every statement, then on the via points' alone) and,
+        with ``timed_chains``, its points at equal arc length with each chain's ``\\T`` timed for the
+        controller; and how many chains that timed."""
+        from joulepath.program._output import written_rapid
+
+        timed_n = 0
+        old = self.fit(text)  # the via-point layout the plan was checked with (fitted into the taught time)
+        only_sets: tuple[set[int] | None, ...] = (None, _added_lines(old[1]))
+        bases = [(*old, only_sets)]
+        if timed_chains:  # the plan's points kept at equal arc length, their \T timed for the controller
+            timings = []
+            for room in (BLEND_ROOM, 0.0):  # clear of the taught blends, or every point kept
+                dense = _plain(
+                    written_rapid(replace(plan, vias=dense_vias(plan, taught=plan_t, room=room))).text
+                )
+                spec_d = resolve_module(parse_module(dense, path=self.path), self.robot)
+                timed = time_chains(
+                    dense,
+                    spec_d,
+                    _added_lines(spec_d),
+                    measure=self.energy,
+                    config=self.config,
+                    cycle_s=self.t_taught,
+                    run_cycle=lambda c: self.run(c)[1:],
+                    max_seconds=max_seconds,
+                    speeds=self.lines,
+                )
+                if self.keeps_lines(
+                    timed.text
+                ):  # its chains on a MoveL's line are timed within its speed data
+                    timings.append(timed)
+            if timings:  # within the taught cycle for the least energy, else the least over it
+                timed = min(timings, key=lambda x: self.in_time_first(x.cycle_s, x.energy_J))
+                # not fitted by shortening its \T (that breaks its chains): over the taught time, the lever
+                # search brings it in
+                spec_t = resolve_module(parse_module(timed.text, path=self.path), self.robot)
+                bases.append(
+                    (timed.text, spec_t, timed.cycle_s, timed.energy_J, 0, (None,))
+                )  # every statement
+                timed_n = timed.timed
+        return bases, timed_n
+
+    def search(
+        self,
+        bases: list[Any],
+        *,
+        spec: CycleSpec,
+        e_taught: float,
+        lab_taught: float,
+        cell: Any,
+        max_seconds: float | None,
+        max_plans: int,
+    ) -> _Searched:
+        """The levers searched on each of the ``bases`` (every move statement, then the via points'
+        alone), each result written, restored, read again by the interpreter and run again, and kept
+        where it runs within the taught cycle time for less energy and keeps the corridor and the cell:
+        the one that saves most as executed (:class:`_Searched`)."""
+        from joulepath.program._cell import clearance
+        from joulepath.program._rapid_write import HEADERS, restore_program
+        from joulepath.program._task import as_sequence, read_written
+
+        assert spec.module is not None
+        original = list(spec.module.source)
+        dev: float | None = None
+        clear: float | None = None
+        header: list[str] = []
+        found: LeverResult | None = None
+        why = "no lever search ran"
+        kept: tuple[float | None, float | None] = (None, None)
+        found_base = bases[0]
+        last: Any = None
+        searches = [
+            (b, only) for b in bases for only in b[5] if b[2] <= self.t_taught + _TOL_S or b is not bases[0]
+        ]
+        for (
+            base,
+            only,
+        ) in searches:  # per base, every move statement and the via points' alone: the best as executed
+            last = base
+            text, via_spec, t_via, e_via, reverted, _ = base
+            added = _added_lines(via_spec)
+            try:
+                lv = levers_module(
+                    via_spec,
+                    self.robot,
+                    energy=self.energy,
+                    text=text,
+                    config=self.config,
+                    max_seconds=max_seconds,
+                    max_evaluations=max_plans,
+                    baseline=(self.t_taught, e_taught, lab_taught),
+                    only_lines=only,
+                    bound=None
+                    if self.corridor_mm is None
+                    else self.past_corridor,  # each step keeps the corridor
+                )
+            except InvalidInput as err:
+                why = f"the levers of the via points: {err}"
+                continue
+            if self.corridor_mm is not None:  # where the search could not bring it within the corridor
+                self.run(lv.written_text)
+                dev = self.farthest(self.runs[lv.written_text][1])[0]
+                if dev > self.corridor_mm:
+                    why = _left(dev, self.corridor_mm)
+                    continue
+            if not (lv.cycle_s <= self.t_taught + _TOL_S and lv.energy_J < e_taught):
+                why = (
+                    f"the via-point module runs {lv.cycle_s:.3f} s for {lv.energy_J:.2f} J against the "
+                    f"taught {self.t_taught:.3f} s and {e_taught:.2f} J"
+                )
+                continue
+            body, where = _marked(text, lv.written_text, added) if only is None else (lv.written_text, None)
+            saved = 100.0 * (1.0 - lv.energy_J / e_taught)
+            header = [
+                f"{HEADERS[0]} {__version__} for energy: the plan's via points and the controller's levers "
+                f"(AccSet, speed data or \\T, zones), as the controller emulation runs this module: "
+                f"{lv.cycle_s:.3f} s per cycle (taught {self.t_taught:.3f} s), {lv.energy_J:.2f} J against "
+                f"the taught {e_taught:.2f} J on {self.energy} energy ({saved:.1f} % saved). "
+                "See cycle.json.",
+                f"{HEADERS[1]} each optimized move calls jp_opt_<proc>_<n> (at the module's end), each "
+                "changed statement stands under its 'was:' lines. Re-teaching a target: optimize the "
+                "re-taught module again.",
+            ]
+            written = _with_header(body, header)
+            restored = restore_program(written)
+            if restored is None or restored.splitlines() != original:
+                why = "the written module does not restore to the program it was written from"
+                continue
+            # read again by the other reader (the interpreter) and run again: the searched motion, or nothing
+            again = read_written(written, f"{spec.module.path} (optimized)", self.robot)
+            plan_a, t_again, e_again = _Evaluator(as_sequence(again), [], self.energy, self.config)(())  # type: ignore[arg-type]
+            if abs(t_again - lv.cycle_s) > 1e-3 or abs(e_again - lv.energy_J) > _TOL_REL * max(1.0, e_taught):
+                why = (
+                    f"the written module, read again, runs {t_again:.3f} s and {e_again:.3f} J against the "
+                    f"searched {lv.cycle_s:.3f} s and {lv.energy_J:.3f} J; not written"
+                )
+                continue
+            dev = self.farthest(plan_a)[0]
+            clear = None
+            if cell is not None:
+                first = plan_a.moves[0].step
+                assert first.robot is not None and first.tcp is not None
+                q = cycle_motion(plan_a).q
+                clear = 1000.0 * (clearance(cell, first.robot, q, first.tcp).distance - cell.margin)
+            if self.corridor_mm is not None and dev > self.corridor_mm:
+                why = _left(dev, self.corridor_mm)
+                continue
+            if clear is not None and clear < 0.0:
+                why = f"it comes {-clear:.1f} mm inside the cell's margin"
+                continue
+            shift = len(header)
+            moves = tuple(
+                replace(m, line=(m.line if where is None else where.get(m.line, m.line)) + shift)
+                for m in lv.moves
+            )
+            if found is None or lv.energy_J < found.energy_J:
+                found = replace(lv, written_text=written, moves=moves, base="via points")
+                kept = (dev, clear)
+                found_base = base
+        return _Searched(found, why, kept, found_base, dev, clear, last)
+
+
 def via_levers(
     result: Any,
     robot: Robot,
@@ -335,8 +607,6 @@ def via_levers(
         for less energy, reads back as searched, and keeps the corridor and the cell.
     """
     from joulepath.program._output import written_rapid
-    from joulepath.program._rapid_write import HEADERS, restore_program
-    from joulepath.program._task import as_sequence, read_written
 
     config = config or ControllerConfig()
     spec = result.spec
@@ -353,94 +623,12 @@ def via_levers(
     plan_t, t_taught, _ = taught(())
     e_taught, lab_taught = taught.energies(plan_t)
     path = f"{spec.module.path} (via points)"
-    lines = line_speeds(plan_t)
-    runs: dict[str, tuple[CycleSpec, PlannedCycle]] = {}  # per module run: what it was read as and its plan
-    on_lines: dict[str, float] = {}  # per module asked: its fastest on a MoveL line, to its speed data
-
-    def run(candidate: str) -> tuple[CycleSpec, float, float]:
-        spec_c = resolve_module(parse_module(candidate, path=path), robot)
-        plan_c, t_c, e_c = _Evaluator(spec_c, [], energy, config)(())
-        runs[candidate] = (spec_c, plan_c)
-        return spec_c, t_c, e_c
-
-    def line_ratio(candidate: str) -> float:
-        if candidate not in on_lines:  # the motion's TCP, only for the modules whose lines are asked about
-            spec_c, plan_c = runs[candidate]
-            on_lines[candidate] = _fastest_on_lines(lines, plan_c, _added_lines(spec_c))[0]
-        return on_lines[candidate]
-
-    def keeps_lines(candidate: str) -> bool:
-        return line_ratio(candidate) <= 1.0 + SPEED_TOL
-
-    def in_time_first(t: float, e: float) -> tuple[bool, float]:  # within the taught time, least energy
-        return (t > t_taught + _TOL_S, e if t <= t_taught + _TOL_S else t)  # else the least over it
-
-    def fit(candidate: str) -> tuple[str, CycleSpec, float, float, int]:
-        """The module within the taught cycle time: its ``\\T`` shortened, else units put back as taught
-        (the cheapest that fits, else the one that saves most time)."""
-        spec_v, t_v, e_v = run(candidate)
-        back = 0
-        while not keeps_lines(candidate):  # units that run a MoveL's line faster than its speed data go back
-            backs = [(_reverted(candidate, u), *run(_reverted(candidate, u))) for u in _units(candidate)]
-            if not backs:
-                break
-            keep = [x for x in backs if keeps_lines(x[0])]
-            candidate, spec_v, t_v, e_v = (
-                min(keep, key=lambda x: x[3]) if keep else min(backs, key=lambda x: line_ratio(x[0]))
-            )
-            back += 1
-        candidate, spec_v, t_v, e_v = _fitted(candidate, spec_v, t_v, e_v, t_taught, run, keeps_lines)
-        while t_v > t_taught + _TOL_S:
-            tries = [run(_reverted(candidate, u)) + (u,) for u in _units(candidate)]
-            if not tries:
-                break
-            fits = [x for x in tries if x[1] <= t_taught + _TOL_S]
-            spec_r, t_r, e_r, u = min(fits, key=lambda x: x[2]) if fits else min(tries, key=lambda x: x[1])
-            if t_r >= t_v - _TOL_S:
-                break
-            candidate, spec_v, t_v, e_v = _fitted(
-                _reverted(candidate, u), spec_r, t_r, e_r, t_taught, run, keeps_lines
-            )
-            back += 1
-        return candidate, spec_v, t_v, e_v, back
-
-    timed_n = 0
+    search = _ViaSearch(robot, energy, config, path, plan_t, t_taught, corridor_mm)
     try:
-        old = fit(text)  # the via-point layout the plan was checked with (fitted into the taught time)
-        only_sets: tuple[set[int] | None, ...] = (None, _added_lines(old[1]))
-        bases = [(*old, only_sets)]
-        if timed_chains:  # the plan's points kept at equal arc length, their \T timed for the controller
-            timings = []
-            for room in (BLEND_ROOM, 0.0):  # clear of the taught blends, or every point kept
-                dense = _plain(
-                    written_rapid(replace(plan, vias=dense_vias(plan, taught=plan_t, room=room))).text
-                )
-                spec_d = resolve_module(parse_module(dense, path=path), robot)
-                timed = time_chains(
-                    dense,
-                    spec_d,
-                    _added_lines(spec_d),
-                    measure=energy,
-                    config=config,
-                    cycle_s=t_taught,
-                    run_cycle=lambda c: run(c)[1:],
-                    max_seconds=max_seconds,
-                    speeds=lines,
-                )
-                if keeps_lines(timed.text):  # its chains on a MoveL's line are timed within its speed data
-                    timings.append(timed)
-            if timings:  # within the taught cycle for the least energy, else the least over it
-                timed = min(timings, key=lambda x: in_time_first(x.cycle_s, x.energy_J))
-                # not fitted by shortening its \T (that breaks its chains): over the taught time, the lever
-                # search brings it in
-                spec_t = resolve_module(parse_module(timed.text, path=path), robot)
-                bases.append(
-                    (timed.text, spec_t, timed.cycle_s, timed.energy_J, 0, (None,))
-                )  # every statement
-                timed_n = timed.timed
+        bases, timed_n = search.bases(plan, plan_t, text, timed_chains=timed_chains, max_seconds=max_seconds)
     except JoulepathError as err:
         return ViaLevers(None, f"the via-point module cannot be read: {err}")
-    text, via_spec, t_via, e_via, reverted, _ = min(bases, key=lambda b: in_time_first(b[2], b[3]))
+    text, via_spec, t_via, e_via, reverted, _ = min(bases, key=lambda b: search.in_time_first(b[2], b[3]))
     if not any(b[2] <= t_taught + _TOL_S for b in bases) and not timed_chains:
         return ViaLevers(
             None,
@@ -448,112 +636,19 @@ def via_levers(
             t_via,
             e_via,
         )
-    from scipy.spatial import cKDTree
-
-    from joulepath.program._cell import clearance
-
-    original = list(spec.module.source)
-    taught_tree = cKDTree(_tool0_path(plan_t))
-
-    def farthest(plan_c: PlannedCycle) -> tuple[float, float]:
-        """The farthest the cycle's tool0 comes from the taught cycle's (mm), and when (s)."""
-        d = taught_tree.query(_tool0_path(plan_c))[0]
-        k = int(np.argmax(d))
-        return 1000.0 * float(d[k]), plan_c.cycle_time * k / max(1, d.size - 1)  # its 2.5 ms grid
-
-    def past_corridor(plan_c: PlannedCycle) -> tuple[float, float]:
-        dev_c, at_s = farthest(plan_c)
-        return dev_c - (np.inf if corridor_mm is None else corridor_mm), at_s
-
-    dev: float | None = None
-    clear: float | None = None
-    header: list[str] = []
-    found: LeverResult | None = None
-    why = "no lever search ran"
-    kept: tuple[float | None, float | None] = (None, None)
-    found_base = bases[0]
-    searches = [(b, only) for b in bases for only in b[5] if b[2] <= t_taught + _TOL_S or b is not bases[0]]
-    for (
-        base,
-        only,
-    ) in searches:  # per base, every move statement and the via points' alone: the best as executed
-        text, via_spec, t_via, e_via, reverted, _ = base
-        added = _added_lines(via_spec)
-        try:
-            lv = levers_module(
-                via_spec,
-                robot,
-                energy=energy,
-                text=text,
-                config=config,
-                max_seconds=max_seconds,
-                max_evaluations=max_plans,
-                baseline=(t_taught, e_taught, lab_taught),
-                only_lines=only,
-                bound=None if corridor_mm is None else past_corridor,  # each step keeps the corridor
-            )
-        except InvalidInput as err:
-            why = f"the levers of the via points: {err}"
-            continue
-        if corridor_mm is not None:  # where the search could not bring it within the corridor
-            run(lv.written_text)
-            dev = farthest(runs[lv.written_text][1])[0]
-            if dev > corridor_mm:
-                why = _left(dev, corridor_mm)
-                continue
-        if not (lv.cycle_s <= t_taught + _TOL_S and lv.energy_J < e_taught):
-            why = (
-                f"the via-point module runs {lv.cycle_s:.3f} s for {lv.energy_J:.2f} J against the taught "
-                f"{t_taught:.3f} s and {e_taught:.2f} J"
-            )
-            continue
-        body, where = _marked(text, lv.written_text, added) if only is None else (lv.written_text, None)
-        saved = 100.0 * (1.0 - lv.energy_J / e_taught)
-        header = [
-            f"{HEADERS[0]} {__version__} for energy: the plan's via points and the controller's levers "
-            f"(AccSet, speed data or \\T, zones), as the controller emulation runs this module: "
-            f"{lv.cycle_s:.3f} s per cycle (taught {t_taught:.3f} s), {lv.energy_J:.2f} J against the taught "
-            f"{e_taught:.2f} J on {energy} energy ({saved:.1f} % saved). See cycle.json.",
-            f"{HEADERS[1]} each optimized move calls jp_opt_<proc>_<n> (at the module's end), each "
-            "changed statement stands under its 'was:' lines. Re-teaching a target: optimize the re-taught "
-            "module again.",
-        ]
-        written = _with_header(body, header)
-        restored = restore_program(written)
-        if restored is None or restored.splitlines() != original:
-            why = "the written module does not restore to the program it was written from"
-            continue
-        # read again by the other reader (the interpreter) and run again: the searched motion, or nothing
-        again = read_written(written, f"{spec.module.path} (optimized)", robot)
-        plan_a, t_again, e_again = _Evaluator(as_sequence(again), [], energy, config)(())  # type: ignore[arg-type]
-        if abs(t_again - lv.cycle_s) > 1e-3 or abs(e_again - lv.energy_J) > _TOL_REL * max(1.0, e_taught):
-            why = (
-                f"the written module, read again, runs {t_again:.3f} s and {e_again:.3f} J against the "
-                f"searched {lv.cycle_s:.3f} s and {lv.energy_J:.3f} J; not written"
-            )
-            continue
-        dev = farthest(plan_a)[0]
-        clear = None
-        if cell is not None:
-            first = plan_a.moves[0].step
-            assert first.robot is not None and first.tcp is not None
-            q = cycle_motion(plan_a).q
-            clear = 1000.0 * (clearance(cell, first.robot, q, first.tcp).distance - cell.margin)
-        if corridor_mm is not None and dev > corridor_mm:
-            why = _left(dev, corridor_mm)
-            continue
-        if clear is not None and clear < 0.0:
-            why = f"it comes {-clear:.1f} mm inside the cell's margin"
-            continue
-        shift = len(header)
-        moves = tuple(
-            replace(m, line=(m.line if where is None else where.get(m.line, m.line)) + shift)
-            for m in lv.moves
-        )
-        if found is None or lv.energy_J < found.energy_J:
-            found = replace(lv, written_text=written, moves=moves, base="via points")
-            kept = (dev, clear)
-            found_base = base
+    searched = search.search(
+        bases,
+        spec=spec,
+        e_taught=e_taught,
+        lab_taught=lab_taught,
+        cell=cell,
+        max_seconds=max_seconds,
+        max_plans=max_plans,
+    )
+    found, why, kept, found_base = searched.found, searched.why, searched.kept, searched.found_base
+    dev, clear = searched.dev, searched.clear
+    if searched.last is not None:  # the last base searched
+        _, _, t_via, e_via, reverted, _ = searched.last
     if found is not None:
         dev, clear = kept
         _, _, t_via, e_via, reverted, _ = found_base
