@@ -387,3 +387,20 @@ def test_data_the_task_also_sets_otherwise_is_not_a_handshake():
     assert _targets(trace) == ["pA"]
     with pytest.raises(RapidError, match="bReq is a bool; give TRUE or FALSE"):
         run(HANDSHAKE_LOOP, decl=HANDSHAKE, io={"bReq": 3.0})
+
+
+def test_a_goto_back_for_ever_is_the_production_loop():
+    """`label: ... GOTO label;` at the end of main repeats for ever, as WHILE TRUE does: the turn after
+    the first is the cycle (before, the run went on until its bound of statements); a GOTO to the same
+    label inside that turn ends it."""
+    body = (
+        "    MoveJ Offs(p10,0,0,100), v1000, fine, tG;\n    top:\n      MoveJ p10, v1000, z10, tG;\n"
+        "      MoveL Offs(p10,0,0,-50), v100, fine, tG;\n    GOTO top;"
+    )
+    _, trace = run(body)
+    assert trace.loop is not None and trace.loop.line == 9  # the GOTO
+    assert len(trace.motions) == 2 and len(trace.events) == 5  # the way there, a first turn, the cycle
+    assert any("GOTO top jumps back for ever" in line for line in trace.notes)
+    short = body.replace("      MoveL", "      n := n + 1;\n      IF n = 2 GOTO top;\n      MoveL")
+    _, second = run(short, decl="  VAR num n := 0;\n")  # the cycle's turn jumps back before its MoveL
+    assert len(second.motions) == 1 and second.loop is not None

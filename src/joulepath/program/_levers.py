@@ -534,94 +534,147 @@ def _search(
     the statements that run where it is farthest past (each step the change that gets it within the
     time for the least energy, else in the least time, else the one that comes nearest), then into
     the time."""
-    state = tuple(s.taught for s in slots)
-    plan, t, e = ev(state)
-    past: dict[tuple[Setting, ...], tuple[float, float]] = {}
+    return _Descent(ev, slots, target_s, max_evaluations, pairs, bound).run()
 
-    def over(trial: tuple[Setting, ...]) -> tuple[float, float]:
-        if bound is None:
+
+class _Descent:
+    """One lever search (:func:`_search`): the settings it stands at, their plan, time and energy,
+    and its phases: within the caller's bound, into the cycle time, then down in energy."""
+
+    def __init__(
+        self,
+        ev: _Evaluator,
+        slots: list[_Slot],
+        target_s: float,
+        max_evaluations: int,
+        pairs: int,
+        bound: Bound | None,
+    ) -> None:
+        self.ev, self.slots, self.target_s = ev, slots, target_s
+        self.max_evaluations, self.pairs, self.bound = max_evaluations, pairs, bound
+        self.past: dict[tuple[Setting, ...], tuple[float, float]] = {}
+        self.take(tuple(s.taught for s in slots))
+
+    def take(self, state: tuple[Setting, ...]) -> None:
+        self.state = state
+        self.plan, self.t, self.e = self.ev(state)
+
+    def over(self, trial: tuple[Setting, ...]) -> tuple[float, float]:
+        if self.bound is None:
             return (0.0, 0.0)
-        if trial not in past:
-            past[trial] = bound(ev(trial)[0])
-        return past[trial]
+        if trial not in self.past:
+            self.past[trial] = self.bound(self.ev(trial)[0])
+        return self.past[trial]
 
-    def ok(trial: tuple[Setting, ...]) -> bool:
-        return over(trial)[0] <= 0.0
+    def ok(self, trial: tuple[Setting, ...]) -> bool:
+        return self.over(trial)[0] <= 0.0
 
-    while not ok(state) and ev.n < max_evaluations:  # past the caller's bound: first within it
-        x_now, at_s = over(state)
-        near = _near(plan, at_s)
+    def spent(self) -> bool:
+        return self.ev.n >= self.max_evaluations
+
+    def options(self, k: int, slot: _Slot, kind: str) -> list[Setting]:
+        duration = _durations(self.plan).get((slot.line, slot.instruction), 0.0)
+        return _options(self.state, k, kind, slot, self.ev.spec, duration)
+
+    def run(self) -> tuple[Setting, ...]:
+        while not self.ok(self.state) and not self.spent():  # past the caller's bound: first within it
+            if not self.into_bound():
+                break
+        while self.t > self.target_s + _TOL_S and not self.spent():  # over the cycle time (a module
+            # written from a plan): first into it
+            if not self.into_time():
+                break
+        while not self.spent():
+            improved, tried = self.sweep()
+            if improved:
+                continue
+            if not self.exchange(tried):
+                break
+        return self.state
+
+    def into_bound(self) -> bool:
+        """One step toward the bound, by the levers of the statements that run where the plan is
+        farthest past it; False where no change helps."""
+        ev, target_s = self.ev, self.target_s
+        x_now, at_s = self.over(self.state)
+        near = _near(self.plan, at_s)
         steps: list[tuple[tuple[int, float], tuple[Setting, ...]]] = []
-        for k, slot in enumerate(slots):
+        for k, slot in enumerate(self.slots):
             if near.isdisjoint(slot.steps):
                 continue
             for kind in _kinds(slot):
-                duration = _durations(plan).get((slot.line, slot.instruction), 0.0)
-                for option in _options(state, k, kind, slot, ev.spec, duration):
-                    trial = _with(state, k, option)
-                    if ev.n >= max_evaluations and trial not in ev.memo:
+                for option in self.options(k, slot, kind):
+                    trial = _with(self.state, k, option)
+                    if self.spent() and trial not in ev.memo:
                         break
                     _, t_new, e_new = ev(trial)
-                    x = over(trial)[0]
+                    x = self.over(trial)[0]
                     if x <= 0.0:
                         steps.append(((0, e_new) if t_new <= target_s + _TOL_S else (1, t_new), trial))
-                    elif x < x_now and t_new <= max(t, target_s) + _TOL_S:
+                    elif x < x_now and t_new <= max(self.t, target_s) + _TOL_S:
                         steps.append(((2, x), trial))
         if not steps:
-            break
-        state = min(steps, key=lambda r: r[0])[1]
-        plan, t, e = ev(state)
+            return False
+        self.take(min(steps, key=lambda r: r[0])[1])
+        return True
 
-    while t > target_s + _TOL_S and ev.n < max_evaluations:  # over the cycle time (a module written
-        # from a plan): first into it, each step the change that gets there for the least energy, else
-        # the one that buys time cheapest (energy per second)
+    def into_time(self) -> bool:
+        """One step into the cycle time: the change that gets there for the least energy, else the
+        one that buys time cheapest (energy per second); False where none does."""
+        ev, target_s = self.ev, self.target_s
         into: tuple[float, tuple[Setting, ...]] | None = None
         cheap: tuple[float, tuple[Setting, ...]] | None = None
-        for k, slot in enumerate(slots):
+        for k, slot in enumerate(self.slots):
             for kind in _kinds(slot):
-                duration = _durations(plan).get((slot.line, slot.instruction), 0.0)
-                for option in _options(state, k, kind, slot, ev.spec, duration):
-                    trial = _with(state, k, option)
+                for option in self.options(k, slot, kind):
+                    trial = _with(self.state, k, option)
                     _, t_new, e_new = ev(trial)
                     if t_new <= target_s + _TOL_S and (into is None or e_new < into[0]):
-                        if ok(trial):
+                        if self.ok(trial):
                             into = (e_new, trial)
-                    elif t_new < t - 1e-6:
-                        rate = (e_new - e) / (t - t_new)
-                        if (cheap is None or rate < cheap[0]) and ok(trial):
+                    elif t_new < self.t - 1e-6:
+                        rate = (e_new - self.e) / (self.t - t_new)
+                        if (cheap is None or rate < cheap[0]) and self.ok(trial):
                             cheap = (rate, trial)
         step = into or cheap
         if step is None:
-            break
-        state = step[1]
-        plan, t, e = ev(state)
+            return False
+        self.take(step[1])
+        return True
 
-    def better(t_new: float, e_new: float, best: tuple[float, object] | None) -> bool:
+    def better(self, t_new: float, e_new: float, best: tuple[float, object] | None) -> bool:
         """Within the cycle time, less energy than now, and than ``best``."""
-        return t_new <= target_s + _TOL_S and e_new < e * (1.0 - 1e-9) and (best is None or e_new < best[0])
+        return (
+            t_new <= self.target_s + _TOL_S
+            and e_new < self.e * (1.0 - 1e-9)
+            and (best is None or e_new < best[0])
+        )
 
-    while ev.n < max_evaluations:
+    def sweep(self) -> tuple[bool, list[Tried]]:
+        """Each slot's each lever in turn, the best single change taken; whether one was, and every
+        change tried with its effect from the settings it was tried on."""
+        ev = self.ev
         improved = False
         tried: list[Tried] = []
-        for k, slot in enumerate(slots):
+        for k, slot in enumerate(self.slots):
             for kind in _kinds(slot):
-                duration = _durations(plan).get((slot.line, slot.instruction), 0.0)
                 best: tuple[float, Setting] | None = None
-                for option in _options(state, k, kind, slot, ev.spec, duration):
-                    if ev.n >= max_evaluations and _with(state, k, option) not in ev.memo:
+                for option in self.options(k, slot, kind):
+                    if self.spent() and _with(self.state, k, option) not in ev.memo:
                         break
-                    _, t_new, e_new = ev(_with(state, k, option))
-                    tried.append(((k, kind), option, t_new - t, e_new - e))
-                    if better(t_new, e_new, best) and ok(_with(state, k, option)):
+                    _, t_new, e_new = ev(_with(self.state, k, option))
+                    tried.append(((k, kind), option, t_new - self.t, e_new - self.e))
+                    if self.better(t_new, e_new, best) and self.ok(_with(self.state, k, option)):
                         best = (e_new, option)
                 if best is not None:
-                    state = _with(state, k, best[1])
-                    plan, t, e = ev(state)
+                    self.take(_with(self.state, k, best[1]))
                     improved = True
-        if improved:
-            continue
-        # no single change helps (every change tried from this state): exchange time between two levers
-        slack = target_s - t
+        return improved, tried
+
+    def exchange(self, tried: list[Tried]) -> bool:
+        """No single change helps (every change tried from this state): exchange time between two
+        levers; whether an exchange was taken."""
+        slack = self.target_s - self.t
         gain = [x for x in tried if x[2] < 0.0]
         spend = [x for x in tried if x[3] < 0.0 and x[2] > slack]
         ranked = sorted(
@@ -637,23 +690,20 @@ def _search(
         # is changed once per exchange step (the effects measured from ``state`` hold for it alone)
         used: set[tuple[int, str]] = set()
         taken = False
-        for _, g, s in ranked[: pairs * 4]:
-            if ev.n >= max_evaluations:
+        for _, g, s in ranked[: self.pairs * 4]:
+            if self.spent():
                 break
             if g[0] in used or s[0] in used:
                 continue
             (kg, kind_g), (ks, kind_s) = g[0], s[0]
-            both = _with(state, kg, _combine(state[kg], g[1], kind_g))
+            both = _with(self.state, kg, _combine(self.state[kg], g[1], kind_g))
             both = _with(both, ks, _combine(both[ks], s[1], kind_s))
-            _, t_new, e_new = ev(both)
-            if better(t_new, e_new, None) and ok(both):
-                state = both
-                plan, t, e = ev(state)
+            _, t_new, e_new = self.ev(both)
+            if self.better(t_new, e_new, None) and self.ok(both):
+                self.take(both)
                 used |= {g[0], s[0]}
                 taken = True
-        if not taken:
-            break
-    return state
+        return taken
 
 
 # ---------------------------------------------------------------- writing
@@ -857,6 +907,79 @@ def _source_text(spec: CycleSpec) -> tuple[str, str]:
         return raw.decode("latin-1"), "latin-1"
 
 
+def _only(slots: list[_Slot], lines: set[int]) -> list[_Slot]:
+    """The slots on ``lines`` open, the others kept as written."""
+    closed = ("acc, speed, zone: kept as written",)
+    return [s if s.line in lines else replace(s, open=(), closed=closed) for s in slots]
+
+
+def _spend_idle(
+    idle: dict[int, tuple[float, int, tuple[int, int], str]], idle_s: float, t_search: float, target: float
+) -> tuple[dict[int, float], float]:
+    """The idle waits shortened by what the moves spend past ``target`` (in whole ms, down), and the
+    cycle time with them."""
+    spent = max(0.0, t_search - target)
+    if not (spent > 0.0 and idle_s > 0.0):
+        return {}, t_search
+    keep = 1.0 - spent / idle_s
+    new_waits = {
+        line: float(np.floor(sec * keep * 1000.0 + 1e-9) / 1000.0) for line, (sec, _, _, _) in idle.items()
+    }
+    t_search -= sum(n * (sec - new_waits[line]) for line, (sec, n, _, _) in idle.items())
+    return new_waits, t_search
+
+
+def _run_written(
+    ev: _Evaluator,
+    robot: Robot,
+    written: str,
+    where: dict[int, int],
+    chosen: tuple[Setting, ...],
+    new_waits: dict[int, float],
+    target: float,
+    taught: tuple[float, float],
+) -> tuple[str | None, tuple[float, float, float] | None]:
+    """The written module read again and run on the controller emulation: why it does not read back
+    as searched or runs past the time or the taught energy (None: it does), and its cycle time,
+    energy and lab energy."""
+    spec = ev.spec
+    assert spec.module is not None
+    try:
+        again = resolve_module(
+            parse_module(written, path=f"{spec.module.path} (levers)"),
+            robot,
+            idle_waits=[where[s.line] for s in spec.steps if s.kind == "wait" and s.idle],
+        )
+        differs = _reads_back(spec, again, ev.slots, chosen, where, new_waits)
+    except InvalidInput as err:
+        return f"it cannot be read: {err}", None
+    if differs is not None:
+        return differs, None
+    plan_x, t_exec, _ = ev.run(again)
+    e_exec, lab_exec = ev.energies(plan_x)
+    t0, e0 = taught
+    if t_exec > target + _TOL_S or e_exec > (e0 if t0 <= target + _TOL_S else np.inf):
+        return f"run again it takes {t_exec:.3f} s and {e_exec:.3f} J", (t_exec, e_exec, lab_exec)
+    return None, (t_exec, e_exec, lab_exec)
+
+
+def _module_text(spec: CycleSpec, text: str | None, encoding: str, max_evaluations: int) -> tuple[str, str]:
+    """The module's source and the encoding to write it in (:func:`levers_module`'s ``text``)."""
+    if spec.module is None:
+        raise InvalidInput(
+            f"{spec.source}: the controller's levers are written into a RAPID module; give a .mod file"
+        )
+    if max_evaluations < 1:
+        raise InvalidInput(f"max_evaluations must be at least 1, got {max_evaluations}")
+    if text is None:
+        text, encoding = _source_text(spec)
+    if tuple(text.splitlines()) != spec.module.source:
+        raise InvalidInput(
+            f"{spec.module.path}: the text given is not the module's source; give the file's text as read"
+        )
+    return text, encoding
+
+
 def levers_module(
     spec: CycleSpec,
     robot: Robot,
@@ -927,27 +1050,11 @@ def levers_module(
         module's text cannot be read again.
     """
     start = time.perf_counter()
-    if spec.module is None:
-        raise InvalidInput(
-            f"{spec.source}: the controller's levers are written into a RAPID module; give a .mod file"
-        )
-    if max_evaluations < 1:
-        raise InvalidInput(f"max_evaluations must be at least 1, got {max_evaluations}")
-    if text is None:
-        text, encoding = _source_text(spec)
-    if tuple(text.splitlines()) != spec.module.source:
-        raise InvalidInput(
-            f"{spec.module.path}: the text given is not the module's source; give the file's text as read"
-        )
+    text, encoding = _module_text(spec, text, encoding, max_evaluations)
+    assert spec.module is not None
     config = config or ControllerConfig()
     lines = text.splitlines(keepends=True)
-    slots = _slots(spec, lines)
-    if only_lines is not None:
-        open_lines = set(only_lines)
-        slots = [
-            s if s.line in open_lines else replace(s, open=(), closed=("acc, speed, zone: kept as written",))
-            for s in slots
-        ]
+    slots = _slots(spec, lines) if only_lines is None else _only(_slots(spec, lines), set(only_lines))
     ev = _Evaluator(spec, slots, energy, config)
     taught_state = tuple(s.taught for s in slots)
     plan0, t0, _ = ev(taught_state)
@@ -961,33 +1068,13 @@ def levers_module(
     idle_s = sum(sec * n for sec, n, _, _ in idle.values())
     chosen = _search(ev, slots, target + idle_s, max_evaluations, pairs, bound)
     _, t_search, e_search = ev(chosen)
-    spent = max(0.0, t_search - target)
-    new_waits: dict[int, float] = {}
-    if spent > 0.0 and idle_s > 0.0:
-        keep = 1.0 - spent / idle_s
-        new_waits = {
-            line: float(np.floor(sec * keep * 1000.0 + 1e-9) / 1000.0)
-            for line, (sec, _, _, _) in idle.items()
-        }
-        t_search -= sum(n * (sec - new_waits[line]) for line, (sec, n, _, _) in idle.items())
+    new_waits, t_search = _spend_idle(idle, idle_s, t_search, target)
     edits = {line: (idle[line][2], idle[line][3], sec) for line, sec in new_waits.items()}
     written, where = write_levers(spec.module, text, slots, chosen, edits)
-    again: CycleSpec | None = None
-    try:
-        again = resolve_module(
-            parse_module(written, path=f"{spec.module.path} (levers)"),
-            robot,
-            idle_waits=[where[s.line] for s in spec.steps if s.kind == "wait" and s.idle],
-        )
-        differs = _reads_back(spec, again, slots, chosen, where, new_waits)
-    except InvalidInput as err:
-        differs = f"it cannot be read: {err}"
-    if differs is None and again is not None:
-        plan_x, t_exec, _ = ev.run(again)
-        e_exec, lab_exec = ev.energies(plan_x)
-        if t_exec > target + _TOL_S or e_exec > (e0 if t0 <= target + _TOL_S else np.inf):
-            differs = f"run again it takes {t_exec:.3f} s and {e_exec:.3f} J"
-    if differs is not None or again is None:  # not written with levers: the program as taught
+    differs, executed = _run_written(ev, robot, written, where, chosen, new_waits, target, (t0, e0))
+    if differs is None and executed is not None:
+        t_exec, e_exec, lab_exec = executed
+    else:  # not written with levers: the program as taught
         chosen, written, t_exec, e_exec, lab_exec, new_waits = taught_state, text, t0, e0, lab0, {}
     moves = tuple(
         MoveLever(s.line, s.label, s.taught, c, s.open, s.closed) for s, c in zip(slots, chosen, strict=True)

@@ -33,6 +33,7 @@ from joulepath.rapid._state import (
     Frame,
     GotoLabel,
     Ref,
+    StopRun,
     opaque_ok,
     parse_literal,
     predefined_data,
@@ -427,9 +428,27 @@ class Machine:
                 )
                 if idx is None:
                     raise
+                if idx < k and isinstance(s, n.Goto) and self.cycle_end is None and self.loop is None:
+                    self._goto_loop(body[idx + 1 : k], s)
                 k = idx + 1
                 continue
             k += 1
+
+    def _goto_loop(self, turn: tuple[n.Stmt, ...], goto: n.Goto) -> None:
+        """An unconditional ``GOTO`` back to a label of its own statement list: the statements from the
+        label to it repeat for ever, the production loop written with ``GOTO`` (as ``WHILE TRUE``: the
+        turn just run led there, the next is the cycle; a ``GOTO`` to the same label inside the turn
+        ends it too)."""
+        self.loop = goto.pos
+        self.note(f"{goto.pos}: GOTO {goto.label} jumps back for ever: a turn from its label is the cycle")
+        self.cycle_start = len(self.events)
+        try:
+            self.exec_body(turn)
+        except GotoLabel as g:
+            if g.label.lower() != goto.label.lower():
+                raise
+        self.cycle_end = len(self.events)
+        raise StopRun(f"{goto.pos}: one turn of the production loop")
 
     # ---- values
     def unfinished(self, p: n.Placeholder) -> RapidError:
