@@ -126,3 +126,13 @@ def test_robot_show_names_the_class_drives_and_its_standby(capsys):
     line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("drive data:"))
     assert "abb-heavy.drives.toml (the heavy class of the ABB range)" in line
     assert "standby 659 W (assumed (from a measurement of arms of this size" in line
+
+
+def test_a_copy_of_the_description_elsewhere_has_only_its_own_drives_file(tmp_path):
+    import shutil
+
+    copy = tmp_path / "irb4600-40-2.55.irml"
+    shutil.copy(preset_path("irb4600-40-2.55"), copy)
+    assert joulepath.load_robot(str(copy)).drives is None  # the user's arm: no bundled figures guessed
+    shutil.copy(abb_drives_path("irb4600"), tmp_path / "irb4600-40-2.55.drives.toml")
+    assert joulepath.load_robot(str(copy)).drives.standby_W == 400.0  # its own file, beside it
