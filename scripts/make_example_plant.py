@@ -4,25 +4,44 @@ Usage::
 
     python scripts/make_example_plant.py [--out examples/plant] [--seed 7]
 
-The plant has 22 cells of an IRB 120 line, in the shapes of the bundled examples
-(examples/*.mod): pick and place, approach and depart, machine tending (long machining
-waits: the idle lever), palletizing with computed patterns (FOR loops over Offs) of
-several pallet sizes, and three multi-module tasks (a main module and a system module of
-routines, an I/O branch chosen by the cell's ``io`` scenario, a ``MoveC``). Each cell's
-targets, pallet size and waits are drawn from a seeded generator around the examples'
-reachable targets, so the same seed writes the same plant. The multi-module tasks need
-the RAPID interpreter; a joulepath that reads one module per program records them as
-failed with that reason, and runs the others.
+The plant is a mixed line, so that its report ranks savings where the kilowatts are:
+
+* a palletizer on an IRB 6700-200/2.60 (40 kg sacks, a 90 kg gripper) and one on an
+  IRB 4600-60/2.05 (15 kg cartons), each stacking a layer of a computed pattern (FOR loops
+  over Offs) and waiting for the pallet's exchange;
+* two handling arms: an IRB 2600-12/1.65 tending a machine (a long machining wait: the idle
+  lever) and an IRB 1600-8/1.45 moving parts between a conveyor and a press;
+* an arc-welding cell on an IRB 1600-6/1.2: two seams welded with slow MoveL (the torch's
+  signal set around them), a torch cleaning in between;
+* small assembly cells: two IRB 1200-7/0.7 cells inserting pins into a fixture, and IRB 120
+  cells in the shapes of the bundled examples (examples/*.mod): pick and place, approach and
+  depart, machine tending, palletizing, and two multi-module tasks (a main module and a system
+  module of routines, an I/O branch chosen by the cell's ``io`` scenario, a ``MoveC``).
+
+Every program is written here (none is copied from a published program). The large arms'
+targets are computed from joint values chosen for each cell (the tool pointing down: axis 5
+at 90° minus axes 2 and 3), through the arm's forward kinematics and the tool's TCP, with the
+confdata of those joint values, so that each target is reachable in the configuration it
+names. Each cell's targets, waits and shares are drawn from a seeded generator, so the same
+seed writes the same plant. The multi-module tasks need the RAPID interpreter; a joulepath
+that reads one module per program records them as failed with that reason, and runs the
+others.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+
+import joulepath  # noqa: E402
+from joulepath.kinematics import confdata  # noqa: E402
+
 TOOL = (
     "PERS tooldata tGripper := [TRUE, [[0, 0, 90], [1, 0, 0, 0]], [0.6, [0, 0, 45], [1, 0, 0, 0], 0, 0, 0]];"
 )
@@ -269,16 +288,307 @@ ENDMODULE
     return {"main.mod": main, "routines.sys": routines}
 
 
+NINES = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
+
+
+class Arm:
+    """A bundled arm of the line, its tool's TCP (mm along the flange's z) and reachable targets."""
+
+    def __init__(self, name: str, tcp_mm: float) -> None:
+        self.name = name
+        self.robot = joulepath.load_robot(name)
+        self.tcp_mm = tcp_mm
+        self._lower = np.asarray(self.robot.lower)
+        self._upper = np.asarray(self.robot.upper)
+
+    def down(self, q1: float, q2: float, q3: float, q6: float = 45.0) -> tuple[float, ...]:
+        """Joint values (deg) with the tool pointing straight down (axis 5 = 90° - axis 2 - axis 3);
+        axis 6 mid-quadrant, so that the targets offset from it keep its confdata."""
+        return (q1, q2, q3, 0.0, 90.0 - q2 - q3, q6)
+
+    def target(
+        self, name: str, q_deg: tuple[float, ...], *, offsets: tuple[tuple[float, ...], ...] = ()
+    ) -> str:
+        """A robtarget at the TCP of joint values ``q_deg``, with their confdata; each ``offsets``
+        (dx, dy, dz mm, as the program's Offs adds them) is checked reachable in that configuration."""
+        from joulepath.kinematics import solve_ik
+
+        q = np.radians(q_deg)
+        if np.any(q < self._lower) or np.any(q > self._upper):
+            raise SystemExit(f"{self.name}: {name} = {q_deg} deg is outside the axis ranges")
+        pose = self.robot.fk(q)
+        rot = np.asarray(pose.rotation)
+        tcp = np.asarray(pose.position_mm) + rot @ np.array([0.0, 0.0, self.tcp_mm])
+        cf = tuple(int(c) for c in confdata(self.robot.chain, q))
+        for d in ((0.0, 0.0, 0.0), *offsets):
+            m = np.eye(4)
+            m[:3, :3] = rot
+            m[:3, 3] = (tcp + np.asarray(d, dtype=float) - rot @ np.array([0.0, 0.0, self.tcp_mm])) / 1000.0
+            if solve_ik(self.robot.chain, m, cf, lower=self._lower, upper=self._upper) is None:
+                raise SystemExit(f"{self.name}: Offs({name}, {d}) is out of reach in configuration {cf}")
+        quat = [0.0 if abs(v) < 5e-5 else round(float(v), 5) for v in pose.quaternion]
+        x, y, z = (round(float(v)) for v in tcp)
+        return (
+            f"    CONST robtarget {name} := [[{x}, {y}, {z}], [{', '.join(f'{v:g}' for v in quat)}], "
+            f"[{', '.join(str(c) for c in cf)}], {NINES}];"
+        )
+
+
+def _tooldata(name: str, tcp_mm: float, kg: float, cog_mm: float) -> str:
+    """A tool pointing along the flange's z: its TCP, mass and centre of gravity (inertia not given)."""
+    return (
+        f"PERS tooldata {name} := [TRUE, [[0, 0, {tcp_mm:g}], [1, 0, 0, 0]], "
+        f"[{kg:g}, [0, 0, {cog_mm:g}], [1, 0, 0, 0], 0, 0, 0]];"
+    )
+
+
+def _j(rng: np.random.Generator, deg: float) -> float:
+    """A joint value jittered by up to 3 degrees (each cell's own layout)."""
+    return round(float(deg + rng.uniform(-3.0, 3.0)), 1)
+
+
+def heavy_palletizer(
+    name: str,
+    arm: Arm,
+    rng: np.random.Generator,
+    *,
+    what: str,
+    gripper_kg: float,
+    part_kg: float,
+    rows: int,
+    cols: int,
+    pitch: tuple[float, float],
+    pick: tuple[float, float, float],
+    pallet: tuple[float, float, float],
+    lift: float,
+) -> str:
+    exchange = round(float(rng.uniform(6.0, 12.0)), 1)
+    grip = round(float(rng.uniform(0.3, 0.6)), 2)
+    places = tuple(
+        (r * pitch[0], c * pitch[1], z) for r in range(rows) for c in range(cols) for z in (0, lift)
+    )
+    p_pick = arm.target("pPick", arm.down(*(_j(rng, v) for v in pick)), offsets=((0, 0, lift),))
+    p_pallet = arm.target("pPallet", arm.down(*(_j(rng, v) for v in pallet)), offsets=places)
+    return f"""MODULE {name}
+    ! Palletizing {what} on an {arm.robot.name} (generated by scripts/make_example_plant.py): each
+    ! {part_kg:g} kg {what[:-1]} is taken from the infeed conveyor and stacked in a {rows} x {cols}
+    ! layer computed with Offs; the full pallet is exchanged in {exchange} s (the robot only waits).
+    {_tooldata("tGripper", arm.tcp_mm, gripper_kg, arm.tcp_mm / 2)}
+    PERS loaddata lPart := [{part_kg:g}, [0, 0, 100], [1, 0, 0, 0], 0, 0, 0];
+{p_pick}
+{p_pallet}
+    CONST num nLift := {lift:g};
+    CONST num nGrip := {grip};
+
+    PROC main()
+        WHILE TRUE DO
+            FOR row FROM 0 TO {rows - 1} DO
+                FOR col FROM 0 TO {cols - 1} DO
+                    PickPart;
+                    PlacePart Offs(pPallet, row * {pitch[0]:g}, col * {pitch[1]:g}, 0);
+                ENDFOR
+            ENDFOR
+            TPWrite "Pallet full: exchange it";
+            WaitTime {exchange}; ! joulepath: idle
+        ENDWHILE
+    ENDPROC
+
+    PROC PickPart()
+        MoveJ Offs(pPick, 0, 0, nLift), v2000, z100, tGripper;
+        MoveL pPick, v500, fine, tGripper;
+        SetDO doGrip, 1;
+        WaitTime nGrip;
+        GripLoad lPart;
+        MoveL Offs(pPick, 0, 0, nLift), v1000, z100, tGripper;
+    ENDPROC
+
+    PROC PlacePart(robtarget pPlace)
+        MoveJ Offs(pPlace, 0, 0, nLift), v2000, z100, tGripper;
+        MoveL pPlace, v500, fine, tGripper;
+        SetDO doGrip, 0;
+        WaitTime nGrip;
+        GripLoad load0;
+        MoveL Offs(pPlace, 0, 0, nLift), v1000, z100, tGripper;
+    ENDPROC
+ENDMODULE
+"""
+
+
+def large_tending(name: str, arm: Arm, rng: np.random.Generator) -> str:
+    machining = round(float(rng.uniform(8.0, 14.0)), 1)
+    return f"""MODULE {name}
+    ! Machine tending on an {arm.robot.name} (generated by scripts/make_example_plant.py): a blank from
+    ! the infeed into the machine's fixture, the robot waits {machining} s outside while the machine
+    ! runs, then the finished part goes to the outfeed.
+    {_tooldata("tGripper", arm.tcp_mm, 6, 80)}
+    PERS loaddata lBlank := [4, [0, 0, 60], [1, 0, 0, 0], 0, 0, 0];
+{arm.target("pInfeed", arm.down(_j(rng, -75), _j(rng, 30), _j(rng, 15)), offsets=((0, 0, 200),))}
+{arm.target("pOutfeed", arm.down(_j(rng, 75), _j(rng, 30), _j(rng, 15)), offsets=((0, 0, 200),))}
+{arm.target("pWait", arm.down(_j(rng, 0), _j(rng, -10), _j(rng, 0)))}
+{arm.target("pFixture", arm.down(_j(rng, 0), _j(rng, 45), _j(rng, 10)), offsets=((0, 0, 250),))}
+
+    PROC main()
+        WHILE TRUE DO
+            MoveJ Offs(pInfeed, 0, 0, 200), v1500, z100, tGripper;
+            MoveL pInfeed, v400, fine, tGripper;
+            SetDO doGrip, 1;
+            WaitTime 0.3;
+            GripLoad lBlank;
+            MoveL Offs(pInfeed, 0, 0, 200), v1000, z50, tGripper;
+            MoveJ Offs(pFixture, 0, 0, 250), v1500, z50, tGripper;
+            MoveL pFixture, v300, fine, tGripper;
+            SetDO doGrip, 0;
+            WaitTime 0.4;
+            GripLoad load0;
+            MoveL Offs(pFixture, 0, 0, 250), v800, z50, tGripper;
+            MoveJ pWait, v1500, fine, tGripper;
+            PulseDO doCycleStart;
+            WaitTime {machining}; ! the machine runs
+            MoveJ Offs(pFixture, 0, 0, 250), v1500, z50, tGripper;
+            MoveL pFixture, v300, fine, tGripper;
+            SetDO doGrip, 1;
+            WaitTime 0.4;
+            GripLoad lBlank;
+            MoveL Offs(pFixture, 0, 0, 250), v800, z50, tGripper;
+            MoveJ Offs(pOutfeed, 0, 0, 200), v1500, z100, tGripper;
+            MoveL pOutfeed, v400, fine, tGripper;
+            SetDO doGrip, 0;
+            WaitTime 0.3;
+            GripLoad load0;
+            MoveL Offs(pOutfeed, 0, 0, 200), v1000, z100, tGripper;
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+
+
+def press_handling(name: str, arm: Arm, rng: np.random.Generator) -> str:
+    press = round(float(rng.uniform(1.5, 3.0)), 1)
+    return f"""MODULE {name}
+    ! Press handling on an {arm.robot.name} (generated by scripts/make_example_plant.py): a part from
+    ! the conveyor into the press, out of it after its stroke ({press} s), onto the outgoing conveyor.
+    {_tooldata("tGripper", arm.tcp_mm, 4, 60)}
+{arm.target("pConveyor", arm.down(_j(rng, -60), _j(rng, 25), _j(rng, 20)), offsets=((0, 0, 150),))}
+{arm.target("pPress", arm.down(_j(rng, 15), _j(rng, 40), _j(rng, 5)), offsets=((0, 0, 150), (-300, 0, 150)))}
+{arm.target("pOut", arm.down(_j(rng, 80), _j(rng, 25), _j(rng, 20)), offsets=((0, 0, 150),))}
+
+    PROC main()
+        WHILE TRUE DO
+            MoveJ Offs(pConveyor, 0, 0, 150), v1500, z50, tGripper;
+            MoveL pConveyor, v400, fine, tGripper;
+            WaitTime 0.2;
+            MoveL Offs(pConveyor, 0, 0, 150), v1000, z50, tGripper;
+            MoveJ Offs(pPress, -300, 0, 150), v1500, z50, tGripper;
+            MoveL Offs(pPress, 0, 0, 150), v1000, z20, tGripper;
+            MoveL pPress, v300, fine, tGripper;
+            WaitTime 0.2;
+            MoveL Offs(pPress, 0, 0, 150), v1000, z20, tGripper;
+            MoveL Offs(pPress, -300, 0, 150), v1000, z50, tGripper;
+            WaitTime {press}; ! the press strokes
+            MoveL Offs(pPress, 0, 0, 150), v1000, z20, tGripper;
+            MoveL pPress, v300, fine, tGripper;
+            WaitTime 0.2;
+            MoveL Offs(pPress, 0, 0, 150), v1000, z20, tGripper;
+            MoveJ Offs(pOut, 0, 0, 150), v1500, z50, tGripper;
+            MoveL pOut, v400, fine, tGripper;
+            WaitTime 0.2;
+            MoveL Offs(pOut, 0, 0, 150), v1000, z50, tGripper;
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+
+
+def arc_welding(name: str, arm: Arm, rng: np.random.Generator) -> str:
+    seam_a = round(float(rng.uniform(150, 250)))
+    seam_b = round(float(rng.uniform(100, 200)))
+    speed = int(rng.choice([15, 20, 25]))
+    load = round(float(rng.uniform(4.0, 8.0)), 1)
+    seam_a_at = arm.down(_j(rng, -20), _j(rng, 30), _j(rng, 10))
+    p_seam_a = arm.target("pSeamA", seam_a_at, offsets=((0, 0, 80), (0, seam_a, 0), (0, seam_a, 80)))
+    seam_b_at = arm.down(_j(rng, 15), _j(rng, 35), _j(rng, 5))
+    p_seam_b = arm.target("pSeamB", seam_b_at, offsets=((0, 0, 80), (-seam_b, 0, 0), (-seam_b, 0, 80)))
+    p_clean = arm.target("pClean", arm.down(_j(rng, 70), _j(rng, 10), _j(rng, 10)), offsets=((0, 0, 100),))
+    p_load = arm.target("pLoad", arm.down(_j(rng, 0), _j(rng, -5), _j(rng, 0)))
+    return f"""MODULE {name}
+    ! Arc welding on an {arm.robot.name} (generated by scripts/make_example_plant.py): two fillet seams
+    ! of {seam_a} and {seam_b} mm at {speed} mm/s (the arc on while doArc is 1), the torch cleaned after
+    ! them; the operator loads the next part in {load} s.
+    {_tooldata("tTorch", arm.tcp_mm, 3, 120)}
+    CONST speeddata vWeld := [{speed}, 50, 5000, 1000];
+{p_seam_a}
+{p_seam_b}
+{p_clean}
+{p_load}
+
+    PROC main()
+        WHILE TRUE DO
+            MoveJ pLoad, v1000, fine, tTorch;
+            WaitTime {load}; ! the operator loads the part
+            MoveJ Offs(pSeamA, 0, 0, 80), v1000, z20, tTorch;
+            MoveL pSeamA, v200, fine, tTorch;
+            SetDO doArc, 1;
+            MoveL Offs(pSeamA, 0, {seam_a}, 0), vWeld, fine, tTorch;
+            SetDO doArc, 0;
+            MoveL Offs(pSeamA, 0, {seam_a}, 80), v500, z20, tTorch;
+            MoveJ Offs(pSeamB, 0, 0, 80), v1000, z20, tTorch;
+            MoveL pSeamB, v200, fine, tTorch;
+            SetDO doArc, 1;
+            MoveL Offs(pSeamB, -{seam_b}, 0, 0), vWeld, fine, tTorch;
+            SetDO doArc, 0;
+            MoveL Offs(pSeamB, -{seam_b}, 0, 80), v500, z20, tTorch;
+            MoveJ Offs(pClean, 0, 0, 100), v1000, z20, tTorch;
+            MoveL pClean, v200, fine, tTorch;
+            WaitTime 2.5; ! the torch is cleaned
+            MoveL Offs(pClean, 0, 0, 100), v500, z20, tTorch;
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+
+
+def pin_assembly(name: str, arm: Arm, rng: np.random.Generator) -> str:
+    pitch = round(float(rng.uniform(20, 35)))
+    pins = 4
+    p_feeder = arm.target("pFeeder", arm.down(_j(rng, -50), _j(rng, 20), _j(rng, 20)), offsets=((0, 0, 60),))
+    holes = tuple((i * pitch, 0, z) for i in range(pins) for z in (0, 60))
+    p_fixture = arm.target("pFixture", arm.down(_j(rng, 20), _j(rng, 25), _j(rng, 15)), offsets=holes)
+    return f"""MODULE {name}
+    ! Assembly on an {arm.robot.name} (generated by scripts/make_example_plant.py): {pins} pins from the
+    ! feeder pressed into a fixture's holes, {pitch} mm apart; the fixture is exchanged after them.
+    {_tooldata("tPinGripper", arm.tcp_mm, 0.8, 40)}
+{p_feeder}
+{p_fixture}
+
+    PROC main()
+        WHILE TRUE DO
+            FOR i FROM 0 TO {pins - 1} DO
+                MoveJ Offs(pFeeder, 0, 0, 60), v1000, z20, tPinGripper;
+                MoveL pFeeder, v300, fine, tPinGripper;
+                WaitTime 0.2;
+                MoveL Offs(pFeeder, 0, 0, 60), v500, z20, tPinGripper;
+                MoveJ Offs(pFixture, i * {pitch}, 0, 60), v1000, z20, tPinGripper;
+                MoveL Offs(pFixture, i * {pitch}, 0, 0), v100, fine, tPinGripper;
+                WaitTime 0.3; ! the pin is pressed in
+                MoveL Offs(pFixture, i * {pitch}, 0, 60), v500, z20, tPinGripper;
+            ENDFOR
+            WaitTime 1.5; ! the fixture is exchanged
+        ENDWHILE
+    ENDPROC
+ENDMODULE
+"""
+
+
 HEADER = """# The example plant (generated by scripts/make_example_plant.py; run it again to regenerate).
 # joulepath plant examples/plant/plant.toml --out plant-run --jobs 2
 [plant]
-name = "Example line: 22 IRB 120 cells"
+name = "Example line: {n} cells, IRB 120 to IRB 6700"
 hours_per_year = 6000
 tariff_eur_per_kwh = 0.20
 co2_kg_per_kwh = 0.35
 
 [defaults]             # the settings of `joulepath cycle`, for every cell (a cell may override them)
-energy = "electrical"  # minimize the energy at the meter (the IRB 120's drives file: assumed values)
+energy = "electrical"  # minimize the energy at the meter (the bundled drives files: assumed values)
 table_points = 2       # a coarse time table and knots keep the example's run short,
 knot_spacing = 0.1
 pass_search = 2
@@ -291,54 +601,85 @@ lever_plans = 60       # each cell searches the controller's levers as `joulepat
 def build(out: Path, seed: int) -> list[str]:
     """Write the plant under ``out``; the cell names."""
     rng = np.random.default_rng(seed)
-    streams = rng.spawn(22)
-    cells: list[tuple[str, list[str], str]] = []  # name, program files (relative), extra TOML lines
+    streams = iter(rng.spawn(16))
+    cells: list[tuple[str, str, list[str], str]] = []  # name, robot, program files (relative), extra TOML
     programs = out / "programs"
+    if programs.is_dir():
+        for old in sorted(programs.rglob("*"), reverse=True):  # a regenerated plant keeps no stale cell
+            old.rmdir() if old.is_dir() else old.unlink()
     programs.mkdir(parents=True, exist_ok=True)
-    k = 0
 
-    def single(name: str, text: str, extra: str = "") -> None:
+    def single(name: str, robot: str, text: str, share: float | None = None) -> None:
         path = programs / f"{name}.mod"
         path.write_text(text, encoding="utf-8")
-        cells.append((name, [f"programs/{name}.mod"], extra))
+        cells.append((name, robot, [f"programs/{name}.mod"], "" if share is None else f"share = {share}"))
 
-    for i in range(8):
-        share = round(float(streams[k].uniform(0.5, 1.0)), 2)
-        single(f"pick-{i + 1:02d}", pick_and_place(f"Pick{i + 1:02d}", streams[k]), f"share = {share}")
-        k += 1
-    for i in range(4):
-        single(f"press-{i + 1:02d}", approach_depart(f"Press{i + 1:02d}", streams[k]))
-        k += 1
-    for i in range(4):
-        share = round(float(streams[k].uniform(0.6, 1.0)), 2)
-        single(f"tend-{i + 1:02d}", machine_tending(f"Tend{i + 1:02d}", streams[k]), f"share = {share}")
-        k += 1
-    for i, (rows, cols) in enumerate(((1, 2), (2, 2), (1, 3))):
-        single(f"pallet-{i + 1:02d}", palletizing(f"Pallet{i + 1:02d}", streams[k], rows, cols))
-        k += 1
-    for i in range(3):
+    def share(s: np.random.Generator, lo: float = 0.6) -> float:
+        return round(float(s.uniform(lo, 1.0)), 2)
+
+    # the large arms: palletizers, handling, a welder
+    s = next(streams)
+    single(
+        "pallet-sacks",
+        "irb6700-200-2.60",
+        heavy_palletizer(
+            "PalletSacks", Arm("irb6700-200-2.60", 350), s, what="sacks", gripper_kg=90, part_kg=40,
+            rows=2, cols=2, pitch=(-500.0, 350.0), pick=(-90, 30, 10), pallet=(15, 45, 5), lift=450.0,
+        ),
+        share(s, 0.8),
+    )  # fmt: skip
+    s = next(streams)
+    single(
+        "pallet-cartons",
+        "irb4600-60-2.05",
+        heavy_palletizer(
+            "PalletCartons", Arm("irb4600-60-2.05", 250), s, what="cartons", gripper_kg=25, part_kg=15,
+            rows=1, cols=3, pitch=(0.0, 300.0), pick=(-90, 30, 15), pallet=(10, 45, 10), lift=350.0,
+        ),
+        share(s, 0.7),
+    )  # fmt: skip
+    s = next(streams)
+    single(
+        "tend-2600", "irb2600-12-1.65", large_tending("Tend2600", Arm("irb2600-12-1.65", 200), s), share(s)
+    )
+    s = next(streams)
+    single(
+        "press-1600", "irb1600-8-1.45", press_handling("Press1600", Arm("irb1600-8-1.45", 180), s), share(s)
+    )
+    s = next(streams)
+    single("weld-1600", "irb1600-6-1.2", arc_welding("Weld1600", Arm("irb1600-6-1.2", 350), s), share(s, 0.7))
+    # the small assembly cells
+    arm1200 = Arm("irb1200-7-0.7", 120)
+    for i in range(2):
+        s = next(streams)
+        single(
+            f"assy-1200-{i + 1:02d}",
+            "irb1200-7-0.7",
+            pin_assembly(f"Assy1200{i + 1:02d}", arm1200, s),
+            share(s),
+        )
+    for i in range(2):
+        s = next(streams)
+        single(f"pick-{i + 1:02d}", "irb120", pick_and_place(f"Pick{i + 1:02d}", s), share(s, 0.5))
+    single("press-01", "irb120", approach_depart("Press01", next(streams)))
+    s = next(streams)
+    single("tend-01", "irb120", machine_tending("Tend01", s), share(s))
+    single("pallet-01", "irb120", palletizing("Pallet01", next(streams), 1, 3))
+    for i in range(2):
         name = f"task-{i + 1:02d}"
         folder = programs / name
         folder.mkdir(exist_ok=True)
-        files = multi_module(f"Task{i + 1:02d}", streams[k])
+        files = multi_module(f"Task{i + 1:02d}", next(streams))
         for fname, text in files.items():
             (folder / fname).write_text(text, encoding="utf-8")
         check = 1 if i % 2 == 0 else 0
-        cells.append(
-            (
-                name,
-                [f"programs/{name}/{f}" for f in files],
-                f"io = {{ diPartReady = 1, diCheckPart = {check} }}",
-            )
-        )
-        k += 1
-    lines = [HEADER]
-    for name, files, extra in cells:
-        program = files[0] if len(files) == 1 else "[" + ", ".join(f'"{f}"' for f in files) + "]"
-        if len(files) == 1:
-            program = f'"{program}"'
+        io = f"io = {{ diPartReady = 1, diCheckPart = {check} }}"
+        cells.append((name, "irb120", [f"programs/{name}/{f}" for f in files], io))
+    lines = [HEADER.format(n=len(cells))]
+    for name, robot, files, extra in cells:
+        program = f'"{files[0]}"' if len(files) == 1 else "[" + ", ".join(f'"{f}"' for f in files) + "]"
         lines.append(
-            f'[[cell]]\nname = "{name}"\nrobot = "irb120"\nprogram = {program}\n'
+            f'[[cell]]\nname = "{name}"\nrobot = "{robot}"\nprogram = {program}\n'
             + (extra + "\n" if extra else "")
         )
     (out / "plant.toml").write_text("\n".join(lines), encoding="utf-8")

@@ -102,6 +102,13 @@ def show(
     r = load_robot(robot, checked=False, lock=parse_locks(lock) or None)  # showing what is wrong is our job
     console.print(r.summary(), markup=False)
     console.print(f"controller: {declared_controller(r)} (--export overrides); friction: {r.friction_note}")
+    drives = r.drives
+    idle = (
+        f": standby {drives.standby_W:g} W ({drives.source('standby_W').split(':')[0]})"
+        if drives is not None
+        else ""
+    )
+    console.print(f"drive data: {r.drives_note}{idle}", markup=False)
     home = r.fk(r.home)
     x, y, z = home.position_mm
     w, qx, qy, qz = home.quaternion

@@ -23,11 +23,14 @@ from joulepath.description._model import (
 from joulepath.description._named import NAMED_ARMS, NamedArm, named_arm_path
 from joulepath.description._pinocchio import chain_from_urdf, pinocchio_model
 from joulepath.description._presets import (
+    ABB_DRIVE_CLASSES,
     ABB_RANGE,
     DEFAULT_ROBOT,
     FAMILY_DEFAULTS,
     HOME,
     PRESETS,
+    abb_drive_class,
+    abb_drives_path,
     abb_preset,
     preset_description,
     preset_path,
@@ -46,6 +49,7 @@ from joulepath.description._provenance import (
 from joulepath.description._sample import sample_chains
 
 __all__ = [
+    "ABB_DRIVE_CLASSES",
     "ABB_RANGE",
     "Chain",
     "DEFAULT_ROBOT",
@@ -64,6 +68,8 @@ __all__ = [
     "RangeSet",
     "RobotDescription",
     "Uncertainty",
+    "abb_drive_class",
+    "abb_drives_path",
     "abb_preset",
     "chain_from_description",
     "chain_from_urdf",

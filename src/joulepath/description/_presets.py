@@ -44,6 +44,16 @@ FAMILY_DEFAULTS = {
 }
 """A family's name -> the variant it stands for (the family's headline variant among those bundled)."""
 
+ABB_DRIVE_CLASSES = {
+    "compact": ("irb140-6-0.8", "irb1200-7-0.7", "irb1200-5-0.9"),
+    "medium": ("irb1600-6-1.2", "irb1600-8-1.45", "irb2600-12-1.65"),
+    "large": ("irb4600-20-2.50", "irb4600-40-2.55", "irb4600-60-2.05"),
+    "heavy": ("irb6700-200-2.60", "irb6700-235-2.65"),
+}
+"""The ABB range by size, for its drive and idle figures: each class's arms share one bundled drives
+file, ``presets/abb-<class>.drives.toml`` (every value assumed, its basis and source given in the file),
+unless a drives file of their own lies beside their description."""
+
 PRESETS = ("irb120", *ABB_RANGE, *FAMILY_DEFAULTS)
 """Names accepted by :func:`preset_path` and :func:`joulepath.load_robot` (variants, then family names)."""
 
@@ -72,6 +82,24 @@ def abb_preset(robot_type: str) -> str | None:
         if fam == family and abs(float(pay) - payload) < 1e-6 and abs(float(rea) - reach) < 1e-6:
             return name
     return None
+
+
+def abb_drive_class(name: str) -> str | None:
+    """The size class of a bundled ABB arm (variant or family name), or None (not of the ABB range).
+
+    >>> abb_drive_class("irb6700"), abb_drive_class("irb1200-5-0.9"), abb_drive_class("irb120")
+    ('heavy', 'compact', None)
+    """
+    variant = preset_variant(name)
+    return next((c for c, arms in ABB_DRIVE_CLASSES.items() if variant in arms), None)
+
+
+def abb_drives_path(name: str) -> Path | None:
+    """The bundled drives file of a bundled ABB arm's size class (:data:`ABB_DRIVE_CLASSES`), or None."""
+    cls = abb_drive_class(name)
+    if cls is None:
+        return None
+    return Path(str(resources.files("joulepath.description") / "presets" / f"abb-{cls}.drives.toml"))
 
 
 def preset_variant(name: str) -> str:

@@ -21,6 +21,8 @@ from joulepath.description import (
     Finding,
     Inertial,
     RobotDescription,
+    abb_drive_class,
+    abb_drives_path,
     chain_from_description,
     chain_from_urdf,
     check_chain,
@@ -45,6 +47,18 @@ weight held at its reach (the IRB 120: about 840 N·m, some 500 times its identi
 TWIN_KINEMATICS_TOLERANCE_MM = 1.0
 """How far tool0 of a twin and of the robot its ``twin_of`` names may lie apart at the same configuration."""
 _IRB120 = re.compile(r"irb[ _-]?120", re.I)
+
+
+def _bundled_abb_drives(source: Path) -> Path | None:
+    """The class drives file of a bundled ABB arm's description (``presets/irb6700-*.irml``), or None."""
+    cls_file = abb_drives_path(source.stem)
+    if cls_file is None or source.stem not in PRESETS:
+        return None
+    if source.resolve().parent != preset_path("irb120").resolve().parent:
+        return None  # a copy elsewhere is the user's robot: its own drives file, if any, beside it
+    return cls_file if cls_file.is_file() else None
+
+
 _FROM_FILES = object()
 FALLBACK_RANGE_SETS = ("lab", "collection")
 """Range sets whose absence falls back to the nominal ranges (:meth:`Robot.ranges_for`)."""
@@ -218,6 +232,13 @@ class Robot:
             beside = src.with_name(src.stem + _energy.DRIVES_SUFFIX)
             if beside.is_file():
                 return _energy.read_drives_file(beside, self.n_joints), f"drives file {beside}"
+            cls_file = _bundled_abb_drives(src)
+            if cls_file is not None:
+                cls = abb_drive_class(src.stem)
+                return (
+                    _energy.read_drives_file(cls_file, self.n_joints),
+                    f"bundled drives file {cls_file} (the {cls} class of the ABB range)",
+                )
         if self.name in NAMED_ARMS:
             bundled = preset_path("irb120").with_name(self.name + _energy.DRIVES_SUFFIX)
             if bundled.is_file():

@@ -56,9 +56,9 @@ CSV_COLUMNS = (
 IDLE_NOTE = (
     "a recommendation, not a saving of the written program: power-saving modes (brakes engaged, bus power "
     "off) entered in the taught cycle's pauses longer than each mode's entry time, at the powers and entry "
-    "times of the robot's drives file (assumed values; the irb120 file scales the per-robot draws that "
-    "Bukata et al., IEEE TII 2017, measured in a six-robot welding cell: motors on 567-751 W, brakes engaged "
-    "218-278 W, bus power off 153-195 W)"
+    "times of the robot's drives file (assumed values; the bundled ABB files, the irb120's and each size "
+    "class's of the ABB range, scale the per-robot draws that Bukata et al., IEEE TII 2017, measured in a "
+    "six-robot welding cell: motors on 567-751 W, brakes engaged 218-278 W, bus power off 153-195 W)"
 )
 
 
