@@ -75,8 +75,10 @@ def run_one(src: Path, name: str, args: list[str], dest: Path) -> None:
         env=env,
         check=False,
     )
-    lines = [line for line in proc.stderr.splitlines() if line.strip()]
-    last = lines[-1].replace(str(dest.resolve()), "<out>") if lines else ""  # where it wrote: not compared
+    # the last line that is not progress (progress lines come at most one a second: which are shown
+    # depends on the machine's speed), where it wrote replaced: the paths of two runs differ
+    lines = [line for line in proc.stderr.splitlines() if line.strip() and not _CLOCK.match(line)]
+    last = lines[-1].replace(str(dest.resolve()), "<out>") if lines else ""
     (out / "exit.json").write_text(
         json.dumps({"rc": proc.returncode, "last_line": last}, indent=1),
         encoding="utf-8",
