@@ -23,7 +23,7 @@ from joulepath.errors import RapidError
 from joulepath.rapid import _standins as standins
 from joulepath.rapid import geometry as geo
 from joulepath.rapid import nodes as n
-from joulepath.rapid._scan import assigned_names, handshake_names, set_names, signal_names
+from joulepath.rapid._scan import assigned_names, handshake_names, set_names, signal_names, written_by_calls
 from joulepath.rapid._state import (
     MAX_SECONDS,
     MAX_STEPS,
@@ -133,8 +133,9 @@ class Machine:
         self.assigned = assigned_names(task)
         self.signals_used = signal_names(task, self.globals)
         self.roles = standins.name_roles(self.task.modules, PROCESS_LINEAR, PROCESS_CIRCULAR)
-        self.set_names = set_names(task, self.routines)
-        self.handshake = handshake_names(task, self.routines, self.globals)
+        written = written_by_calls(task, self.routines)  # the task's calls' arguments matched once
+        self.set_names = set_names(task, written)
+        self.handshake = handshake_names(task, written, self.globals)
         """Data the task only sets back to its declared value: its other values come from outside."""
         self._initialising: set[tuple[str, str]] = set()
 

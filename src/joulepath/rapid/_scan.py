@@ -33,10 +33,11 @@ def assigned_names(task: Task) -> set[str]:
     return out - {""}
 
 
-def set_names(task: Task, routines: Mapping[str, object]) -> set[str]:
-    """Data the task's statements set: assigned, passed to a routine of the task, or written by an
-    instruction that writes its argument (``Incr``, ``TPReadNum``, ``SocketReceive`` ...)."""
-    out = _written_by_calls(task, routines)
+def set_names(task: Task, written: set[str]) -> set[str]:
+    """Data the task's statements set: assigned, or ``written`` by its calls (:func:`written_by_calls`:
+    passed to a routine of the task, or to an instruction that writes its argument: ``Incr``,
+    ``TPReadNum``, ``SocketReceive`` ...)."""
+    out = set(written)
     for s in walk_statements(task):
         if isinstance(s, n.Assign):
             out.add(n.base_name(s.target) or "")
@@ -53,13 +54,13 @@ _DEFAULTS: dict[str, tuple[str, object]] = {
 
 
 def handshake_names(
-    task: Task, routines: Mapping[str, object], declared: Mapping[str, tuple[n.DataDecl, n.Module]]
+    task: Task, written: set[str], declared: Mapping[str, tuple[n.DataDecl, n.Module]]
 ) -> set[str]:
     """Data the task only ever sets back to its declared value (a ``bool``, ``num`` or ``string``
     ``VAR``/``PERS``: a start flag it clears once it acts on it, a job number it resets): its other
     values come from outside the task (a PLC, a PC, the HMI or another task)."""
     rest: set[str] = set()
-    other = _written_by_calls(task, routines)
+    other = set(written)  # what the calls write (:func:`written_by_calls`)
     for s in walk_statements(task):
         if not isinstance(s, n.Assign):
             continue
@@ -87,7 +88,7 @@ def _literal(e: n.Expr) -> tuple[str, object] | None:
     return None
 
 
-def _written_by_calls(task: Task, routines: Mapping[str, object]) -> set[str]:
+def written_by_calls(task: Task, routines: Mapping[str, object]) -> set[str]:
     """Data the task's calls may write: passed to a routine of the task (or one declared nowhere), or
     to an argument an instruction writes."""
     out: set[str] = set()
