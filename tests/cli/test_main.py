@@ -125,3 +125,37 @@ def test_main_demo_and_run_demo_and_make_demo_share_one_folder(monkeypatch, tmp_
     assert recipe is not None
     assert "joulepath run demo\n" in recipe[1] and "--out" not in recipe[1]
     assert "runs/demo/report.html" in recipe[1]
+
+
+def test_main_error_line_names_files_of_a_deep_folder_within_300_characters(capsys, tmp_path, monkeypatch):
+    """Two modules of one name in a task given by a long absolute path: the one error line stays
+    within 300 characters and still names both files (their last parts)."""
+    deep = tmp_path.joinpath(*(f"a_rather_long_folder_name_{k}" for k in range(6)), "TASK1", "PROGMOD")
+    deep.mkdir(parents=True)
+    body = "MODULE MainModule\nPROC main()\n  WaitTime 1;\nENDPROC\nENDMODULE\n"
+    (deep / "first.mod").write_text(body)
+    (deep / "second.mod").write_text(body)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    task = deep.parent
+    assert len(str(task)) > 150
+    assert main(["cycle", str(task), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error:")
+    assert len(err[0]) <= 300, err[0]
+    assert "first.mod" in err[0] and "second.mod" in err[0]
+    assert "MainModule" in err[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_short_paths_keeps_a_short_line_and_shortens_paths_of_a_long_one():
+    from joulepath.cli._main import short_paths
+
+    line = "error: /x/y.mod:3: a name declared twice"
+    assert short_paths(line) == line
+    long_path = "/" + "/".join(f"part{k:02d}_of_a_long_path" for k in range(12)) + "/m.mod"
+    text = f"error: {long_path}:4: one thing; {long_path}:9: another"
+    out = short_paths(text)
+    assert len(out) < 300 < len(text)
+    assert out.count("part11_of_a_long_path/m.mod:") == 2

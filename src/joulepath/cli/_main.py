@@ -10,6 +10,8 @@ after success they are shown as usual.
 from __future__ import annotations
 
 import errno
+import os
+import re
 import sys
 import warnings
 from collections.abc import Sequence
@@ -77,6 +79,33 @@ def _root(
 
 SELF_RECOVERING = frozenset({"run", "demo"})
 """Commands whose stages keep or drop their own folders (``experiment``), not undone as a whole."""
+
+ERROR_LINE_CHARS = 300
+"""Longest error line printed as it is: a longer one names its files shorter (:func:`short_paths`)."""
+_SHORT = 80
+_PATH = re.compile(r"/[^\s:;,()'\"]+(?:/[^\s:;,()'\"]+)+")
+
+
+def short_paths(text: str, limit: int = ERROR_LINE_CHARS) -> str:
+    """``text`` with its file paths written shorter where it is longer than ``limit``: relative to
+    the working folder where that is below it (and short), else the last three parts after an ellipsis (the
+    file stays recognisable; a task's modules differ in their last parts)."""
+    if len(text) <= limit:
+        return text
+
+    def shorter(m: re.Match[str]) -> str:
+        path = m.group(0)
+        try:
+            rel = os.path.relpath(path)
+        except ValueError:
+            rel = path
+        if not rel.startswith("..") and len(rel) <= _SHORT:
+            return rel
+        parts = path.split("/")
+        return path if len(parts) <= 4 else "…/" + "/".join(parts[-3:])
+
+    return _PATH.sub(shorter, text)
+
 
 _FULL = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
 _DENIED = frozenset({errno.EROFS, errno.EACCES, errno.EPERM})
@@ -152,7 +181,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 f"; nothing of this run was kept (the {journal.undone} file(s) it had written were "
                 "removed, and any it had replaced put back)"
             )
-        print(text, file=sys.stderr)
+        print(short_paths(text), file=sys.stderr)
         return code
     _replay(caught)
     return int(result) if isinstance(result, int) else 0
