@@ -613,6 +613,7 @@ def read_cycle_program(
     routine: str | None = None,
     seed: int = 0,
     given: Mapping[str, Any] | None = None,
+    as_written: bool = False,
 ) -> tuple[CycleSpec, bool]:
     """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID task.
 
@@ -626,7 +627,8 @@ def read_cycle_program(
     joulepath wrote is read as the program it was written from (its targets as they are
     now: re-taught ones included; :func:`joulepath.program._rapid_write.restore_program`).
     ``progress`` (optional) is told each move (or step) read once the cycle is within the
-    moves limit.
+    moves limit. ``as_written``: the task as it is (a module joulepath wrote is run as written, not
+    restored), for a run of it rather than an optimization (no static module view either).
     """
     paths = [Path(path)] if isinstance(path, (str, Path)) else [Path(p) for p in path]
     if not paths:
@@ -639,12 +641,12 @@ def read_cycle_program(
         )
     from joulepath.program._task import read_task_cycle
 
-    restored = _restored(paths)
+    restored = None if as_written else _restored(paths)
     if restored is not None:
         paths = [restored]
     tc = read_task_cycle(paths, robot, io=io, routine=routine, seed=seed, progress=progress, given=given)
     steps = _mark_idle(tc, idle_waits)
-    module = _static_view(tc, steps, robot, routine, io)
+    module = None if as_written else _static_view(tc, steps, robot, routine, io)
     if module is not None:
         steps = module[1]
     moves = [st for st in steps if st.kind == "move"]
