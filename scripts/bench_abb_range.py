@@ -85,11 +85,15 @@ def main() -> None:
                 cpu = time.process_time() - cpu
                 s = result.summary
                 desc = robot.description
-                if desc is not None and has_axis3_coupling(desc):  # the controller's axis 3 (q2 + q3) in its range
+                if desc is not None and has_axis3_coupling(
+                    desc
+                ):  # the controller's axis 3 (q2 + q3) in its range
                     axis3 = joints_to_axes(desc, result.optimized.q)[:, 2]
                     lo3, hi3 = np.radians(-60.0), np.radians(65.0)
-                    print(f"  axis 3 (q2 + q3) {np.degrees(axis3.min()):.1f}..{np.degrees(axis3.max()):.1f} deg, "
-                          f"within -60..65: {bool(axis3.min() >= lo3 and axis3.max() <= hi3)}")
+                    print(
+                        f"  axis 3 (q2 + q3) {np.degrees(axis3.min()):.1f}..{np.degrees(axis3.max()):.1f} deg, "
+                        f"within -60..65: {bool(axis3.min() >= lo3 and axis3.max() <= hi3)}"
+                    )
                 stated = saving_over_uncertainty(
                     robot, result.default, result.optimized, prov.uncertainty, seed=0
                 )

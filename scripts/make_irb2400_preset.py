@@ -45,7 +45,6 @@ import make_abb_presets as abb  # noqa: E402
 from joulepath.description import (  # noqa: E402
     Inertial,
     JointDescription,
-    RangeSet,
     RobotDescription,
     irml_string,
 )
