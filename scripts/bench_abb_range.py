@@ -11,7 +11,8 @@ baseline of the robust one) and ``--robust`` (CMA-ES on the expected energy over
 search and verification (``time.process_time``). Writes benchmarks/results/abb_range.csv
 and prints a markdown table.
 
-Run from the repository root: ``PYTHONPATH=src python scripts/bench_abb_range.py``
+Run from the repository root: ``PYTHONPATH=src python scripts/bench_abb_range.py [--only FAMILY]``
+(``--only irb2400``: that family's rows, in ``abb_range_irb2400.csv``).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from joulepath import load_robot
-from joulepath.description import FAMILY_DEFAULTS, provenance_beside
+from joulepath.description import FAMILY_DEFAULTS, has_axis3_coupling, joints_to_axes, provenance_beside
 from joulepath.optimize import (
     ExpectedEnergy,
     OptimizeConfig,
@@ -43,8 +44,13 @@ MOVES = {
 
 
 def main() -> None:
+    import sys
+
+    only = sys.argv[sys.argv.index("--only") + 1] if "--only" in sys.argv else None  # e.g. --only irb2400
     rows = []
-    for variant in FAMILY_DEFAULTS.values():
+    for family, variant in FAMILY_DEFAULTS.items():
+        if only is not None and family != only:
+            continue
         robot = load_robot(variant)
         prov = provenance_beside(robot.source)
         assert prov is not None
@@ -78,6 +84,16 @@ def main() -> None:
                 result = optimize_move(robot, q0, qf, duration, config, models=models)
                 cpu = time.process_time() - cpu
                 s = result.summary
+                desc = robot.description
+                if desc is not None and has_axis3_coupling(
+                    desc
+                ):  # the controller's axis 3 (q2 + q3) in its range
+                    axis3 = joints_to_axes(desc, result.optimized.q)[:, 2]
+                    lo3, hi3 = np.radians(-60.0), np.radians(65.0)
+                    print(
+                        f"  axis 3 (q2 + q3) {np.degrees(axis3.min()):.1f}..{np.degrees(axis3.max()):.1f} deg, "
+                        f"within -60..65: {bool(axis3.min() >= lo3 and axis3.max() <= hi3)}"
+                    )
                 stated = saving_over_uncertainty(
                     robot, result.default, result.optimized, prov.uncertainty, seed=0
                 )
@@ -91,7 +107,7 @@ def main() -> None:
                     }
                 )  # fmt: skip
                 print(rows[-1], flush=True)
-    out = ROOT / "benchmarks" / "results" / "abb_range.csv"
+    out = ROOT / "benchmarks" / "results" / (f"abb_range_{only}.csv" if only else "abb_range.csv")
     with out.open("w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()

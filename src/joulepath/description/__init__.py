@@ -12,6 +12,7 @@ from joulepath.description._chain import (
     transform_inertial,
 )
 from joulepath.description._check import Finding, check_chain, check_inertial, check_physical
+from joulepath.description._coupling import axes_to_joints, has_axis3_coupling, joints_to_axes
 from joulepath.description._irml import irml_string, parse_irml, read_irml, write_irml
 from joulepath.description._model import (
     Chain,
@@ -71,6 +72,7 @@ __all__ = [
     "abb_drive_class",
     "abb_drives_path",
     "abb_preset",
+    "axes_to_joints",
     "chain_from_description",
     "chain_from_urdf",
     "check_chain",
@@ -79,7 +81,9 @@ __all__ = [
     "combine_inertials",
     "dh_link",
     "dh_transform",
+    "has_axis3_coupling",
     "irml_string",
+    "joints_to_axes",
     "named_arm_path",
     "parse_irml",
     "pinocchio_model",

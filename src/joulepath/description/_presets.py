@@ -4,7 +4,9 @@ The ABB range (``irb140-6-0.8`` ... ``irb6700-235-2.65``) is named as ABB names 
 payload and reach (``IRB 4600-40/2.55`` -> ``irb4600-40-2.55``); a family's name alone
 (``irb4600``) is its default variant (:data:`FAMILY_DEFAULTS`). Each of them has a
 ``.provenance.toml`` beside its ``.irml``: its masses and inertias are estimates
-(:func:`joulepath.description.read_provenance`). ``scripts/make_abb_presets.py`` writes them.
+(:func:`joulepath.description.read_provenance`). ``scripts/make_abb_presets.py`` writes them;
+``scripts/make_irb2400_preset.py`` the IRB 2400 (published masses, part-published inertias and
+friction; its axis 3 is coupled to axis 2, see :func:`joulepath.description.axes_to_joints`).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ ABB_RANGE = (
     "irb1200-5-0.9",
     "irb1600-6-1.2",
     "irb1600-8-1.45",
+    "irb2400-12-1.55",
     "irb2600-12-1.65",
     "irb4600-20-2.50",
     "irb4600-40-2.55",
@@ -38,6 +41,7 @@ FAMILY_DEFAULTS = {
     "irb140": "irb140-6-0.8",
     "irb1200": "irb1200-7-0.7",
     "irb1600": "irb1600-8-1.45",
+    "irb2400": "irb2400-12-1.55",
     "irb2600": "irb2600-12-1.65",
     "irb4600": "irb4600-40-2.55",
     "irb6700": "irb6700-200-2.60",
@@ -46,7 +50,7 @@ FAMILY_DEFAULTS = {
 
 ABB_DRIVE_CLASSES = {
     "compact": ("irb140-6-0.8", "irb1200-7-0.7", "irb1200-5-0.9"),
-    "medium": ("irb1600-6-1.2", "irb1600-8-1.45", "irb2600-12-1.65"),
+    "medium": ("irb1600-6-1.2", "irb1600-8-1.45", "irb2400-12-1.55", "irb2600-12-1.65"),
     "large": ("irb4600-20-2.50", "irb4600-40-2.55", "irb4600-60-2.05"),
     "heavy": ("irb6700-200-2.60", "irb6700-235-2.65"),
 }
