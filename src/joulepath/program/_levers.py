@@ -54,6 +54,7 @@ from pathlib import Path
 
 import numpy as np
 
+from joulepath._typing import FloatArray
 from joulepath.dynamics import NOMINAL_FRICTION, Robot
 from joulepath.energy import measure_power
 from joulepath.errors import InvalidInput
@@ -66,6 +67,7 @@ from joulepath.sim import (
     ControllerConfig,
     PathCache,
     PlannedCycle,
+    PlannedMove,
     Plant,
     Step,
     evaluate_cycle,
@@ -378,7 +380,15 @@ def _zone_options(slot: _Slot, spec: CycleSpec) -> list[str]:
 class _Evaluator:
     """The cycle with settings, as the controller emulation runs it: its plan, time and energy."""
 
-    def __init__(self, spec: CycleSpec, slots: list[_Slot], measure: str, config: ControllerConfig) -> None:
+    def __init__(
+        self,
+        spec: CycleSpec,
+        slots: list[_Slot],
+        measure: str,
+        config: ControllerConfig,
+        *,
+        by_runs: bool = False,
+    ) -> None:
         self.spec = spec
         self.slots = slots
         self.measure = measure
@@ -387,6 +397,7 @@ class _Evaluator:
         self.n = 0
         self.memo: dict[tuple[Setting, ...], tuple[PlannedCycle, float, float]] = {}
         self._plant: Plant | None = None
+        self.runs = RunEnergy(measure) if by_runs else None
 
     def spec_with(self, state: tuple[Setting, ...]) -> CycleSpec:
         steps = list(self.spec.steps)
@@ -415,7 +426,13 @@ class _Evaluator:
         return plan, plan.cycle_time, self.energy(plan)
 
     def energy(self, plan: PlannedCycle) -> float:
-        """The physics energy of :func:`joulepath.program._output.check_written` (without the lab's)."""
+        """The physics energy of :func:`joulepath.program._output.check_written` (without the lab's); with
+        ``by_runs`` (a search that plans the cycle many times), as :class:`RunEnergy` sums it: each run
+        of moves between stops on its own grid, found once."""
+        return self.whole_energy(plan) if self.runs is None else self.runs(plan)
+
+    def whole_energy(self, plan: PlannedCycle) -> float:
+        """The physics energy on the cycle's one 2.5 ms grid, as the written-program check takes it."""
         traj = cycle_motion(plan)
         robot = plan.moves[0].step.robot
         assert robot is not None
@@ -431,6 +448,78 @@ class _Evaluator:
         if self._plant is None:
             self._plant = make_plant("lab", robot)
         return trajectory_energy(robot, self._plant, cycle_motion(plan), self.measure)
+
+
+class RunEnergy:
+    """A cycle's energy as the sum of its runs: the moves between two stops (a fine point, a wait),
+    each sampled on its own 2.5 ms grid from its first move's start and found once per run (its
+    moves' paths, profiles and times in it, and where it starts), and the rests between them at the
+    power of holding the arm still there.
+
+    A lever changes the runs it touches; the others keep their energy. The sum is the cycle's energy
+    on the one grid of :func:`cycle_motion` but for where the samples fall (each run's grid starts
+    at its own start): the two differ by the sampling alone (a test bounds it)."""
+
+    def __init__(self, measure: str) -> None:
+        self.measure = measure
+        self._runs: dict[tuple[object, ...], float] = {}
+        self._rests: dict[tuple[int, bytes], float] = {}
+
+    def __call__(self, plan: PlannedCycle) -> float:
+        total, t_free, q_rest = 0.0, 0.0, plan.start
+        robot = plan.moves[0].step.robot
+        for run in _runs(plan):
+            robot = run[0].step.robot
+            total += self.rest_power(robot, q_rest) * max(run[0].t0 - t_free, 0.0)
+            total += self.run(run, q_rest)
+            t_free = max(m.t_end for m in run)
+            q_rest = run[-1].path.q1
+        return total + self.rest_power(robot, q_rest) * max(plan.cycle_time - t_free, 0.0)
+
+    def run(self, run: tuple[PlannedMove, ...], q0: FloatArray) -> float:
+        ta = run[0].t0
+        key = (q0.tobytes(), *((m.path, m.profile, round(m.t0 - ta, 12), id(m.step.robot)) for m in run))
+        found = self._runs.get(key)
+        if found is None:
+            span = max(m.t_end for m in run) - ta
+            n = max(2, int(np.ceil(span / FINE_DT)) + 1)
+            moves = tuple(replace(m, t0=m.t0 - ta) for m in run)
+            traj = evaluate_cycle(PlannedCycle(moves, (), span, q0), np.linspace(0.0, span, n))
+            robot = run[0].step.robot
+            assert robot is not None
+            tau = robot.inverse_dynamics(traj.q, traj.qd, traj.qdd, friction=NOMINAL_FRICTION)
+            power = measure_power(self.measure, tau, traj.qd, robot.drivetrain).value
+            h = span / (n - 1)  # the trapezoid: the run's first and last samples are at its rests' ends
+            found = self._runs[key] = float((power.sum() - 0.5 * (power[0] + power[-1])) * h)
+        return found
+
+    def rest_power(self, robot: Robot | None, q: FloatArray) -> float:
+        """W of holding the arm still at ``q`` (0 on the mechanical measures)."""
+        assert robot is not None
+        key = (id(robot), q.tobytes())
+        found = self._rests.get(key)
+        if found is None:
+            z = np.zeros((1, q.size))
+            tau = robot.inverse_dynamics(q[None], z, z, friction=NOMINAL_FRICTION)
+            found = self._rests[key] = float(measure_power(self.measure, tau, z, robot.drivetrain).value[0])
+        return found
+
+
+def _runs(plan: PlannedCycle) -> list[tuple[PlannedMove, ...]]:
+    """The plan's moves in runs, each ending at a move that stops (or the last); a run that the next
+    overlaps (it would not, after a stop) is joined to it."""
+    runs: list[list[PlannedMove]] = []
+    cur: list[PlannedMove] = []
+    for m in plan.moves:
+        if not cur and runs and m.t0 < max(x.t_end for x in runs[-1]) - 1e-12:
+            cur = runs.pop()
+        cur.append(m)
+        if m.stops:
+            runs.append(cur)
+            cur = []
+    if cur:
+        runs.append(cur)
+    return [tuple(r) for r in runs]
 
 
 def cycle_motion(plan: PlannedCycle) -> Trajectory:
@@ -1055,7 +1144,7 @@ def levers_module(
     config = config or ControllerConfig()
     lines = text.splitlines(keepends=True)
     slots = _slots(spec, lines) if only_lines is None else _only(_slots(spec, lines), set(only_lines))
-    ev = _Evaluator(spec, slots, energy, config)
+    ev = _Evaluator(spec, slots, energy, config, by_runs=True)
     taught_state = tuple(s.taught for s in slots)
     plan0, t0, _ = ev(taught_state)
     e0, lab0 = ev.energies(plan0)
@@ -1067,7 +1156,8 @@ def levers_module(
     idle = _idle_waits(spec, lines) if use_waits else {}
     idle_s = sum(sec * n for sec, n, _, _ in idle.values())
     chosen = _search(ev, slots, target + idle_s, max_evaluations, pairs, bound)
-    _, t_search, e_search = ev(chosen)
+    plan_s, t_search, _ = ev(chosen)
+    e_search = ev.whole_energy(plan_s)  # reported as the check takes it
     new_waits, t_search = _spend_idle(idle, idle_s, t_search, target)
     edits = {line: (idle[line][2], idle[line][3], sec) for line, sec in new_waits.items()}
     written, where = write_levers(spec.module, text, slots, chosen, edits)
