@@ -517,8 +517,10 @@ LINK_FLOORS = np.array([0.1, 0.01, 0.01, 0.01, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-
 """Smallest scale of each of a link's 10 parameters in the pull towards the prior (kg, kg·m, kg·m²)."""
 ARMATURE_SCALE_SHARE = 0.1
 """The scale of a joint's armature in the pull towards the prior: at least this share of the nominal
-mass matrix's diagonal at home (the inertia the joint turns), so that a prior of 0 pulls as weakly as
-an inertia of the link's size does."""
+mass matrix's diagonal at home (the inertia the joint turns), and at least the least-squares value
+(a geared drive's reflected rotor inertia can be many times its wrist link's: 70 kg·m² on a KUKA
+KR300's joint 4, whose link turns 1.2 kg·m²), so that a prior of 0 does not pull an armature the
+data show towards 0."""
 
 
 def _parameter_floors(robot: Robot, n_params: int) -> FloatArray:
@@ -766,6 +768,7 @@ def identify(
         warnings.warn(k.warning(), UnexcitedParameterWarning, stacklevel=2)
     beta_ls, f_ls = x[: base.n], x[base.n :]
     phi = _lift(base, beta_ls, prior)
+    floors[10 * n :] = np.maximum(floors[10 * n :], np.abs(phi[10 * n :]))
     f = f_ls
     if options.consistent:
         lower_f = np.concatenate(
