@@ -66,7 +66,7 @@ def test_exact_recovery_on_the_sim_plant(irb120):
     sim = Plant(name="sim", robot=irb120, friction=NOMINAL_FRICTION)
     data = _exact_data(irb120, sim, 12, seed=3)
     result = identify(data, irb120, IdentifyOptions(gear_efficiency=1.0))
-    truth = base_parameters(irb120).project(true_parameters(irb120))
+    truth = base_parameters(irb120, armature=True).project(true_parameters(irb120, armature=True))
     assert _relative_error(result.beta_ls, truth) < 1e-9
     assert _relative_error(result.beta, truth) < 1e-6  # the consistent refinement keeps it
     np.testing.assert_allclose(result.friction.coulomb, NOMINAL_COULOMB, atol=1e-8)
@@ -86,7 +86,7 @@ def test_exact_recovery_of_a_perturbed_robot_with_stribeck_friction_and_gear_los
     # exact speeds: no sensor noise to read as rest (rest_speed 0: the plant's own side of the gears)
     options = IdentifyOptions(stribeck_speed=friction.stribeck_speed, rest_speed=0.0)
     result = identify(data, irb120, options)
-    truth = base_parameters(irb120).project(true_parameters(real))
+    truth = base_parameters(irb120, armature=True).project(true_parameters(real, armature=True))
     assert abs(result.gear_efficiency - 0.85) < 1e-4
     assert _relative_error(result.beta_ls, truth) < 1e-3
     np.testing.assert_allclose(result.friction.coulomb, friction.coulomb, rtol=1e-3, atol=1e-4)
@@ -97,7 +97,7 @@ def test_exact_recovery_of_a_perturbed_robot_with_stribeck_friction_and_gear_los
 def test_error_shrinks_with_more_noisy_data(irb120):
     """Consistency: with torque noise, 4x the moves gives clearly smaller base-parameter errors."""
     sim = Plant(name="sim", robot=irb120, friction=NOMINAL_FRICTION)
-    truth = base_parameters(irb120).project(true_parameters(irb120))
+    truth = base_parameters(irb120, armature=True).project(true_parameters(irb120, armature=True))
     options = IdentifyOptions(gear_efficiency=1.0, consistent=False)
     errors = {}
     for n in (8, 32):
@@ -211,7 +211,7 @@ def test_generic_log_with_accelerations_recovers_the_sim_plant_exactly(irb120, t
     data = data_from_logs([path], irb120)
     assert data.n_samples == d.n_samples and len(data.data_hash) == 64
     result = identify(data, irb120, IdentifyOptions(gear_efficiency=1.0))
-    truth = base_parameters(irb120).project(true_parameters(irb120))
+    truth = base_parameters(irb120, armature=True).project(true_parameters(irb120, armature=True))
     assert _relative_error(result.beta_ls, truth) < 1e-9
 
 

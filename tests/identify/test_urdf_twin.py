@@ -105,7 +105,7 @@ def test_chain_urdf_string_reads_back_as_the_same_chain(ur5, tmp_path):
 
 
 def test_identify_recovers_the_base_parameters_and_friction_of_a_urdf_arm(ur5, plant, identified):
-    truth = base_parameters(ur5).project(true_parameters(plant.robot))
+    truth = base_parameters(ur5, armature=True).project(true_parameters(plant.robot, armature=True))
     assert identified.kept == ()
     assert _relative(identified.beta_ls, truth) < EXACT
     assert _relative(identified.beta, truth) < EXACT
@@ -162,7 +162,7 @@ def test_a_parameter_the_motion_does_not_excite_keeps_its_prior_with_a_warning(u
         result = identify(_data(plant, q, qd, qdd), ur5, OPTIONS)
     assert [k.name for k in result.kept] == ["joint6.offset"]
     assert result.friction.offset[5] == 0.0
-    truth = base_parameters(ur5).project(true_parameters(plant.robot))
+    truth = base_parameters(ur5, armature=True).project(true_parameters(plant.robot, armature=True))
     assert _relative(result.beta_ls, truth) < EXACT
     np.testing.assert_allclose(result.friction.coulomb, plant.friction.coulomb, rtol=EXACT)
     # the card says which parameter was assumed, from where and why
@@ -192,11 +192,11 @@ def test_an_unexcited_inertial_parameter_keeps_the_nominal_value(ur5, plant):
         result = identify(noisy, ur5, OPTIONS)
     names = [k.name for k in result.kept]
     assert len(record) == len(names)
-    base = base_parameters(ur5)
+    base = base_parameters(ur5, armature=True)
     index = {name: i for i, name in enumerate(base.names)}
     inertial = [name for name in names if name in index]
     assert len(inertial) == 1, names
-    prior = base.project(true_parameters(ur5))
+    prior = base.project(true_parameters(ur5, armature=True))
     kept = index[inertial[0]]
     assert result.beta[kept] == pytest.approx(prior[kept], rel=1e-6)
     assert result.beta_ls[kept] == pytest.approx(prior[kept], rel=1e-12)

@@ -36,6 +36,11 @@ def identify(
         "--viscous-per-direction/--no-viscous-per-direction",
         help="Identify the viscous friction level per direction of motion (a viscous offset per joint).",
     ),
+    armature: bool = typer.Option(
+        True,
+        "--armature/--no-armature",
+        help="Identify an armature per joint (the drives' rotor inertia reflected to the joint, kg·m²).",
+    ),
     gear_efficiency: float = typer.Option(
         0.0,
         "--gear-efficiency",
@@ -120,6 +125,7 @@ def identify(
         max_condition=max_condition,
         holdout=holdout,
         unexcited=unexcited,
+        armature=armature,
     )
     with console.status(f"reading {len(logs)} log(s)..."):
         data = data_from_logs(logs, nominal, signal=signal)

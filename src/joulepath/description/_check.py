@@ -226,6 +226,20 @@ def check_axes(labels: list[str], axes: FloatArray) -> list[Finding]:
     return out
 
 
+def check_armature(labels: list[str], armature: FloatArray) -> list[Finding]:
+    """An error for each joint whose armature (reflected rotor inertia, kg·m²) is negative or not finite."""
+    return [
+        Finding(
+            "error",
+            label,
+            f"armature {float(a):g} kg·m² is not a finite number ≥ 0 (a rotating inertia cannot be "
+            "negative); identify the twin again or remove the value",
+        )
+        for label, a in zip(labels, armature, strict=True)
+        if not (np.isfinite(a) and a >= 0)
+    ]
+
+
 def check_chain(chain: Chain) -> list[Finding]:
     """List everything not physical about a :class:`Chain` (e.g. one read from a URDF).
 
@@ -238,6 +252,7 @@ def check_chain(chain: Chain) -> list[Finding]:
         body = Inertial.from_arrays(chain.masses[i], chain.coms[i], chain.inertias[i])
         out += check_inertial(f"link of {label}", body)
     out += check_axes(labels, chain.axes)
+    out += check_armature(labels, chain.joint_armature)
     out += check_limits(labels, chain.lower, chain.upper, chain.velocity, chain.effort, tag="<limit>")
     out += [Finding("warning", where, message) for where, message in chain.notes]
     out.sort(key=lambda f: f.severity != "error")

@@ -178,6 +178,13 @@ class Chain:
     tool : ndarray of shape (4, 4)
     lower, upper, velocity, effort : ndarray of shape (n,)
         rad, rad/s, N·m; NaN where unknown.
+    armature : ndarray of shape (n,) or None
+        kg·m², per joint: the drive's rotating inertia reflected to the joint, ``J_rotor *
+        ratio²`` (motor rotor and gear input side), which adds ``armature[i] * qdd[i]`` to the
+        torque of joint ``i`` and ``armature[i]`` to the mass matrix's diagonal (Pinocchio's
+        ``model.armature``). It is the one definition of the quantity: every dynamics of the chain
+        (RNEA, Lagrange–Euler, mass matrix, forward dynamics) and identification use it. None: no
+        armature (zero), as for a description that gives none (URDF and IRML do not).
     """
 
     name: str
@@ -195,7 +202,15 @@ class Chain:
     gravity: FloatArray = field(default_factory=lambda: np.array([0.0, 0.0, -9.80665]))
     notes: tuple[tuple[str, str], ...] = ()
     """``(where, message)`` warnings from reading the description (e.g. a joint named like a gripper)."""
+    armature: FloatArray | None = None
 
     @property
     def n_joints(self) -> int:
         return len(self.joint_names)
+
+    @property
+    def joint_armature(self) -> FloatArray:
+        """:attr:`armature` as an array of ``n`` values (zeros where none is given), kg·m²."""
+        if self.armature is None:
+            return np.zeros(self.n_joints)
+        return np.asarray(self.armature, dtype=float).copy()

@@ -481,4 +481,6 @@ def pinocchio_model(chain: Chain) -> Any:
     tool = pin.SE3(chain.tool[:3, :3].copy(), chain.tool[:3, 3].copy())
     model.addFrame(pin.Frame("tool0", parent, tool, pin.FrameType.OP_FRAME))
     model.gravity = pin.Motion(np.concatenate([chain.gravity, np.zeros(3)]))
+    if chain.armature is not None:
+        model.armature = chain.joint_armature  # in RNEA, CRBA and ABA: armature * qdd, diag of M
     return model

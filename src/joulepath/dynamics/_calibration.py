@@ -8,8 +8,10 @@ once, read by :func:`joulepath.load_robot` and written by :mod:`joulepath.identi
   from a URDF (a named arm, a ``.urdf`` file) :data:`TWIN_URDF_FILE` instead: the arm as
   joulepath reads it (locked joints fixed, fixed links merged) written as a serial URDF
   with the identified inertials. A folder holds one of the two, never both;
-* :data:`TWIN_FRICTION_FILE` — JSON: the identified :class:`IdentifiedFriction`
-  and the drives' gear efficiency;
+* :data:`TWIN_FRICTION_FILE` — JSON: the identified :class:`IdentifiedFriction`,
+  the drives' gear efficiency and (when identified) their armature, the reflected rotor
+  inertia per joint (kg·m², :attr:`joulepath.description.Chain.armature`; neither URDF nor
+  IRML has a place for it, so it is written with the other drive terms);
 * :data:`TWIN_CARD_FILE` — JSON: what the twin was identified from and how well it fits.
 
 Loading a twin never executes code: the friction file is plain JSON checked field by field.
@@ -127,6 +129,8 @@ class Calibration:
     gear_efficiency: float = 1.0
     twin_of: str | None = None
     folder: str | None = None
+    armature: tuple[float, ...] = ()
+    """kg·m² per joint (:attr:`joulepath.description.Chain.armature`); empty: none identified."""
 
     def motor_torque(self, tau: FloatArray, qd: FloatArray) -> FloatArray:
         """Joint torque ``tau`` as the drives measure it (see :func:`motor_torque`)."""
@@ -138,6 +142,7 @@ class Calibration:
             "twin_of": self.twin_of,
             "gear_efficiency": self.gear_efficiency,
             "friction": self.friction.to_json(),
+            **({"armature": list(self.armature)} if len(self.armature) else {}),
         }
 
 
@@ -196,7 +201,22 @@ def read_calibration(path: str | os.PathLike[str], n_joints: int) -> Calibration
             else ()
         ),
     )
-    return Calibration(friction=friction, gear_efficiency=float(eta), twin_of=twin_of, folder=str(p.parent))
+    armature: tuple[float, ...] = ()
+    if "armature" in data:
+        armature = _floats(data["armature"], f"{p}: armature", n_joints)
+        bad = [j + 1 for j, a in enumerate(armature) if a < 0]
+        if bad:
+            raise InvalidRobotDescription(
+                f"{p}: armature of joint {bad[0]} is {armature[bad[0] - 1]:g} kg·m²; a rotating inertia "
+                "cannot be negative: identify the twin again"
+            )
+    return Calibration(
+        friction=friction,
+        gear_efficiency=float(eta),
+        twin_of=twin_of,
+        folder=str(p.parent),
+        armature=armature,
+    )
 
 
 def twin_paths(folder: str | os.PathLike[str]) -> tuple[Path, Path]:

@@ -63,6 +63,7 @@ def mass_matrix_le(chain: Chain, q: FloatArray) -> FloatArray:
     out: FloatArray = np.einsum("Nkia,Nkja,k->Nij", a, a, chain.masses) + np.einsum(
         "Nkia,Nkab,Nkjb->Nij", b, dw, b
     )
+    out += np.diag(chain.joint_armature)  # the drives' reflected rotor inertia (Chain.armature)
     return out
 
 
@@ -97,5 +98,5 @@ def lagrange_euler(chain: Chain, q: FloatArray, qd: FloatArray, qdd: FloatArray)
     # C^i_kj = dD_ij/dq_k - 1/2 dD_kj/dq_i ; d_mass[N, l, i, j] = dD_ij / dq_l
     coupling = np.einsum("Nkij,Nk,Nj->Ni", d_mass, qd, qd) - 0.5 * np.einsum("Nikj,Nk,Nj->Ni", d_mass, qd, qd)
     gravity = -np.einsum("Nkia,k,a->Ni", a, m, chain.gravity)
-    out: FloatArray = np.einsum("Nij,Nj->Ni", mass, qdd) + coupling + gravity
+    out: FloatArray = np.einsum("Nij,Nj->Ni", mass, qdd) + coupling + gravity + chain.joint_armature * qdd
     return out

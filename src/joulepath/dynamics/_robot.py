@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import re
+from dataclasses import replace
 from functools import cached_property
 from pathlib import Path
 from typing import Any
@@ -471,7 +472,9 @@ class Robot:
         if mass < 0 or (mass > 0 and inertia is not None and problems):
             raise InvalidInput("; ".join(str(p) for p in problems) or "payload mass must be ≥ 0")
         if self.description is not None:
-            chain = chain_from_description(self.description, payload=load)
+            chain = replace(
+                chain_from_description(self.description, payload=load), armature=self.chain.armature
+            )
         else:
             from joulepath.description import combine_inertials, transform_inertial
 
@@ -481,8 +484,6 @@ class Robot:
             coms = self.chain.coms.copy()
             inertias = self.chain.inertias.copy()
             masses[-1], coms[-1], inertias[-1] = last.mass, last.com_array, last.inertia_array
-            from dataclasses import replace
-
             chain = replace(self.chain, masses=masses, coms=coms, inertias=inertias)
         return Robot(
             chain,
@@ -612,7 +613,8 @@ def load_robot(
 
 
 def _load_twin(folder: Path, *, checked: bool) -> Robot:
-    """A twin folder (``joulepath identify --out``): its IRML robot with its identified friction."""
+    """A twin folder (``joulepath identify --out``): its robot with its identified friction, drive
+    losses and armature (:attr:`Calibration.armature`, set as the chain's :attr:`Chain.armature`)."""
     robot_file, friction_file = twin_paths(folder)
     robot = load_robot(robot_file, checked=checked)
     calibration = read_calibration(friction_file, robot.n_joints)
@@ -626,6 +628,15 @@ def _load_twin(folder: Path, *, checked: bool) -> Robot:
         stribeck=np.array(f.stribeck),
     )
     _check_twin_of(robot, calibration.twin_of, str(friction_file))
+    if calibration.armature:
+        # the drives' identified armature (friction file) joins the chain: every dynamics uses it
+        twin = Robot(
+            replace(robot.chain, armature=np.array(calibration.armature)),
+            description=robot.description,
+            source=robot.source,
+            calibration=calibration,
+        )  # read_calibration refused a negative armature
+        return twin
     robot.calibration = calibration
     return robot
 

@@ -3,8 +3,9 @@
 Steps (:func:`identify`):
 
 1. **Regressor.** ``tau = [Y_b(q, qd, qdd) | F(qd)] x`` stacked over every sample and
-   joint: ``Y_b`` the base columns of Pinocchio's joint torque regressor
-   (:func:`~joulepath.identify.base_parameters`), ``F`` the friction columns.
+   joint: ``Y_b`` the base columns of Pinocchio's joint torque regressor with, by default,
+   one armature column per joint (the drives' reflected rotor inertia, ``armature_i *
+   qdd_i``; :func:`~joulepath.identify.base_parameters`), ``F`` the friction columns.
 2. **Excitation.** The condition number of the stacked regressor with unit-norm
    columns (weighted rows). Data that leave a parameter unexcited (a joint that never
    moves, a condition number over ``max_condition``) are refused with the parameter
@@ -20,8 +21,8 @@ Steps (:func:`identify`):
    construction) with ``scipy.optimize.least_squares``: the same weighted data
    residual (through a QR compression of the full regressor), plus a small pull
    towards the nominal parameters (``prior_weight``) that fixes the directions the data
-   cannot see (which do not change any torque). Friction coefficients are kept ≥ 0
-   (the offset may take either sign). Started from the least-squares base solution
+   cannot see (which do not change any torque). Friction coefficients and the armature
+   are kept ≥ 0 (the offset may take either sign). Started from the least-squares base solution
    lifted onto the nominal parameters (minimum-norm change), or from the nominal
    parameters when that lift is not consistent.
 """
@@ -47,8 +48,8 @@ from joulepath.identify._data import IdentificationData
 from joulepath.identify._regressor import (
     BaseParameters,
     base_parameters,
+    dynamic_regressor,
     friction_regressor,
-    inertial_regressor,
     true_parameters,
 )
 
@@ -148,6 +149,13 @@ class IdentifyOptions:
         rad/s: a sample whose every joint speed is within this counts as the arm at rest
         for the side of the gear losses (:func:`gear_side_speed`): logged speeds that small
         are sensor noise. 0 for exact speeds (a plant's signals).
+    armature : bool
+        Identify an armature per joint (the drives' rotating inertia reflected to the joint,
+        ``armature_i * qdd_i``, :attr:`joulepath.description.Chain.armature`), ≥ 0 in the
+        consistent refinement. A log of motor torques holds it (KUKA KR300: +0.02 to +0.04
+        held-out torque R², ``benchmarks/identify_real.py``); a joint-side torque sensor
+        after the gear does not (it reads about 0 there). Its prior is the robot's own armature
+        (0 for a URDF or IRML arm). False: the rigid-body links only (the twin has no armature).
     """
 
     offset: bool = True
@@ -162,6 +170,7 @@ class IdentifyOptions:
     holdout: float = 0.0
     unexcited: str = "prior"
     rest_speed: float = GEAR_REST_SPEED
+    armature: bool = True
 
     def __post_init__(self) -> None:
         if not self.smoothing > 0:
@@ -225,6 +234,9 @@ class Identification:
         On the fitted samples; on the held-out ones (None without a hold-out).
     min_pseudo_inertia_eig : ndarray of shape (n,)
         Smallest eigenvalue of each link's pseudo-inertia (> 0: consistent).
+    armature : ndarray of shape (n,) or None
+        kg·m² per joint (:attr:`joulepath.description.Chain.armature`), ≥ 0 when ``consistent``;
+        None when not identified (``IdentifyOptions(armature=False)``).
     """
 
     robot_name: str
@@ -244,16 +256,23 @@ class Identification:
     data_hash: str = ""
     sources: tuple[str, ...] = field(default=())
     kept: tuple[KeptParameter, ...] = field(default=())
+    armature: FloatArray | None = None
+
+    @property
+    def parameters(self) -> FloatArray:
+        """The full parameters the base set is of: :attr:`phi`, then :attr:`armature` if identified."""
+        return self.phi if self.armature is None else np.concatenate([self.phi, self.armature])
 
     @property
     def beta(self) -> FloatArray:
-        """Base parameters of :attr:`phi` (equal to :attr:`beta_ls` up to the consistency constraint)."""
-        return self.base.project(self.phi)
+        """Base parameters of :attr:`parameters` (:attr:`beta_ls` up to the consistency constraint)."""
+        return self.base.project(self.parameters)
 
     def joint_torque(self, robot: Robot, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
-        """Joint-side torque ``Y phi + F f`` (N·m) for samples ``(N, n)``; ``robot`` gives the kinematics."""
-        Y = inertial_regressor(robot, q, qd, qdd)
-        out: FloatArray = Y @ self.phi + self.friction.torque(qd)
+        """Joint-side torque ``Y phi + armature qdd + F f`` (N·m) for samples ``(N, n)``; ``robot``
+        gives the kinematics."""
+        Y = dynamic_regressor(robot, q, qd, qdd, armature=self.armature is not None)
+        out: FloatArray = Y @ self.parameters + self.friction.torque(qd)
         return out
 
     def motor_torque(self, robot: Robot, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
@@ -273,6 +292,7 @@ class Identification:
             "gear_efficiency": self.gear_efficiency,
             "physically_consistent": self.consistent,
             "min_pseudo_inertia_eigenvalue": [float(v) for v in self.min_pseudo_inertia_eig],
+            "armature": None if self.armature is None else [float(v) for v in self.armature],
             "fit": asdict(self.fit),
             "held_out": None if self.held_out is None else asdict(self.held_out),
             "options": asdict(self.options),
@@ -493,12 +513,33 @@ def _lift(base: BaseParameters, beta: FloatArray, prior: FloatArray) -> FloatArr
     return out
 
 
-def _prior_scale(prior: FloatArray) -> FloatArray:
-    floors = np.array([0.1, 0.01, 0.01, 0.01, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
-    n = prior.size // 10
-    out: FloatArray = np.maximum(np.abs(prior), np.tile(floors, n))
+LINK_FLOORS = np.array([0.1, 0.01, 0.01, 0.01, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
+"""Smallest scale of each of a link's 10 parameters in the pull towards the prior (kg, kg·m, kg·m²)."""
+ARMATURE_SCALE_SHARE = 0.1
+"""The scale of a joint's armature in the pull towards the prior: at least this share of the nominal
+mass matrix's diagonal at home (the inertia the joint turns), and at least the least-squares value
+(a geared drive's reflected rotor inertia can be many times its wrist link's: 70 kg·m² on a KUKA
+KR300's joint 4, whose link turns 1.2 kg·m²), so that a prior of 0 does not pull an armature the
+data show towards 0."""
+
+
+def _parameter_floors(robot: Robot, n_params: int) -> FloatArray:
+    """Smallest scale of each full parameter (``10 n`` inertial, then the armature if any)."""
+    n = robot.n_joints
+    floors = np.tile(LINK_FLOORS, n)
+    if n_params == 10 * n:
+        return floors
+    turned = np.diag(np.asarray(robot.mass_matrix(robot.home), dtype=float))
+    return np.concatenate([floors, np.maximum(ARMATURE_SCALE_SHARE * turned, 1e-3)])
+
+
+def _prior_scale(prior: FloatArray, floors: FloatArray) -> FloatArray:
+    out: FloatArray = np.maximum(np.abs(prior), floors)
     return out
 
+
+CONSISTENT_MAX_NFEV = 300
+"""Most residual evaluations of the consistent refinement."""
 
 CONSISTENT_TOL = 1e-12
 """kg·m²: a link's pseudo-inertia with its smallest eigenvalue above minus this is consistent (an
@@ -518,18 +559,24 @@ def _consistent(
     prior_weight: float,
     held: tuple[FloatArray, FloatArray, FloatArray],
     f_fixed: dict[int, float],
+    *,
+    floors: FloatArray,
+    max_nfev: int,
 ) -> tuple[FloatArray, FloatArray]:
     """``held = (G, g, scale)``: rows ``G @ phi = g`` held with weight :data:`KEPT_WEIGHT` (base
     parameters kept at their priors, each row divided by its scale); ``f_fixed``: friction
-    coefficients (by index) kept at these values, not searched."""
+    coefficients (by index) kept at these values, not searched. ``phi`` (``start_phi``, ``prior``,
+    ``Y``'s columns) holds ``10 n`` link parameters (searched in log-Cholesky coordinates), then
+    the armature if any (searched ≥ 0)."""
     N, n, n_phi = Y.shape
     A = np.concatenate([Y, F], axis=2) * w[None, :, None]
     b = (tau_joint * w).reshape(-1, 1)
     Raug = scipy.linalg.qr(np.hstack([A.reshape(-1, A.shape[2]), b]), mode="r")[0]
     q = A.shape[2]
     R, c = Raug[:q, :q], Raug[:q, q]
-    scale = _prior_scale(prior)
-    links = n_phi // 10
+    scale = _prior_scale(prior, floors)
+    links = n
+    n_arm = n_phi - 10 * links
     reg = np.sqrt(prior_weight * N * n)
     G, g, g_scale = held
     hold = KEPT_WEIGHT * float(np.abs(R).max()) * g_scale  # per unit of the parameter, 1e3 x the data's
@@ -541,11 +588,12 @@ def _consistent(
         f_all[k] = v
 
     def phi_of(z: FloatArray) -> FloatArray:
-        return np.concatenate([from_log_cholesky(z[10 * i : 10 * i + 10]) for i in range(links)])
+        bodies = [from_log_cholesky(z[10 * i : 10 * i + 10]) for i in range(links)]
+        return np.concatenate([*bodies, z[10 * links : 10 * links + n_arm]])
 
     def f_of(z: FloatArray) -> FloatArray:
         out = f_all.copy()
-        out[free_f] = z[10 * links :]
+        out[free_f] = z[10 * links + n_arm :]
         return out
 
     def residual(z: FloatArray) -> FloatArray:
@@ -560,13 +608,14 @@ def _consistent(
         theta0 = np.concatenate([to_log_cholesky(start_phi[10 * i : 10 * i + 10]) for i in range(links)])
     except np.linalg.LinAlgError:
         theta0 = np.concatenate([to_log_cholesky(prior[10 * i : 10 * i + 10]) for i in range(links)])
+    arm0 = np.maximum(start_phi[10 * links :], 1e-6 * floors[10 * links :])
     f0 = np.maximum(start_f, lower_f + 1e-9)[free_f]
-    z0 = np.concatenate([theta0, f0])
-    lo = np.concatenate([np.full(theta0.size, -np.inf), lower_f[free_f]])
+    z0 = np.concatenate([theta0, arm0, f0])
+    lo = np.concatenate([np.full(theta0.size, -np.inf), np.zeros(n_arm), lower_f[free_f]])
     # a trial step the residual marks with its 1e150 sentinel overflows in the solver's cost
     # (0.5 f·f); the solver rejects that step, so the overflow is no error
     with np.errstate(over="ignore"):
-        sol = least_squares(residual, z0, bounds=(lo, np.inf), method="trf", x_scale="jac", max_nfev=300)
+        sol = least_squares(residual, z0, bounds=(lo, np.inf), method="trf", x_scale="jac", max_nfev=max_nfev)
     return phi_of(sol.x), f_of(sol.x)
 
 
@@ -582,8 +631,16 @@ def _prior_values(
     n = robot.n_joints
     beta = base.project(prior)
     values = list(beta)
-    sources = [f"nominal description of {robot.name}"] * base.n
-    known = [True] * base.n
+    given = robot.chain.armature is not None
+    sources = [
+        (
+            f"nominal description of {robot.name}"
+            if not name.endswith(".armature")
+            else f"the armature of {robot.name}" + ("" if given else " (none given: 0)")
+        )
+        for name in base.names
+    ]
+    known = [given or not name.endswith(".armature") for name in base.names]
     friction = robot.friction
     for t in terms:
         level = getattr(friction, t, None) if friction is not None else None
@@ -606,15 +663,14 @@ def _prior_values(
 
 
 def _held_rows(
-    base: BaseParameters, kept: list[int], prior_x: FloatArray
+    base: BaseParameters, kept: list[int], prior_x: FloatArray, floors: FloatArray
 ) -> tuple[tuple[FloatArray, FloatArray, FloatArray], dict[int, float]]:
     """Rows ``G phi = g`` (with scales) that hold the kept base parameters at their priors, and the
     kept friction coefficients (index into the friction columns: value)."""
     B = base.matrix()
     rows = [i for i in kept if i < base.n]
-    floors = np.array([0.1, 0.01, 0.01, 0.01, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
     scale = np.array(
-        [max(abs(float(prior_x[i])), floors[int(base.independent[i]) % 10]) for i in rows], dtype=float
+        [max(abs(float(prior_x[i])), floors[int(base.independent[i])]) for i in rows], dtype=float
     )
     friction = {i - base.n: float(prior_x[i]) for i in kept if i >= base.n}
     return (B[rows], prior_x[rows], scale), friction
@@ -651,7 +707,7 @@ def identify(
         cut = int(round((1.0 - options.holdout) * data.n_samples))
         idx = np.arange(data.n_samples)
         fit_data, held = data.subset(idx < cut), data.subset(idx >= cut)
-    base = base_parameters(robot)
+    base = base_parameters(robot, armature=options.armature)
     n = robot.n_joints
     F, terms = friction_regressor(
         fit_data.qd,
@@ -661,11 +717,12 @@ def identify(
         viscous_offset=options.viscous_offset,
     )
     _check_motion(fit_data, base.n + F.shape[2])
-    Y = inertial_regressor(robot, fit_data.q, fit_data.qd, fit_data.qdd)
+    Y = dynamic_regressor(robot, fit_data.q, fit_data.qd, fit_data.qdd, armature=options.armature)
     A = np.concatenate([Y[:, :, base.independent], F], axis=2)
     names = (*base.names, *(f"joint{j + 1}.{t}" for t in terms for j in range(n)))
     side = gear_side_speed(fit_data.qd, options.rest_speed)
-    prior = true_parameters(robot)
+    prior = true_parameters(robot, armature=options.armature)
+    floors = _parameter_floors(robot, prior.size)
     prior_x, prior_sources, prior_known = _prior_values(robot, base, prior, terms)
     problem = _Problem(A, fit_data.tau, side, prior_x)
     w = np.ones(n)
@@ -711,6 +768,7 @@ def identify(
         warnings.warn(k.warning(), UnexcitedParameterWarning, stacklevel=2)
     beta_ls, f_ls = x[: base.n], x[base.n :]
     phi = _lift(base, beta_ls, prior)
+    floors[10 * n :] = np.maximum(floors[10 * n :], np.abs(phi[10 * n :]))
     f = f_ls
     if options.consistent:
         lower_f = np.concatenate(
@@ -726,20 +784,23 @@ def identify(
             prior,
             lower_f,
             options.prior_weight,
-            *_held_rows(base, kept, prior_x),
+            *_held_rows(base, kept, prior_x, floors),
+            floors=floors,
+            max_nfev=CONSISTENT_MAX_NFEV,
         )
     friction = _friction_of(f, terms, n, options)
-    eig = min_eigenvalues(phi)
+    armature = phi[10 * n :] if options.armature else None
+    eig = min_eigenvalues(phi[: 10 * n])
 
     def predict(d: IdentificationData) -> FloatArray:
-        Yd = inertial_regressor(robot, d.q, d.qd, d.qdd)
+        Yd = dynamic_regressor(robot, d.q, d.qd, d.qdd, armature=options.armature)
         return motor_torque(Yd @ phi + friction.torque(d.qd), gear_side_speed(d.qd, options.rest_speed), eta)
 
     return Identification(
         robot_name=robot.name,
         base=base,
         beta_ls=beta_ls,
-        phi=phi,
+        phi=phi[: 10 * n],
         friction=friction,
         gear_efficiency=eta,
         condition_number=cond,
@@ -748,11 +809,12 @@ def identify(
         fit=score_prediction(motor_torque(Y @ phi + friction.torque(fit_data.qd), side, eta), fit_data),
         held_out=None if held is None else score_prediction(predict(held), held),
         min_pseudo_inertia_eig=eig,
-        consistent=bool(np.all(eig > -CONSISTENT_TOL)),
+        consistent=bool(np.all(eig > -CONSISTENT_TOL)) and (armature is None or bool(np.all(armature >= 0))),
         options=options,
         data_hash=data.data_hash,
         sources=data.sources,
         kept=kept_parameters,
+        armature=armature,
     )
 
 

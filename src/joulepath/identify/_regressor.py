@@ -14,6 +14,13 @@ parameters are ``beta = phi[indep] + K phi[dep]`` and ``Y phi = Y[:, indep] beta
 for every motion. A column counts as independent when its pivot exceeds
 :data:`RANK_TOLERANCE` times the largest one.
 
+Armature (optional, ``armature=True``): per joint ``i`` one more parameter, the drive's
+rotating inertia reflected to the joint (:attr:`joulepath.description.Chain.armature`), whose
+column is ``qdd_i`` in joint ``i``'s row and 0 elsewhere; the full parameters are then ``10 n +
+n``: ``[phi, armature]``. On a joint whose axis never turns (a first joint about the vertical)
+the armature acts exactly as the link's inertia about that axis: the base set regroups the two
+(structurally, as any other dependent column).
+
 Friction: per joint, the columns ``s``, ``qd``, ``|s|`` and (optionally)
 ``exp(-(qd/v_s)²) s`` with ``s = tanh(qd / smoothing)`` (see
 :class:`joulepath.dynamics.IdentifiedFriction`).
@@ -51,10 +58,34 @@ def inertial_regressor(robot: Robot, q: FloatArray, qd: FloatArray, qdd: FloatAr
     return out
 
 
-def true_parameters(robot: Robot) -> FloatArray:
-    """The robot's own inertial parameters ``phi`` (``10 n``), in the regressor's order."""
+def armature_regressor(qdd: FloatArray) -> FloatArray:
+    """Armature columns ``(N, n, n)``: ``tau[k, i] += armature[i] * qdd[k, i]``."""
+    N, n = qdd.shape
+    out = np.zeros((N, n, n))
+    idx = np.arange(n)
+    out[:, idx, idx] = qdd
+    return out
+
+
+def dynamic_regressor(
+    robot: Robot, q: FloatArray, qd: FloatArray, qdd: FloatArray, *, armature: bool
+) -> FloatArray:
+    """The rigid-body regressor (:func:`inertial_regressor`), followed by the armature columns
+    (:func:`armature_regressor`) when ``armature``: ``(N, n, 10 n [+ n])``."""
+    Y = inertial_regressor(robot, q, qd, qdd)
+    if not armature:
+        return Y
+    return np.concatenate([Y, armature_regressor(qdd)], axis=2)
+
+
+def true_parameters(robot: Robot, *, armature: bool = False) -> FloatArray:
+    """The robot's own parameters in the regressor's order: ``phi`` (``10 n``), followed by its
+    armature (:attr:`joulepath.description.Chain.armature`, ``n``) when ``armature``."""
     model = robot.pinocchio_model
-    return np.concatenate([model.inertias[i + 1].toDynamicParameters() for i in range(robot.n_joints)])
+    phi = np.concatenate([model.inertias[i + 1].toDynamicParameters() for i in range(robot.n_joints)])
+    if not armature:
+        return phi
+    return np.concatenate([phi, robot.chain.joint_armature])
 
 
 def friction_regressor(
@@ -101,7 +132,7 @@ class BaseParameters:
         Columns of ``Y`` kept: base parameter ``k`` is ``phi[independent[k]]`` plus ...
     dependent : ndarray of int
         ... the columns regrouped into it ...
-    combination : ndarray of shape (r, 10 n - r)
+    combination : ndarray of shape (r, p - r)
         ... with these weights: ``beta = phi[independent] + combination @ phi[dependent]``.
     names : tuple of str
         ``link<i>.<parameter>`` of each base parameter's leading column.
@@ -117,12 +148,13 @@ class BaseParameters:
         return int(self.independent.size)
 
     def project(self, phi: FloatArray) -> FloatArray:
-        """Base parameters of full parameters ``phi`` (``(..., 10 n)`` -> ``(..., r)``)."""
+        """Base parameters of full parameters ``phi`` (``(..., p)`` -> ``(..., r)``; ``p`` is ``10 n``,
+        or ``11 n`` with the armature)."""
         out: FloatArray = phi[..., self.independent] + phi[..., self.dependent] @ self.combination.T
         return out
 
     def matrix(self) -> FloatArray:
-        """``B`` of shape ``(r, 10 n)`` with ``beta = B @ phi``."""
+        """``B`` of shape ``(r, p)`` with ``beta = B @ phi``."""
         n_phi = self.independent.size + self.dependent.size
         B = np.zeros((self.n, n_phi))
         B[np.arange(self.n), self.independent] = 1.0
@@ -130,13 +162,18 @@ class BaseParameters:
         return B
 
 
-def parameter_names(n_joints: int) -> tuple[str, ...]:
-    return tuple(f"link{i + 1}.{p}" for i in range(n_joints) for p in PARAMETER_NAMES)
+def parameter_names(n_joints: int, *, armature: bool = False) -> tuple[str, ...]:
+    """``link<i>.<parameter>`` of the ``10 n`` inertial parameters, then ``joint<i>.armature``."""
+    links = tuple(f"link{i + 1}.{p}" for i in range(n_joints) for p in PARAMETER_NAMES)
+    return links + (tuple(f"joint{i + 1}.armature" for i in range(n_joints)) if armature else ())
 
 
-def base_parameters(robot: Robot, *, samples: int = 40, seed: int = 0) -> BaseParameters:
-    """The base set of ``robot`` (structural: from random motions, cached per robot chain)."""
-    return _base_cached(_ChainKey(robot), samples, seed)
+def base_parameters(
+    robot: Robot, *, armature: bool = False, samples: int = 40, seed: int = 0
+) -> BaseParameters:
+    """The base set of ``robot`` (structural: from random motions, cached per robot chain), of the
+    inertial parameters and, when ``armature``, the armature (:func:`dynamic_regressor`)."""
+    return _base_cached(_ChainKey(robot), samples, seed, armature)
 
 
 class _ChainKey:
@@ -155,21 +192,22 @@ class _ChainKey:
 
 
 @cache
-def _base_cached(key: _ChainKey, samples: int, seed: int) -> BaseParameters:
+def _base_cached(key: _ChainKey, samples: int, seed: int, armature: bool) -> BaseParameters:
     robot = key.robot
     n = robot.n_joints
     rng = np.random.default_rng(seed)
     q = rng.uniform(-np.pi, np.pi, (samples, n))
     qd = rng.normal(0.0, 2.0, (samples, n))
     qdd = rng.normal(0.0, 5.0, (samples, n))
-    W = inertial_regressor(robot, q, qd, qdd).reshape(-1, 10 * n)
+    Y = dynamic_regressor(robot, q, qd, qdd, armature=armature)
+    W = Y.reshape(-1, Y.shape[2])
     _, R, piv = scipy.linalg.qr(W, mode="economic", pivoting=True)
     d = np.abs(np.diag(R))
     r = int(np.sum(d > RANK_TOLERANCE * d[0]))
     independent, dependent = piv[:r], piv[r:]
     K = scipy.linalg.solve_triangular(R[:r, :r], R[:r, r:])
     K[np.abs(K) < 1e-12] = 0.0
-    names = parameter_names(n)
+    names = parameter_names(n, armature=armature)
     return BaseParameters(
         independent=np.asarray(independent),
         dependent=np.asarray(dependent),
@@ -183,7 +221,9 @@ __all__ = [
     "FRICTION_TERMS",
     "PARAMETER_NAMES",
     "RANK_TOLERANCE",
+    "armature_regressor",
     "base_parameters",
+    "dynamic_regressor",
     "friction_regressor",
     "inertial_regressor",
     "parameter_names",

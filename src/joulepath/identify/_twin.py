@@ -11,7 +11,10 @@ and read back by :func:`joulepath.load_robot`:
   nominal URDF, locked joints fixed, fixed links merged) with the identified inertials,
   written as a serial URDF (:func:`joulepath.identify._urdf.chain_urdf_string`); the
   nominal URDF (with its meshes) is the one ``twin_of`` names;
-* ``friction.json`` — identified friction and gear efficiency;
+* ``friction.json`` — identified friction, gear efficiency and armature (the drives' reflected
+  rotor inertia per joint, :attr:`joulepath.description.Chain.armature`: neither URDF nor IRML
+  has a place for it, so it lives with the other drive terms; ``load_robot`` sets it on the
+  twin's chain, and every dynamics of the twin uses it);
 * ``card.json`` — data hash, fit and held-out scores, condition number, base parameters,
   ``robot_file`` (which of the two robot files the folder holds), ``kept_at_prior`` (the
   parameters the logs left unexcited, each with its prior, where the prior comes from and
@@ -118,6 +121,7 @@ def twin_chain(nominal: Robot, ident: Identification) -> Chain:
         masses=np.array([b.mass for b in bodies]),
         coms=np.array([b.com_array for b in bodies]),
         inertias=np.array([b.inertia_array for b in bodies]),
+        armature=None if ident.armature is None else np.array(ident.armature, dtype=float),
     )
 
 
@@ -132,12 +136,16 @@ def twin_robot(nominal: Robot, ident: Identification) -> Robot:
         friction=ident.friction,
         gear_efficiency=ident.gear_efficiency,
         twin_of=load_name(nominal),
+        armature=() if ident.armature is None else tuple(float(a) for a in ident.armature),
     )
     if nominal.description is None:
         return Robot(twin_chain(nominal, ident), source=f"twin of {nominal.name}", calibration=calibration)
     desc = twin_description(nominal.description, ident)
     return Robot(
-        chain_from_description(desc),
+        replace(
+            chain_from_description(desc),
+            armature=None if ident.armature is None else np.array(ident.armature, dtype=float),
+        ),
         description=desc,
         source=f"twin of {nominal.name}",
         calibration=calibration,
@@ -214,6 +222,11 @@ def parameter_report(
                 else {"status": "not modelled", "value": 0.0}
             ),
             "gear_efficiency": {"status": eta_status, "value": ident.gear_efficiency},
+            "armature": (
+                {"status": "not modelled", "value": 0.0}
+                if ident.armature is None
+                else _armature_entry(ident, j, kept)
+            ),
         }
         if gains is not None:
             k = {"value": gains.torque_constant[j], "relative_error": gains.relative_error[j]}
@@ -233,6 +246,29 @@ def parameter_report(
                 }
         out.append(row)
     return out
+
+
+def _armature_entry(ident: Identification, j: int, kept: dict[str, Any]) -> dict[str, Any]:
+    """The armature of joint ``j``: kept at its prior, identified alone, or only in a sum with link
+    inertias (a dependent column, regrouped into a base parameter)."""
+    assert ident.armature is not None
+    name = f"joint{j + 1}.armature"
+    value = float(ident.armature[j])
+    if name in kept:
+        return {
+            "status": "assumed",
+            "value": value,
+            "prior": kept[name].prior_source,
+            "reason": kept[name].reason,
+        }
+    if name in ident.base.names:
+        return {"status": "identified", "value": value}
+    return {
+        "status": "identified in a sum",
+        "value": value,
+        "note": "the logs fix it only together with the inertia of the link about the joint's axis "
+        "(a base parameter regroups them); the split follows the prior",
+    }
 
 
 def write_twin(
