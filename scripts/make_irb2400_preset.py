@@ -203,6 +203,7 @@ def main() -> None:
             ("manipulator-mass", repr(CATALOGUE_KG)),
             ("joint-zero", "ABB: q = 0 is the calibration (home) pose"),
             ("joint-coupling", coupling),
+            ("axis3-range-deg", "-60 65"),  # the controller's axis 3 (product specification)
             ("frames", "center and inertia in the link's DH frame; inertia about the COM"),
             (
                 "model",

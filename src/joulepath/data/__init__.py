@@ -26,7 +26,7 @@ from joulepath.data._schema import (
     table_columns,
     target_columns,
 )
-from joulepath.data._table import EnergyTable, check_columns, ingest, load_table, save_table
+from joulepath.data._table import EnergyTable, check_columns, ingest, load_table, log_in_joints, save_table
 from joulepath.data._table import _check_limits as check_limits
 
 __all__ = [
@@ -53,6 +53,7 @@ __all__ = [
     "is_moves_sidecar",
     "joints_in",
     "load_table",
+    "log_in_joints",
     "moves_sidecar_path",
     "read_log",
     "save_table",

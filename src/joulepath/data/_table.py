@@ -7,7 +7,7 @@ import io
 import json
 import os
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -233,6 +233,18 @@ def _check_tcp(log: JointLog, robot: Robot) -> None:
     )
 
 
+def log_in_joints(log: JointLog, robot: Robot) -> JointLog:
+    """A controller log in ``robot``'s joints: the controller logs its axis values (positions, speeds,
+    torques), which differ from the model's joints on an arm whose axis 3 is coupled to axis 2
+    (:meth:`~joulepath.dynamics.Robot.axes_to_joints`, ``axis_torques_to_joints``). The log
+    itself for any other arm, and for a generic log (taken as in the model's joints).
+    """
+    if log.kind != "controller" or not robot.axes_coupled:
+        return log
+    tau = None if log.tau is None else robot.axis_torques_to_joints(log.tau)
+    return replace(log, q=robot.axes_to_joints(log.q), qd=robot.axes_to_joints(log.qd), tau=tau)
+
+
 def _check_limits(log: JointLog, robot: Robot) -> None:
     """Refuse logged positions outside ``robot``'s ranges and speeds far beyond its limits.
 
@@ -349,7 +361,7 @@ def ingest(
                     f"(*{MOVES_SIDECAR_SUFFIX}), not a log"
                 )
             continue
-        log = read_log(p)
+        log = read_log(p) if robot is None else log_in_joints(read_log(p), robot)
         log.torques("ingestion (the energy targets)")  # a log of currents only is refused here
         n_log = log.q.shape[1]
         if robot is not None and robot.n_joints != n_log:

@@ -12,7 +12,14 @@ from joulepath.description._chain import (
     transform_inertial,
 )
 from joulepath.description._check import Finding, check_chain, check_inertial, check_physical
-from joulepath.description._coupling import axes_to_joints, has_axis3_coupling, joints_to_axes
+from joulepath.description._coupling import (
+    axes_to_joints,
+    axis3_range,
+    axis_torques_to_joints,
+    has_axis3_coupling,
+    joint_torques_to_axes,
+    joints_to_axes,
+)
 from joulepath.description._irml import irml_string, parse_irml, read_irml, write_irml
 from joulepath.description._model import (
     Chain,
@@ -73,6 +80,8 @@ __all__ = [
     "abb_drives_path",
     "abb_preset",
     "axes_to_joints",
+    "axis3_range",
+    "axis_torques_to_joints",
     "chain_from_description",
     "chain_from_urdf",
     "check_chain",
@@ -83,6 +92,7 @@ __all__ = [
     "dh_transform",
     "has_axis3_coupling",
     "irml_string",
+    "joint_torques_to_axes",
     "joints_to_axes",
     "named_arm_path",
     "parse_irml",

@@ -24,11 +24,17 @@ from joulepath.description import (
     RobotDescription,
     abb_drive_class,
     abb_drives_path,
+    axes_to_joints,
+    axis3_range,
+    axis_torques_to_joints,
     chain_from_description,
     chain_from_urdf,
     check_chain,
     check_inertial,
     check_physical,
+    has_axis3_coupling,
+    joint_torques_to_axes,
+    joints_to_axes,
     named_arm_path,
     pinocchio_model,
     preset_path,
@@ -284,6 +290,67 @@ class Robot:
             gear_source=gear_source,
             drives=drives,
             drives_source=note if drives is None else f"{drives.describe()}",
+        )
+
+    # ------------------------------------------------------------- controller axes
+    def axes_to_joints(self, axes: ArrayLike) -> FloatArray:
+        """The model's serial joints (rad) for the controller's axis values (rad), shape ``(..., n)``.
+
+        What a controller reads and writes (RAPID ``jointtarget``, its logs, EGM joint messages) are
+        axis values; for an arm whose axis 3 is coupled to axis 2 (the IRB 2400's parallel
+        linkage, :func:`~joulepath.description.axes_to_joints`) they differ from the joints every
+        model here works in. The identity for any other arm. Convert at the boundary, only there.
+
+        >>> load_robot("irb2400").axes_to_joints([0, 0.2, 0.3, 0, 0, 0]).round(3).tolist()
+        [0.0, 0.2, 0.1, 0.0, 0.0, 0.0]
+        """
+        if self.description is None:
+            return np.array(axes, dtype=float)
+        return axes_to_joints(self.description, axes)
+
+    def joints_to_axes(self, q: ArrayLike) -> FloatArray:
+        """The controller's axis values (rad) for serial joints ``q`` (rad), the inverse map."""
+        if self.description is None:
+            return np.array(q, dtype=float)
+        return joints_to_axes(self.description, q)
+
+    @property
+    def axes_coupled(self) -> bool:
+        """Whether the controller's axis values differ from the joints (axis 3 = joint 2 + joint 3)."""
+        return self.description is not None and has_axis3_coupling(self.description)
+
+    def axis_torques_to_joints(self, tau_axes: ArrayLike) -> FloatArray:
+        """The model's joint torques (N·m) for the controller's axis torques (a log's), shape ``(..., n)``.
+
+        The transpose of :meth:`axes_to_joints`' map, so power is kept; the identity for an uncoupled arm.
+        """
+        if self.description is None:
+            return np.array(tau_axes, dtype=float)
+        return axis_torques_to_joints(self.description, tau_axes)
+
+    def joint_torques_to_axes(self, tau: ArrayLike) -> FloatArray:
+        """The controller's axis torques (N·m) for the model's joint torques (the inverse map)."""
+        if self.description is None:
+            return np.array(tau, dtype=float)
+        return joint_torques_to_axes(self.description, tau)
+
+    @property
+    def axis3_range(self) -> tuple[float, float] | None:
+        """The controller's axis-3 range (rad) of an axis-coupled arm (no joint box states it), or None."""
+        return None if self.description is None else axis3_range(self.description)
+
+    def axes_outside(self, axes: ArrayLike) -> str | None:
+        """Why controller axis values ``axes`` (rad, shape ``(n,)``) are refused by a range that only
+        the controller's axes have (the coupled axis 3), or None. The joints' own ranges are checked
+        on :meth:`axes_to_joints` of them."""
+        rng = self.axis3_range
+        a = np.asarray(axes, dtype=float)
+        if rng is None or a.shape[-1] < 3 or rng[0] - 1e-9 <= a[2] <= rng[1] + 1e-9:
+            return None
+        lo, hi = np.degrees(rng)
+        return (
+            f"axis 3 = {np.degrees(a[2]):.2f} deg is outside the controller's axis-3 range "
+            f"[{lo:.1f}, {hi:.1f}] deg (axis 3 = joint 2 + joint 3: a parallel linkage)"
         )
 
     # ------------------------------------------------------------- kinematics

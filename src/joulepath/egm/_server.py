@@ -124,12 +124,18 @@ def serve(
     config: ServeConfig,
     *,
     on_listening: Callable[[Address], None] | None = None,
+    robot: Robot | None = None,
 ) -> Session:
     """Answer the controller on ``endpoint`` until done, a fault, or silence; return what was seen.
 
     The plan must have been checked (:func:`~joulepath.egm.check_plan`). Never raises
     on what the controller sends: faults end the session with :attr:`Session.fault`.
+    EGM's joint messages carry the controller's axis values: ``robot`` converts them to and
+    from the plan's joints (:meth:`~joulepath.dynamics.Robot.axes_to_joints`; none given: the
+    identity, right for every arm whose axis 3 is not coupled). The session holds joints.
     """
+    to_joints = robot.axes_to_joints if robot is not None else np.asarray
+    to_axes = robot.joints_to_axes if robot is not None else np.asarray
     n = plan.n_joints
     settings = config.settings
     state = PolicyState()
@@ -180,14 +186,18 @@ def serve(
         parsed += 1
         last_t = msg.time_s
         robot = RobotState(
-            t=msg.time_s, q=np.radians(msg.joints_deg), running=msg.motors_on and msg.egm_running
+            t=msg.time_s,
+            q=to_joints(np.radians(msg.joints_deg)),
+            running=msg.motors_on and msg.egm_running,
         )
         before = state
         ref, state = step(plan, settings, state, robot)
         _track(reps, before, state, robot.t)
         seqno += 1
         endpoint.send(
-            encode_sensor(seqno, msg.tm_ms, np.degrees(ref.q).tolist(), np.degrees(ref.qd).tolist()),
+            encode_sensor(
+                seqno, msg.tm_ms, np.degrees(to_axes(ref.q)).tolist(), np.degrees(to_axes(ref.qd)).tolist()
+            ),
             dgram.sender,
         )
         if time.monotonic() - dgram.received_s > CONTROL_PERIOD:
@@ -442,7 +452,7 @@ def stream_run(
     check_plan(plan, r)
     out = Path(out_dir) if out_dir is not None else Path(folder)
     with UdpEndpoint(config.host, config.port) as endpoint:
-        session = serve(plan, endpoint, config, on_listening=on_listening)
+        session = serve(plan, endpoint, config, on_listening=on_listening, robot=r)
     summary = finite_json(summarize(session, plan, r, result, config))
     with output_journal():  # both files or neither, kept even when the session faulted (its record)
         files = {

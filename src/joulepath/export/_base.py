@@ -140,7 +140,8 @@ def refuse_foreign(robot: Robot, exporter: str, *, explicit: bool) -> str | None
 
 
 def check_path(robot: Robot, q: FloatArray, qd: FloatArray | None, *, what: str) -> None:
-    """Refuse (LimitViolation) a sampled path outside the joint ranges or over a speed limit.
+    """Refuse (LimitViolation) a sampled path outside the joint ranges (and a coupled axis 3's own
+    range, :meth:`~joulepath.dynamics.Robot.axes_outside`) or over a speed limit.
 
     ``q`` and ``qd`` have shape (n_steps, n); ``what`` names the file not written.
     """
@@ -157,6 +158,13 @@ def check_path(robot: Robot, q: FloatArray, qd: FloatArray | None, *, what: str)
             f"sample {k}: joint {j + 1} at {np.degrees(q[k, j]):.2f} deg leaves its range "
             f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg; {what} is not written"
         )
+    if robot.axis3_range is not None:  # a coupled axis 3 has a range of its own on the controller
+        axes = robot.joints_to_axes(q)
+        (lo3, hi3), a3 = robot.axis3_range, axes[:, 2]
+        out = np.nonzero((a3 < lo3 - 1e-9) | (a3 > hi3 + 1e-9))[0]
+        if out.size:
+            k = int(out[0])
+            raise LimitViolation(f"sample {k}: {robot.axes_outside(axes[k])}; {what} is not written")
     if qd is None:
         return
     vmax = robot.velocity_limit

@@ -73,7 +73,7 @@ def egm_module(
 
     _six_axes(robot)
     check_path(robot, trajectory.q, trajectory.qd, what="egm.mod")
-    deg = np.degrees(trajectory.q)
+    deg = np.degrees(robot.joints_to_axes(trajectory.q))  # a jointtarget holds the controller's axis values
     max_speed = math.degrees(float(np.max(robot.velocity_limit)))
     conv = " ".join(f"\\J{j}:=CONV" for j in range(1, N_JOINTS + 1))
     joints = " ".join(f"\\J{j}" for j in range(1, N_JOINTS + 1))

@@ -269,11 +269,12 @@ def collection_programs(
     moves = None
     if mode == "table":
         drawn = draw_moves(robot, n_moves, range_set=range_set, rng=np.random.default_rng(seed))
-        moves = [(np.degrees(m.target), m.speed, m.zone) for m in drawn]
+        moves = [(np.degrees(robot.joints_to_axes(m.target)), m.speed, m.zone) for m in drawn]
+    lower, upper = _axis_bounds(robot, lower, upper)
     collect = collection_module(
         lower_deg=np.degrees(lower),
         upper_deg=np.degrees(upper),
-        nominal=robot.joint_ranges(),
+        nominal=_axis_bounds(robot, *robot.joint_ranges()),
         n_moves=n_moves,
         mode=mode,
         moves=moves,
@@ -283,6 +284,16 @@ def collection_programs(
         "JPCollect.mod": collect,
         "JPMeasure.mod": measurement_module(sample_period=sample_period),
     }
+
+
+def _axis_bounds(robot: Robot, lower: FloatArray, upper: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Bounds (rad) on the controller's axes for joint bounds: the same but for a coupled axis 3, whose
+    bounds are the controller's axis-3 range (else the loosest, ``lower2 + lower3 .. upper2 + upper3``)."""
+    if not robot.axes_coupled:
+        return lower, upper
+    lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
+    lo[2], hi[2] = robot.axis3_range or (lower[1] + lower[2], upper[1] + upper[2])
+    return lo, hi
 
 
 def _six_axes(robot: Robot) -> None:
@@ -354,7 +365,7 @@ def path_module(
             f"via segment {k + 1}: joint {j + 1} at {np.degrees(seg_speed[k, j]):.1f} deg/s exceeds its "
             f"limit {np.degrees(robot.velocity_limit[j]):.1f} deg/s; path.mod is not written"
         )
-    deg = np.degrees(q)
+    deg = np.degrees(robot.joints_to_axes(q))  # a jointtarget holds the controller's axis values
     zone = f"z{VIA_ZONE_MM:.0f}"
     count = n - 1
     out = [

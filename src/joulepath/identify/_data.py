@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from joulepath._typing import FloatArray
-from joulepath.data import find_gaps, is_moves_sidecar, read_log
+from joulepath.data import find_gaps, is_moves_sidecar, log_in_joints, read_log
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, InvalidLog
 
@@ -197,7 +197,7 @@ def data_from_logs(
     labels: list[np.ndarray] = []
     n_stretch = 0
     for path in files:
-        log = read_log(path)
+        log = log_in_joints(read_log(path), robot)
         if signal == "current":
             if log.current is None:
                 raise InvalidLog(

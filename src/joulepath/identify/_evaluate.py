@@ -53,7 +53,7 @@ import numpy as np
 
 from joulepath._io import atomic_write_bytes, finite_json, make_folder
 from joulepath._typing import FloatArray
-from joulepath.data import REST_SPEED, find_gaps, read_log, segment_moves
+from joulepath.data import REST_SPEED, find_gaps, log_in_joints, read_log, segment_moves
 from joulepath.dynamics import Robot
 from joulepath.energy import DRIVES_SUFFIX, TWIN_DRIVES_FILE, joint_energy, read_drives_toml
 from joulepath.errors import InvalidInput
@@ -317,7 +317,7 @@ def _samples(path: str | os.PathLike[str], robot: Robot) -> tuple[str, _Samples]
     """The log's samples with accelerations, stretch and move labels (ends of stretches dropped)."""
     from joulepath.data import check_limits as _check_limits  # the ingest check: ranges and speeds, named
 
-    log = read_log(path)
+    log = log_in_joints(read_log(path), robot)
     if log.q.shape[1] != robot.n_joints:
         raise InvalidInput(
             f"{log.source}: the log has {log.q.shape[1]} joints but robot {robot.name!r} has "

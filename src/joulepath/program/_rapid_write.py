@@ -663,7 +663,12 @@ def _run_body(
         raise LimitViolation(f"line {move.line}: a via segment exceeds a joint speed limit; not written")
     named = bool(np.abs(q[-1] - step.q).max() <= TARGET_ATOL_RAD)
     vias = q[:-1] if named else q
-    elements = tuple(_jt(np.degrees(qk)) for qk in vias)
+    axes = robot.joints_to_axes(vias)  # a jointtarget holds the controller's axis values
+    if any(robot.axes_outside(a) is not None for a in axes):
+        raise LimitViolation(
+            f"line {move.line}: a via point leaves the controller's axis-3 range; the program is not written"
+        )
+    elements = tuple(_jt(np.degrees(a)) for a in axes)
     lines = []
     for k, tk in enumerate(times[: len(vias)], start=1):
         zone = end if (k == len(vias) and not named) else VIA_ZONE

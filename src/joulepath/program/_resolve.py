@@ -336,7 +336,8 @@ def _move_step(
             )
         jt = _lookup(module, s.target, "jointtarget", s.line)
         assert isinstance(jt, JointTarget)
-        q = np.radians(np.asarray(jt.joints_deg[: robot.n_joints], dtype=float))
+        axes = np.radians(np.asarray(jt.joints_deg[: robot.n_joints], dtype=float))
+        q = robot.axes_to_joints(axes)  # robax holds the controller's axis values
         bad = np.nonzero((q < lo - 1e-9) | (q > hi + 1e-9))[0]
         if bad.size:
             j = int(bad[0])
@@ -345,6 +346,9 @@ def _move_step(
                 f"{s.target}: joint {j + 1} = {np.degrees(q[j]):.2f} deg is outside its range "
                 f"[{np.degrees(lo[j]):.1f}, {np.degrees(hi[j]):.1f}] deg",
             )
+        why = robot.axes_outside(axes)
+        if why is not None:
+            raise module.error(s.line, f"{s.target}: {why}")
     else:
         rt, pose = target_in_object(module, s.target_ref or TargetRef(s.target), s.line, ())
         if s.wobj is not None:

@@ -64,6 +64,15 @@ class RobotKinematics:
         bad = np.nonzero((q < self.lo - 1e-9) | (q > self.hi + 1e-9))[0]
         return int(bad[0]) if bad.size else None
 
+    def axes_to_joints(self, axes: FloatArray) -> FloatArray:
+        return self.robot.axes_to_joints(axes)
+
+    def joints_to_axes(self, q: FloatArray) -> FloatArray:
+        return self.robot.joints_to_axes(q)
+
+    def axes_outside(self, axes: FloatArray) -> str | None:
+        return self.robot.axes_outside(axes)
+
     def reach_m(self) -> float:
         """The farthest the flange comes from the base (m), over 4,096 seeded configurations within
         the joint ranges (a lower bound of the true reach, within a few mm)."""

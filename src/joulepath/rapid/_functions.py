@@ -17,7 +17,7 @@ from joulepath.rapid import builtins
 from joulepath.rapid import geometry as geo
 from joulepath.rapid import nodes as n
 from joulepath.rapid._machine import Machine
-from joulepath.rapid._motion import jointtarget, robax, robtarget_at, solve
+from joulepath.rapid._motion import joints_of, jointtarget, robtarget_at, solve
 from joulepath.rapid._routines import invoke
 from joulepath.rapid._state import UNKNOWN_TARGET, Ref, parse_literal, show
 from joulepath.rapid._trace import CLEAN, Taint
@@ -286,11 +286,11 @@ def kinematic_function(
         rt = t.coerce(a[0], "robtarget")
         assert isinstance(rt, Record)
         q = solve(ip, rt, tool, wobj, e.pos, "CalcJointT")
-        return jointtarget(t, q), CLEAN
+        return jointtarget(ip, q), CLEAN
     if key == "calcrobt":
         jt = t.coerce(a[0], "jointtarget")
         assert isinstance(jt, Record)
-        q = np.radians(robax(jt))
+        q = joints_of(ip, jt)
         return robtarget_at(ip, q, tool, wobj), CLEAN
     taint = ip.current_taint
     if ip.current_q is None:
@@ -299,7 +299,7 @@ def kinematic_function(
     else:
         q = ip.current_q
     if key == "cjointt":
-        return jointtarget(t, q), taint
+        return jointtarget(ip, q), taint
     rt = robtarget_at(ip, q, tool, wobj)
     if key == "cpos":
         return rt.get("trans"), taint

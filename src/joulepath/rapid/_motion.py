@@ -31,7 +31,7 @@ from joulepath.rapid._vocabulary import (
     RAPID_AXES,
     SEARCH_MOTIONS,
 )
-from joulepath.rapid.values import Record, TypeErrorRapid, Types, Value, num
+from joulepath.rapid.values import Record, TypeErrorRapid, Value, num
 
 
 @dataclass(slots=True)
@@ -194,12 +194,17 @@ def _joints(
     if ip.kin is None:
         return None, None
     if kind == "absjoint":
-        joints = np.radians(robax(target))
+        axes = np.radians(robax(target))
+        joints = ip.kin.axes_to_joints(axes)
         bad = ip.kin.in_range(joints)
-        if bad is not None:
+        why = (
+            ip.kin.axes_outside(axes)
+            if bad is None
+            else f"joint {bad + 1} = {math.degrees(joints[bad]):.2f} deg is outside this robot's range"
+        )
+        if why is not None:
             raise RapidError(
-                f"{s.pos}: {target_text}: joint {bad + 1} = {math.degrees(joints[bad]):.2f} deg is "
-                "outside this robot's range: correct the jointtarget, or give the robot it was "
+                f"{s.pos}: {target_text}: {why}: correct the jointtarget, or give the robot it was "
                 "taught on with --robot"
             )
     else:
@@ -233,9 +238,7 @@ def motion(ip: Machine, s: n.Call, key: str) -> None:
         if joints is not None:
             circle_joints = joints if circle is not None else None
             target = (
-                jointtarget(ip.types, joints)
-                if kind == "absjoint"
-                else robtarget_at(ip, joints, mv.tool, mv.wobj)
+                jointtarget(ip, joints) if kind == "absjoint" else robtarget_at(ip, joints, mv.tool, mv.wobj)
             )
             circle = target if circle is not None else None
     else:
@@ -453,14 +456,23 @@ def _as_record(v: Value) -> Record:
 
 
 def robax(jt: Record) -> FloatArray:
+    """A ``jointtarget``'s ``robax`` as written: the controller's axis values (deg)."""
     rob = _as_record(jt.get("robax"))
     return np.array([num(v) for v in rob.values], dtype=float)
 
 
-def jointtarget(types: Types, q: FloatArray) -> Record:
-    deg = tuple(float(v) for v in np.degrees(q)[:6])
+def joints_of(ip: Machine, jt: Record) -> FloatArray:
+    """The model's serial joints (rad) of a ``jointtarget``: its axis values converted (a robot given)."""
+    assert ip.kin is not None
+    return ip.kin.axes_to_joints(np.radians(robax(jt)))
+
+
+def jointtarget(ip: Machine, q: FloatArray) -> Record:
+    """The ``jointtarget`` of serial joints ``q`` (rad): the controller's axis values (deg) in ``robax``."""
+    axes = q if ip.kin is None else ip.kin.joints_to_axes(q)
+    deg = tuple(float(v) for v in np.degrees(axes)[:6])
     deg = deg + (0.0,) * (6 - len(deg))
-    out = types.coerce((deg, (9e9,) * 6), "jointtarget")
+    out = ip.types.coerce((deg, (9e9,) * 6), "jointtarget")
     assert isinstance(out, Record)
     return out
 

@@ -16,7 +16,13 @@ CLEAN: Taint = frozenset()
 
 
 class Kinematics(Protocol):
-    """What the interpreter asks of the robot (SI, 4x4 transforms of the flange in the base)."""
+    """What the interpreter asks of the robot (SI, 4x4 transforms of the flange in the base).
+
+    ``q`` are the model's serial joints; a ``jointtarget``'s ``robax`` holds the controller's axis
+    values, which ``axes_to_joints`` / ``joints_to_axes`` convert (the identity but for an arm
+    whose axis 3 is coupled to axis 2); ``axes_outside`` says why axis values are refused by a
+    range only the controller's axes have, or None.
+    """
 
     def joints(
         self, flange: FloatArray, conf: tuple[int, int, int, int] | None, near: FloatArray | None
@@ -29,6 +35,12 @@ class Kinematics(Protocol):
     def in_range(self, q: FloatArray) -> int | None: ...
 
     def reach_m(self) -> float | None: ...
+
+    def axes_to_joints(self, axes: FloatArray) -> FloatArray: ...
+
+    def joints_to_axes(self, q: FloatArray) -> FloatArray: ...
+
+    def axes_outside(self, axes: FloatArray) -> str | None: ...
 
 
 @dataclass(frozen=True, slots=True)

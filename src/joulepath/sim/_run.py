@@ -60,14 +60,20 @@ def measure(
 
 
 def log_text(robot: Robot, m: Measured) -> str:
-    """The measurement as the controller's CSV text (a generic joint log for an arm not of 6 joints)."""
+    """The measurement as the controller's CSV text (a generic joint log for an arm not of 6 joints).
+
+    The controller logs its axis values: for an arm whose axis 3 is coupled to axis 2 the
+    positions, speeds and torques are converted from the model's joints
+    (:meth:`~joulepath.dynamics.Robot.joints_to_axes`, ``joint_torques_to_axes``).
+    """
     if robot.n_joints != 6:
         return generic_log_text(m.t, m.q, m.qd, m.tau)
     pose = robot.fk(m.q)
     quat = pose.quaternion
     euler = pose.euler_zyx_deg  # (z, y, x)
+    axes, axes_d = np.degrees(robot.joints_to_axes(m.q)), np.degrees(robot.joints_to_axes(m.qd))
     return controller_log_text(
-        m.t, np.degrees(m.q), np.degrees(m.qd), m.tau, pose.position_mm, quat, euler[:, ::-1]
+        m.t, axes, axes_d, robot.joint_torques_to_axes(m.tau), pose.position_mm, quat, euler[:, ::-1]
     )
 
 
