@@ -104,7 +104,7 @@ CLASSES: list[tuple[str, str, re.Pattern[str]]] = [
         "out-of-reach",
         "out of the IRB 120's reach or joint range (probably a program for another robot)",
         re.compile(
-            r"out of (the robot's )?reach|unreachable|cannot reach|outside (its|this robot's) range|joint limit|"
+            r"out of (the robot's |this arm's )?reach|unreachable|cannot reach|outside (its|this robot's) range|joint limit|"
             r"beyond its reach|a larger arm"
         ),
     ),
@@ -188,7 +188,7 @@ def extract(manifest: list[dict[str, object]], mirrors: Path, dest: Path) -> Non
         print(f"extracted {p['id']}", file=sys.stderr)
 
 
-LARGER_ARMS = ("irb140", "irb1200", "irb1600", "irb2600", "irb4600", "irb6700")
+LARGER_ARMS = ("irb140", "irb1200", "irb1600", "irb2400", "irb2600", "irb4600", "irb6700")
 """The bundled ABB families, smallest first: ``--larger`` retries a program refused as out of reach on
 each in turn, and records the first that reads it (the smallest bundled arm its targets fit)."""
 

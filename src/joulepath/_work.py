@@ -7,10 +7,10 @@ refused before any work, with one line that names the limit, its variable and wh
 change in the input::
 
     name          default  what it bounds
-    motion_s      600      seconds the moves of one cycle take together (at the default or given cycle time)
+    motion_s      3600     seconds the moves of one cycle take together (at the default or given cycle time)
     move_s        10       seconds one move to be optimized takes (its solve grows with the duration;
                            moves joined by zones into one fly-by chain count as one move)
-    moves         2000     moves in one cycle
+    moves         10000    moves in one cycle
     obstacles     1000     obstacles of a cell (boxes, cylinders, spheres, meshes)
     triangles     200000   triangles of all the meshes of a cell together
 """
@@ -37,9 +37,9 @@ class WorkLimit:
 
 
 WORK_LIMITS: dict[str, WorkLimit] = {
-    "motion_s": WorkLimit(600.0, "s of motion in one cycle"),
+    "motion_s": WorkLimit(3600.0, "s of motion in one cycle"),
     "move_s": WorkLimit(10.0, "s of one move to optimize"),
-    "moves": WorkLimit(2000, "moves in one cycle"),
+    "moves": WorkLimit(10_000, "moves in one cycle"),
     "obstacles": WorkLimit(1000, "obstacles in a cell"),
     "triangles": WorkLimit(200_000, "mesh triangles in a cell"),
 }

@@ -156,10 +156,28 @@ def test_a_tool_far_over_the_rating_is_refused_at_its_line(tmp_path, capsys):
     )
     out = tmp_path / "run"
     err = _refused(
-        capsys, ["cycle", str(program), "--out", str(out)], "tool tGripper2: 1e+06 kg is more than"
+        capsys, ["cycle", str(program), "--out", str(out)], "tool tGripper2: 1e+06 kg is more than 2 times"
     )
-    assert "rated payload of 3 kg" in err and "heavy.mod:" in err
+    assert "rated payload of 3 kg" in err and "heavy.mod:" in err and "--robot" in err
     assert not out.exists()
+
+
+def test_a_tool_somewhat_over_the_rating_runs_and_says_so(tmp_path):
+    """A program's loaddata a little over the rated payload runs as the controller runs it, with a
+    line that names the load, and its dynamics carry that load."""
+    from joulepath.program import read_cycle_program
+
+    irb = joulepath.load_robot("irb120")
+    program = tmp_path / "heavier.mod"
+    text = (EXAMPLES / "payload_tool.mod").read_text()
+    assert "[1.5, [10, 0, 60]" in text
+    program.write_text(text.replace("[1.5, [10, 0, 60]", "[3.6, [10, 0, 60]"))
+    spec, _ = read_cycle_program(program, irb)
+    lines = [c for c in spec.choices if "rated payload" in c]
+    assert len(lines) == 1 and "tool tGripper2: 3.6 kg, above the IRB 120's rated payload of 3 kg" in lines[0]
+    assert lines[0].startswith(str(program))
+    loads = {round(s.robot.payload.mass, 9) for s in spec.steps if s.kind == "move" and s.robot.payload is not None}
+    assert 3.6 in loads
 
 
 def test_payload_rating_and_fallback():

@@ -71,6 +71,12 @@ FALLBACK_RANGE_SETS = ("lab", "collection")
 """Range sets whose absence falls back to the nominal ranges (:meth:`Robot.ranges_for`)."""
 
 
+OVERLOAD_FACTOR = 2.0
+"""A program's load above the rated payload is run (with a line that says so) up to this many times
+it: a controller runs a ``loaddata`` over the rating (at reduced performance, within its load
+diagram); beyond it, the program is taken to be for a larger arm and refused with that hint."""
+
+
 class Robot:
     """A six-axis (or any n-axis serial revolute) arm.
 
@@ -477,9 +483,10 @@ class Robot:
             return arm.payload_kg
         return None
 
-    def check_payload(self, mass: float, *, what: str = "payload") -> None:
-        """Refuse a load the arm cannot carry: above its :attr:`rated_payload_kg`, or, when no rating
-        is known, heavier than the arm's own moving links.
+    def check_payload(self, mass: float, *, what: str = "payload", over_rated: bool = False) -> None:
+        """Refuse a load the arm cannot carry: above its :attr:`rated_payload_kg` (with
+        ``over_rated``, as a controller runs a program's load: above :data:`OVERLOAD_FACTOR` times
+        it), or, when no rating is known, heavier than the arm's own moving links.
 
         Raises
         ------
@@ -489,7 +496,12 @@ class Robot:
         if not (np.isfinite(mass) and mass >= 0):
             raise InvalidInput(f"{what}: mass {mass!r} kg is not a finite number ≥ 0")
         rated = self.rated_payload_kg
-        if rated is not None and mass > rated:
+        if rated is not None and over_rated and mass > OVERLOAD_FACTOR * rated:
+            raise InvalidInput(
+                f"{what}: {mass:g} kg is more than {OVERLOAD_FACTOR:g} times the {self.name}'s rated "
+                f"payload of {rated:g} kg: probably a program for a larger arm; give it with --robot"
+            )
+        if rated is not None and not over_rated and mass > rated:
             raise InvalidInput(
                 f"{what}: {mass:g} kg is more than the {self.name}'s rated payload of {rated:g} kg; "
                 "check the mass (kg), or use an arm rated for it"
@@ -502,6 +514,17 @@ class Robot:
                 "<carrying-capacity> in its IRML"
             )
 
+    def over_rated_note(self, mass: float, what: str = "payload") -> str | None:
+        """The line a result carries when ``mass`` (kg) is above the rated payload (None: it is not)."""
+        rated = self.rated_payload_kg
+        if rated is None or mass <= rated:
+            return None
+        return (
+            f"{what}: {mass:g} kg, above the {self.name}'s rated payload of {rated:g} kg: run as the "
+            "controller runs it (its load diagram and motion supervision may slow or stop it); the "
+            "saving is stated on this load"
+        )
+
     def with_payload(
         self,
         mass: float,
@@ -509,6 +532,7 @@ class Robot:
         inertia: ArrayLike | None = None,
         *,
         what: str = "payload",
+        over_rated: bool = False,
     ) -> Robot:
         """A copy of this robot carrying a payload at tool0.
 
@@ -523,6 +547,9 @@ class Robot:
             (ABB ``ix, iy, iz``). Default: a point mass.
         what : str
             How a refusal names the load (e.g. ``"tool tGripper"``).
+        over_rated : bool
+            Carry a load above the rated payload, up to :data:`OVERLOAD_FACTOR` times it, as a
+            controller runs a program's ``loaddata`` (:meth:`over_rated_note` says so).
 
         Raises
         ------
@@ -530,7 +557,7 @@ class Robot:
             A negative or non-finite mass, a mass above the arm's rating (:meth:`check_payload`),
             or an inertia that is not physical.
         """
-        self.check_payload(float(mass), what=what)
+        self.check_payload(float(mass), what=what, over_rated=over_rated)
         inertia_arr = np.zeros((3, 3)) if inertia is None else np.asarray(inertia, dtype=float)
         if inertia_arr.shape == (3,):
             inertia_arr = np.diag(inertia_arr)

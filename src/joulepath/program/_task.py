@@ -105,8 +105,11 @@ def _load(rec: object) -> tuple[float, FloatArray]:
     return float(num(rec.get("mass"))), np.asarray(pos_values(rec.get("cog"))) / 1000.0
 
 
-def _robot_for(robot: Robot, m: Motion, cache: dict[tuple[float, ...], Robot]) -> Robot:
-    """The robot carrying the tool's load and the ``GripLoad`` in force (their centre of mass combined)."""
+def _robot_for(
+    robot: Robot, m: Motion, cache: dict[tuple[float, ...], Robot], notes: list[str] | None = None
+) -> Robot:
+    """The robot carrying the tool's load and the ``GripLoad`` in force (their centre of mass combined);
+    a load above the rated payload is carried, and ``notes`` told so once."""
     mass, cog = _load(m.tool.get("tload")) if bool(m.tool.get("robhold")) else (0.0, np.zeros(3))
     if m.settings.grip_load is not None:
         gm, gc = _load(m.settings.grip_load)
@@ -121,9 +124,12 @@ def _robot_for(robot: Robot, m: Motion, cache: dict[tuple[float, ...], Robot]) -
     )
     if key not in cache:
         try:
-            cache[key] = robot.with_payload(mass, com=cog, what=what) if mass > 0 else robot
+            cache[key] = robot.with_payload(mass, com=cog, what=what, over_rated=True) if mass > 0 else robot
         except InvalidInput as err:
             raise RapidError(f"{m.pos}: {err}") from err
+        note = robot.over_rated_note(mass, what)
+        if note is not None and notes is not None:
+            notes.append(f"{m.pos}: {note}")
     return cache[key]
 
 
@@ -132,10 +138,16 @@ def _speed(rec: Record) -> SpeedData:
 
 
 def steps_of(
-    trace: Trace, robot: Robot, *, progress: Callable[[str], None] | None = None, source: str = ""
+    trace: Trace,
+    robot: Robot,
+    *,
+    progress: Callable[[str], None] | None = None,
+    source: str = "",
+    notes: list[str] | None = None,
 ) -> tuple[tuple[Step, ...], tuple[tuple[str, str], ...]]:
     """The cycle's steps from a trace run on ``robot``'s kinematics, and the kept moves with a reason;
-    ``progress`` is told each move (``reading SOURCE: move k/N``) as its step is made."""
+    ``progress`` is told each move (``reading SOURCE: move k/N``) as its step is made; ``notes`` a
+    line for each load carried above the rated payload."""
     cycle = trace.cycle
     counts: dict[tuple[str, int], int] = {}
     for e in cycle:
@@ -170,7 +182,7 @@ def steps_of(
                     time_s=e.time_s,
                     zone_mm=zone_mm,
                     tcp=tcp,
-                    robot=_robot_for(robot, e, robots),
+                    robot=_robot_for(robot, e, robots, notes),
                     repeated=counts[(e.pos.file, e.pos.start)] > 1,
                     kept=reasons,
                     circle_q=None if e.circle_joints is None else e.circle_joints.copy(),
@@ -274,9 +286,10 @@ def read_task_cycle(
         task.source,
         "the cycle (calls and loops run) has that many moves; split it into shorter programs",
     )
-    steps, kept = steps_of(trace, robot, progress=progress, source=task.source)
+    loads: list[str] = []
+    steps, kept = steps_of(trace, robot, progress=progress, source=task.source, notes=loads)
     unused = sorted(set(k.lower() for k in (io or {})) - interp.io_used)
-    notes = list(trace.notes)
+    notes = [*trace.notes, *loads]
     for k in unused:
         notes.append(f"--io {k}: the cycle never read it")
     trace = replace(trace, notes=tuple(notes))
