@@ -1156,8 +1156,7 @@ def levers_module(
     idle = _idle_waits(spec, lines) if use_waits else {}
     idle_s = sum(sec * n for sec, n, _, _ in idle.values())
     chosen = _search(ev, slots, target + idle_s, max_evaluations, pairs, bound)
-    plan_s, t_search, _ = ev(chosen)
-    e_search = ev.whole_energy(plan_s)  # reported as the check takes it
+    plan_s, t_search, _ = ev(chosen)  # its energy reported as the check takes it (the whole grid)
     new_waits, t_search = _spend_idle(idle, idle_s, t_search, target)
     edits = {line: (idle[line][2], idle[line][3], sec) for line, sec in new_waits.items()}
     written, where = write_levers(spec.module, text, slots, chosen, edits)
@@ -1181,7 +1180,7 @@ def levers_module(
         default_lab_J=lab0,
         energy_lab_J=lab_exec,
         searched_cycle_s=t_search,
-        searched_energy_J=e_search,
+        searched_energy_J=ev.whole_energy(plan_s),
         moves=moves,
         written_text=written,
         encoding=encoding,
