@@ -126,7 +126,7 @@ def main() -> None:
     origins, limits, meshes = abb.read_xacro(text)
     # the 12/1.55 macro puts the flange offset (85 mm) on joint_6-tool0; the twin URDF here puts it on
     # joint_6 (as the rest of the range), so link_6's mesh is moved back by it
-    assert origins[5] == (0.0, 0.0, 0.0) and "<origin xyz=\"0.085 0 0\" rpy=\"0 1.57079632679 0\"/>" in text
+    assert origins[5] == (0.0, 0.0, 0.0) and '<origin xyz="0.085 0 0" rpy="0 1.57079632679 0"/>' in text
     origins = [*origins[:5], (0.085, 0.0, 0.0)]
     src = f"ROS-Industrial abb @ {head}, {XACRO} (Apache-2.0)"
     k = abb.dh_params(origins)
@@ -138,13 +138,19 @@ def main() -> None:
 
     mesh_links, density = abb.mesh_inertials(repo, meshes, CATALOGUE_KG)  # scaled below, per link
     link_inertials: dict[str, Inertial] = {}
-    for link, mass in (("link_4", PUBLISHED_MASS[3]), ("link_5", PUBLISHED_MASS[4]), ("link_6", PUBLISHED_MASS[5])):
+    for link, mass in (
+        ("link_4", PUBLISHED_MASS[3]),
+        ("link_5", PUBLISHED_MASS[4]),
+        ("link_6", PUBLISHED_MASS[5]),
+    ):
         b = mesh_links[link]
         com = b.com_array - (np.array([0.085, 0.0, 0.0]) if link == "link_6" else 0.0)
         link_inertials[link] = Inertial.from_arrays(mass, com, b.inertia_array * mass / b.mass)
     base_mass = CATALOGUE_KG - sum(PUBLISHED_MASS)
     b = mesh_links["base_link"]
-    link_inertials["base_link"] = Inertial.from_arrays(base_mass, b.com_array, b.inertia_array * base_mass / b.mass)
+    link_inertials["base_link"] = Inertial.from_arrays(
+        base_mass, b.com_array, b.inertia_array * base_mass / b.mass
+    )
 
     published, smallest = published_inertials(rows)
     # links 1-3 into URDF link frames too (for the twin URDF)
@@ -163,7 +169,9 @@ def main() -> None:
         rel = np.linalg.inv(uf) @ df
         rot, t = rel[:3, :3], rel[:3, 3]
         p = published[i]
-        link_inertials[abb.LINKS[i + 1]] = Inertial.from_arrays(p.mass, rot @ p.com_array + t, rot @ p.inertia_array @ rot.T)
+        link_inertials[abb.LINKS[i + 1]] = Inertial.from_arrays(
+            p.mass, rot @ p.com_array + t, rot @ p.inertia_array @ rot.T
+        )
     urdf_path.write_text(abb.urdf_text(ID, origins, limits, link_inertials, header))
     dh_links = abb.to_dh(urdf_path, rows, link_inertials)
 
@@ -274,10 +282,20 @@ def main() -> None:
         f"catalogue_mass_rel = {abb.CATALOGUE_BOUND}",
     ]
     for name, kind, source, how, bound in params:
-        lines += ["", "[[parameter]]", f"name = {q(name)}", f"kind = {q(kind)}", f"source = {q(source)}", f"how = {q(how)}", f"bound = {q(bound)}"]
+        lines += [
+            "",
+            "[[parameter]]",
+            f"name = {q(name)}",
+            f"kind = {q(kind)}",
+            f"source = {q(source)}",
+            f"how = {q(how)}",
+            f"bound = {q(bound)}",
+        ]
     (abb.PRESETS / f"{ID}.provenance.toml").write_text("\n".join(lines) + "\n")
     total = desc.base.mass + sum(j.inertial.mass for j in desc.joints)  # type: ignore[union-attr]
-    print(f"{ID}: {k}; total {total:.1f} kg; mesh density {density:.0f} kg/m³; published tensors' smallest principal moments {np.round(smallest, 4)}")
+    print(
+        f"{ID}: {k}; total {total:.1f} kg; mesh density {density:.0f} kg/m³; published tensors' smallest principal moments {np.round(smallest, 4)}"
+    )
 
 
 if __name__ == "__main__":

@@ -176,7 +176,9 @@ def test_a_tool_somewhat_over_the_rating_runs_and_says_so(tmp_path):
     lines = [c for c in spec.choices if "rated payload" in c]
     assert len(lines) == 1 and "tool tGripper2: 3.6 kg, above the IRB 120's rated payload of 3 kg" in lines[0]
     assert lines[0].startswith(str(program))
-    loads = {round(s.robot.payload.mass, 9) for s in spec.steps if s.kind == "move" and s.robot.payload is not None}
+    loads = {
+        round(s.robot.payload.mass, 9) for s in spec.steps if s.kind == "move" and s.robot.payload is not None
+    }
     assert 3.6 in loads
 
 
