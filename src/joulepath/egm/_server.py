@@ -185,14 +185,14 @@ def serve(
             continue
         parsed += 1
         last_t = msg.time_s
-        robot = RobotState(
+        seen = RobotState(
             t=msg.time_s,
             q=to_joints(np.radians(msg.joints_deg)),
             running=msg.motors_on and msg.egm_running,
         )
         before = state
-        ref, state = step(plan, settings, state, robot)
-        _track(reps, before, state, robot.t)
+        ref, state = step(plan, settings, state, seen)
+        _track(reps, before, state, seen.t)
         seqno += 1
         endpoint.send(
             encode_sensor(
@@ -202,12 +202,12 @@ def serve(
         )
         if time.monotonic() - dgram.received_s > CONTROL_PERIOD:
             slow += 1
-        rows_t.append(robot.t)
+        rows_t.append(seen.t)
         rows_phase.append(state.phase.value)
         rows_s.append(math.nan if ref.plan_time is None else ref.plan_time)
         rows_ref.append(ref.q)
         rows_qd.append(ref.qd)
-        rows_fb.append(robot.q)
+        rows_fb.append(seen.q)
         if state.phase is Phase.DONE:
             break
         if state.phase is Phase.FAULT:
