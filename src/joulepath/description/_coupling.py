@@ -81,8 +81,8 @@ def axis3_range(desc: RobotDescription) -> tuple[float, float] | None:
     """The controller's axis-3 range (rad) of a coupled arm, from ``<axis3-range-deg>`` ("lo hi"), or None.
 
     >>> from joulepath.description import preset_description
-    >>> [round(math.degrees(v)) for v in axis3_range(preset_description("irb2400"))]
-    [-60, 65]
+    >>> tuple(round(math.degrees(v)) for v in axis3_range(preset_description("irb2400")))
+    (-60, 65)
     """
     text = desc.info_value("axis3-range-deg")
     if text is None or not has_axis3_coupling(desc):
