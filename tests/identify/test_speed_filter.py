@@ -87,8 +87,8 @@ def _base_error(data, robot, real):
 
 
 def test_the_filter_recovers_the_parameters_the_raw_difference_misses(irb120, plant_robot, jittered_log):
-    """Measured on this plant (seed 1): acceleration RMS error 5.2 rad/s² raw, 0.46 at 20 Hz; base-parameter
-    error 25.6 % raw, 0.11 % at 20 Hz. Asserted with margins."""
+    """Measured on this plant (seed 1): acceleration RMS error 5.2 rad/s² raw, 0.47 at 20 Hz; base-parameter
+    error 25.6 % raw, 0.05 % at 20 Hz. Asserted with margins."""
     raw = data_from_logs([jittered_log], irb120)
     low = data_from_logs([jittered_log], irb120, speed_cutoff_hz=20.0)
     assert raw.motion is not None and not raw.motion.filtered

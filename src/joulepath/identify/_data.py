@@ -32,6 +32,7 @@ differentiated, all but the first and last of each stretch), with the same torqu
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -327,7 +328,8 @@ def filtered_motion(
     the others' speeds go onto a uniform time base of their median period, through a
     Butterworth low-pass at ``cutoff_hz`` (order :data:`FILTER_ORDER`, forwards and
     backwards), are differentiated there by central differences (or the logged ``qdd`` is
-    low-passed the same way), and are read back at ``t`` by linear interpolation; the
+    low-passed the same way), and are read back at ``t`` by linear interpolation (the filter's
+    ends padded by one period of the cutoff, odd extension); the
     positions of the rows left out are interpolated between the others. Contract (checked
     by the callers): ``t`` non-decreasing, and ``0 < cutoff_hz`` below half the rate.
     """
@@ -347,7 +349,10 @@ def filtered_motion(
         return np.column_stack([np.interp(at, xs, a[:, j]) for j in range(a.shape[1])])
 
     b, a = butter(FILTER_ORDER, min(2.0 * cutoff_hz * h, 0.99))
-    pad = min(3 * (FILTER_ORDER + 1), grid.size - 1)
+    # padded by one period of the cutoff (odd extension, filtfilt's default kind): scipy's default
+    # 15 samples leave a start-up error at the stretch's ends of up to 35 rad/s² on an exact 1 kHz
+    # motion at 20 Hz, one period 3 (measured on the sums of sines of tests/identify/test_speed_filter.py)
+    pad = min(max(3 * (FILTER_ORDER + 1), math.ceil(1.0 / (cutoff_hz * h))), grid.size - 1)
     speed = filtfilt(b, a, resample(qd[fresh], grid, tf), axis=0, padlen=pad)
     if qdd is None:
         accel = np.gradient(speed, grid, axis=0)
@@ -408,7 +413,7 @@ def motion_record(
     if cutoff is not None and steps.size and not cutoff < 0.5 * rate:
         raise InvalidInput(
             f"{source}: speed cutoff {cutoff:g} Hz is not below half the log's sample rate "
-            f"({rate:.4g} Hz); give a lower cutoff (e.g. {0.1 * rate:.3g} Hz) or none"
+            f"({rate:.4g} Hz); give a lower cutoff (e.g. {0.1 * rate:.3g} Hz), or none (--speed-cutoff off)"
         )
     return MotionDerivation(
         requested=requested,
