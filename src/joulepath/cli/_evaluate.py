@@ -48,10 +48,10 @@ def evaluate(
     )
 
     if speed_cutoff is not None:
-        cutoff, origin = parse_speed_cutoff(speed_cutoff), "--speed-cutoff"
+        cutoff, origin = parse_speed_cutoff(speed_cutoff), f"--speed-cutoff {speed_cutoff}"
     else:
         on_card, cutoff = twin_speed_cutoff(robot)
-        origin = "as the twin's card says it was identified" if on_card else "default"
+        origin = "as the twin's card says it was identified" if on_card else "the default, auto"
         if not on_card:
             cutoff = "auto"
     inputs = [str(log), *robot_inputs(robot), *([str(drives)] if drives else [])]
