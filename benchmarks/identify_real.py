@@ -26,11 +26,16 @@ repository: FOLDER holds that repository's
 21 s at 1 kHz of joint positions, speeds and joint-torque-sensor readings (joint side, so the
 gear efficiency is fixed at 1). The named arm ``panda`` (example-robot-data, hand locked) is
 the nominal robot; the twin is identified on the first 60 % of the excitation and its torques
-predicted on the last 40 %. The Panda is judged twice: on the log as it is, and with its logged
-speeds low-passed at 20 Hz (4th-order Butterworth, zero phase) before identification and evaluation
-differentiate them (``reshaped_log``; the identification part and the held-out motion alike, never
-the held-out torque): the log's timestamps jitter (0.95 to 1.8 ms between samples of a 1 kHz log)
-and 6 % of its rows repeat the one before, so the central difference of the raw speeds is a noisy
+predicted on the last 40 %.
+
+Each arm is judged twice, by the library's option for deriving the motion from a log
+(``data_from_logs(speed_cutoff_hz=...)``, ``EvaluateConfig(speed_cutoff_hz=...)``, ``--speed-cutoff``
+on the command line): raw (``off``: the central difference of the logged speeds), and ``auto``,
+the command line's default (20 Hz for a log of 200 Hz or more: both arms here), which low-passes
+the logged speeds (4th-order Butterworth, zero phase, on a uniform time base, repeated rows left
+out) before differentiating them, the identification part and the held-out motion alike, never the
+held-out torque. The Panda log's timestamps jitter (0.7 to 1.9 ms between rows of a 1 kHz log) and
+6 % of its rows repeat the one before, so the central difference of its raw speeds is a noisy
 acceleration, which joint 1 (turning about the vertical, no gravity torque, its torque mostly
 inertial) cannot afford.
 
@@ -44,9 +49,10 @@ With ``--study``, the KR300 alone through a ladder of refinements instead, each 
 the held-out torque R² per joint (each run held out in turn, the raw logged torque as the
 reference), least squares and physically consistent: the viscous level per direction
 (``viscous_offset``), a sharper Coulomb switch (``smoothing``), a Stribeck term, a time shift
-between the torque and the motion signals (the torque column moved by whole samples), and a
-zero-phase low-pass of the logged speed before its differentiation (identification and
-held-out motion alike; never the held-out torque). Writes the ``identify_real_study`` section.
+between the torque and the motion signals (the torque column moved by whole samples), and the
+library's zero-phase low-pass of the logged speed before its differentiation (``speed_cutoff_hz``;
+identification and held-out motion alike; never the held-out torque). Writes the
+``identify_real_study`` section.
 
 Usage: python benchmarks/identify_real.py [--data FOLDER] [--panda FOLDER] [--study]
 """
@@ -68,6 +74,7 @@ import numpy as np  # noqa: E402
 
 import joulepath  # noqa: E402
 from joulepath.identify import (  # noqa: E402
+    EvaluateConfig,
     IdentifyOptions,
     UnexcitedParameterWarning,
     data_from_logs,
@@ -165,8 +172,8 @@ def kr300_urdf() -> str:
     return "\n".join(parts)
 
 
-PANDA_SPEED_CUTOFF_HZ = 20.0
-"""Hz: the low-pass of the Panda's logged speeds before their differentiation (see the module docstring)."""
+CUTOFFS: tuple[tuple[str, float | str | None], ...] = (("off", None), ("auto", "auto"))
+"""How the motion is derived from the logs in the main table: raw, and the command line's default."""
 
 
 def write_panda_logs(folder: Path, out: Path, share: float = 0.6) -> tuple[Path, Path]:
@@ -189,22 +196,28 @@ def write_panda_logs(folder: Path, out: Path, share: float = 0.6) -> tuple[Path,
 
 
 def judge(
-    robot: joulepath.Robot, ident_logs: list[Path], valid: Path, options: IdentifyOptions, twin: Path
+    robot: joulepath.Robot,
+    ident_logs: list[Path],
+    valid: Path,
+    options: IdentifyOptions,
+    twin: Path,
+    cutoff: float | str | None = None,
 ) -> dict:
     """Identify on ``ident_logs``; with the consistent refinement write the twin and ``evaluate`` it on
     ``valid``; without it (parameters that need not be physical, so no twin a robot can be built
-    from) score the identification's own prediction on ``valid``."""
-    data = data_from_logs(ident_logs, robot)
+    from) score the identification's own prediction on ``valid``. ``cutoff``: the library's
+    ``speed_cutoff_hz`` for the identification and the held-out motion alike."""
+    data = data_from_logs(ident_logs, robot, speed_cutoff_hz=cutoff)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UnexcitedParameterWarning)
         ident = identify(data, robot, options)
     if options.consistent:
         write_twin(ident, robot, twin)
-        r2 = evaluate_model(valid, joulepath.load_robot(twin), robot_source=str(twin)).summary()["torque"][
-            "r2"
-        ]
+        config = EvaluateConfig(speed_cutoff_hz=cutoff)
+        ev = evaluate_model(valid, joulepath.load_robot(twin), robot_source=str(twin), config=config)
+        r2 = ev.summary()["torque"]["r2"]
     else:
-        held = data_from_logs([valid], robot)
+        held = data_from_logs([valid], robot, speed_cutoff_hz=cutoff)
         r2 = r2_per_joint(held.tau, ident.motor_torque(robot, held.q, held.qd, held.qdd)).tolist()
     return {
         "fit": ident.fit.torque_r2,
@@ -215,26 +228,21 @@ def judge(
         "kept": [k.name for k in ident.kept],
         "warned": len(caught),
         "consistent": ident.consistent,
+        "motion": data.motion.describe() if data.motion is not None else "",
+        "cutoff_hz": data.motion.cutoff_hz if data.motion is not None else (),
     }
 
 
-def reshaped_log(log: Path, out: Path, *, shift: int = 0, cutoff_hz: float | None = None) -> Path:
+def reshaped_log(log: Path, out: Path, *, shift: int = 0) -> Path:
     """A generic log with its torques moved ``shift`` samples later in time (the torque logged at
-    sample ``k + shift`` paired with the motion of sample ``k``), and/or its speeds low-passed
-    (4th-order Butterworth at ``cutoff_hz``, zero phase) before identification differentiates them."""
+    sample ``k + shift`` paired with the motion of sample ``k``)."""
     import pandas as pd
-    from scipy.signal import butter, filtfilt
 
     frame = pd.read_csv(log)
     taus = [c for c in frame.columns if c.startswith("tau")]
     if shift:
         frame[taus] = frame[taus].shift(-shift)
         frame = frame.dropna().reset_index(drop=True)
-    if cutoff_hz is not None:
-        dt = float(np.median(np.diff(frame["t"].to_numpy())))
-        b, a = butter(4, 2.0 * cutoff_hz * dt)
-        speeds = [c for c in frame.columns if c.startswith("dq")]
-        frame[speeds] = filtfilt(b, a, frame[speeds].to_numpy(), axis=0)
     frame.to_csv(out, index=False, float_format="%.10g")
     return out
 
@@ -294,11 +302,18 @@ def study(args: argparse.Namespace) -> None:
             for r in RUNS
         }
         for k, (label, extra, shift, cutoff) in enumerate(STUDY):
-            logs = {r: reshaped_log(raw[r], d / f"s{k}_{r}.csv", shift=shift, cutoff_hz=cutoff) for r in RUNS}
+            logs = {r: reshaped_log(raw[r], d / f"s{k}_{r}.csv", shift=shift) for r in RUNS}
             for consistent in (False, True):
                 options = IdentifyOptions(consistent=consistent, **extra)  # type: ignore[arg-type]
                 per_run = [
-                    judge(robot, [logs[r] for r in RUNS if r != held], logs[held], options, d / f"t{k}{held}")
+                    judge(
+                        robot,
+                        [logs[r] for r in RUNS if r != held],
+                        logs[held],
+                        options,
+                        d / f"t{k}{held}",
+                        cutoff,
+                    )
                     for held in RUNS
                 ]
                 r2 = np.array([p["r2"] for p in per_run], dtype=float)
@@ -320,7 +335,8 @@ def study(args: argparse.Namespace) -> None:
         "runs at 250 Hz; each run held out in turn, the twin identified on the other two; R² of the held-out "
         "run's raw logged joint torque (motor torque x gear ratio), per joint averaged over the three runs. "
         "Each step adds to the one above (the shifts and filters each to the Stribeck step); every step "
-        "with the armature per joint (`IdentifyOptions.armature`, the default).",
+        "with the armature per joint (`IdentifyOptions.armature`, the default); the filters are the "
+        "library's (`speed_cutoff_hz`), every other step differentiates the raw speeds (`--speed-cutoff off`).",
         "",
         "| step | identified with | held-out torque R² per joint (mean of 3 runs) | mean | per held-out run (A, B, C) |",
         "|---|---|---|---|---|",
@@ -355,29 +371,32 @@ def main() -> None:
             for r in RUNS
         }
         for held in RUNS:
-            for label, options in settings.items():
-                result = judge(
-                    robot,
-                    [logs[r] for r in RUNS if r != held],
-                    logs[held],
-                    options,
-                    d / f"twin-{held}-{label}",
-                )
-                rows.append({"arm": "KUKA KR300", "held": f"run {held}", "how": label, **result})
-                print(rows[-1], flush=True)
+            for name, cutoff in CUTOFFS:
+                for label, options in settings.items():
+                    result = judge(
+                        robot,
+                        [logs[r] for r in RUNS if r != held],
+                        logs[held],
+                        options,
+                        d / f"twin-{held}-{label}-{name}",
+                        cutoff,
+                    )
+                    rows.append(
+                        {"arm": "KUKA KR300", "held": f"run {held}", "how": label, "speeds": name, **result}
+                    )
+                    print(rows[-1], flush=True)
         if args.panda is not None:
             panda = joulepath.load_robot("panda")
             ident_log, valid_log = write_panda_logs(args.panda, d)
-            for cutoff in (None, PANDA_SPEED_CUTOFF_HZ):
-                il, vl = ident_log, valid_log
-                if cutoff is not None:
-                    il = reshaped_log(ident_log, d / "panda_ident_lp.csv", cutoff_hz=cutoff)
-                    vl = reshaped_log(valid_log, d / "panda_valid_lp.csv", cutoff_hz=cutoff)
+            for name, cutoff in CUTOFFS:
                 for label, options in settings.items():
                     options = IdentifyOptions(gear_efficiency=1.0, consistent=options.consistent)
-                    result = judge(panda, [il], vl, options, d / f"twin-panda-{label}-{cutoff}")
-                    how = label if cutoff is None else f"{label}, speeds low-passed at {cutoff:g} Hz"
-                    rows.append({"arm": "Franka Panda", "held": "last 40 %", "how": how, **result})
+                    result = judge(
+                        panda, [ident_log], valid_log, options, d / f"twin-panda-{label}-{name}", cutoff
+                    )
+                    rows.append(
+                        {"arm": "Franka Panda", "held": "last 40 %", "how": label, "speeds": name, **result}
+                    )
                     print(rows[-1], flush=True)
     lines = [
         "## Identification on real logs: KUKA KR300 (benchmarks/identify_real.py)",
@@ -387,23 +406,36 @@ def main() -> None:
         "the DH model of that repository (no hydraulic counterbalance). Twin identified on two runs, "
         "torques of the third predicted (`evaluate`). Franka Panda (with `--panda`): Gaz et al. "
         "(GPL-3.0, used locally, not in the repository), 21 s excitation at 1 kHz, joint torque sensors; "
-        "identified on the first 60 %, predicted on the last 40 %; nominal robot: the named arm `panda`; "
-        "raw, and with its logged speeds low-passed (zero phase) before differentiation, identification and "
-        "held-out motion alike (the held-out torque raw). Every fit with an armature per joint "
+        "identified on the first 60 %, predicted on the last 40 %; nominal robot: the named arm `panda`. "
+        "Speeds: `off`, the central difference of the raw logged speeds; `auto` (the command line's "
+        "default), the library's low-pass of the logged speeds before differentiation "
+        "(`speed_cutoff_hz`; 20 Hz on both arms' logs, 250 Hz and 1 kHz), identification and held-out "
+        "motion alike; the held-out torque always raw. Every fit with an armature per joint "
         "(`IdentifyOptions.armature`, the default).",
         "",
-        "| arm | held out | identified with | torque R² per joint (held out) | mean | fit R² per joint | "
+        "| arm | held out | identified with | speeds | torque R² per joint (held out) | mean | fit R² per joint | "
         "gear eff. | cond. | consistent | kept at prior |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         held_out = ", ".join("n/a" if v is None else f"{v:.3f}" for v in r["r2"])
         fit = ", ".join(f"{v:.3f}" for v in r["fit"])
         kept = ", ".join(r["kept"]) or "none"
+        cut = "/".join(sorted({"raw" if c is None else f"{c:g} Hz" for c in r["cutoff_hz"]}))
         lines.append(
-            f"| {r['arm']} | {r['held']} | {r['how']} | {held_out} | {r['mean']:.3f} | {fit} | {r['eta']:.3f} | "
-            f"{r['cond']:.0f} | {r['consistent']} | {kept} |"
+            f"| {r['arm']} | {r['held']} | {r['how']} | {r['speeds']} ({cut}) | {held_out} | {r['mean']:.3f} | "
+            f"{fit} | {r['eta']:.3f} | {r['cond']:.0f} | {r['consistent']} | {kept} |"
         )
+    lines += ["", "Means over the KR300's three held-out runs:", ""]
+    for name, _ in CUTOFFS:
+        for label in settings:
+            sel = [r for r in rows if r["arm"] == "KUKA KR300" and r["speeds"] == name and r["how"] == label]
+            if sel:
+                per_joint = np.mean([r["r2"] for r in sel], axis=0)
+                lines.append(
+                    f"- speeds {name}, {label}: per joint {', '.join(f'{v:.3f}' for v in per_joint)}, "
+                    f"mean {float(np.mean(per_joint)):.3f}"
+                )
     write_section("identify_real", "\n".join(lines))
     print("\n".join(lines))
 

@@ -71,6 +71,13 @@ def identify(
         help="prior: keep a parameter the logs do not excite at its prior (the nominal description's, "
         "the robot's friction, else 0), with a warning; refuse: refuse such logs.",
     ),
+    speed_cutoff: str = typer.Option(
+        "auto",
+        "--speed-cutoff",
+        help="How accelerations are derived from the logged speeds: HZ low-passes them at HZ (zero phase, "
+        "uniform time base) before differentiation; off differentiates them raw; auto: 20 Hz for a "
+        "log of 200 Hz or more without ddq columns, else off. Torques and currents stay raw.",
+    ),
     force: bool = typer.Option(False, "--force", help="Replace a twin already in --out."),
     unchecked: bool = unchecked_option(),
 ) -> int:
@@ -101,6 +108,7 @@ def identify(
     )
     from joulepath.identify import identify as run
 
+    cutoff = parse_speed_cutoff(speed_cutoff)
     com = _payload_options(payload_log, payload_mass, payload_com)
     inputs = [*map(str, logs), *([str(payload_log)] if payload_log else []), *robot_inputs(robot)]
     signal = "current" if payload_log is not None else logged_signal(logs)
@@ -128,12 +136,16 @@ def identify(
         armature=armature,
     )
     with console.status(f"reading {len(logs)} log(s)..."):
-        data = data_from_logs(logs, nominal, signal=signal)
+        data = data_from_logs(logs, nominal, signal=signal, speed_cutoff_hz=cutoff)
         payload = None
         if payload_log is not None and com is not None:
             payload = PayloadReference(
-                data=data_from_logs([payload_log], nominal, signal="current"), mass=payload_mass, com=com
+                data=data_from_logs([payload_log], nominal, signal="current", speed_cutoff_hz=cutoff),
+                mass=payload_mass,
+                com=com,
             )
+    if data.motion is not None:
+        console.print(data.motion.describe(), markup=False)
     # each parameter kept at its prior is said once below, in one line (not as a Python warning)
     if signal == "current":
         with (
@@ -194,6 +206,27 @@ def identify(
     )
     console.print(f"wrote {out}/: {', '.join(files)} (use it as --robot {out})")
     return 0
+
+
+def parse_speed_cutoff(text: str) -> float | str | None:
+    """``--speed-cutoff``: ``"auto"``, None for ``off`` (raw), or a frequency in Hz."""
+    from joulepath.errors import InvalidInput
+
+    word = text.strip().lower()
+    if word == "auto":
+        return "auto"
+    if word in ("off", "none", "raw"):
+        return None
+    try:
+        hz = float(word.removesuffix("hz"))
+    except ValueError:
+        hz = float("nan")
+    if not (math.isfinite(hz) and hz > 0):
+        raise InvalidInput(
+            f"--speed-cutoff {text!r}: give a frequency in Hz (e.g. 20), off (differentiate the raw "
+            "speeds) or auto (20 Hz for logs of 200 Hz or more)"
+        )
+    return hz
 
 
 def _payload_options(log: Path | None, mass: float, com: str) -> tuple[float, float, float] | None:

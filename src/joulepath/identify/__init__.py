@@ -30,7 +30,16 @@ from joulepath.identify._currents import (
     identify_from_currents,
     same_motor,
 )
-from joulepath.identify._data import SIGNALS, IdentificationData, data_from_logs, logged_signal
+from joulepath.identify._data import (
+    AUTO_MIN_RATE_HZ,
+    AUTO_SPEED_CUTOFF_HZ,
+    SIGNALS,
+    IdentificationData,
+    MotionDerivation,
+    data_from_logs,
+    filtered_motion,
+    logged_signal,
+)
 from joulepath.identify._evaluate import (
     EVALUATE_FILES,
     DriveGains,
@@ -39,6 +48,7 @@ from joulepath.identify._evaluate import (
     drives_path,
     evaluate_model,
     read_drive_gains,
+    twin_speed_cutoff,
     write_evaluation,
 )
 from joulepath.identify._excitation import (
@@ -82,6 +92,8 @@ from joulepath.identify._twin import (
 )
 
 __all__ = [
+    "AUTO_MIN_RATE_HZ",
+    "AUTO_SPEED_CUTOFF_HZ",
     "AssumedGain",
     "BaseParameters",
     "CARD_FORMAT",
@@ -101,6 +113,7 @@ __all__ = [
     "MAX_CONDITION",
     "MAX_GAIN_ERROR",
     "MAX_KEPT_SHARE",
+    "MotionDerivation",
     "NOMINAL_PRIOR_WEIGHT",
     "PayloadReference",
     "RANK_TOLERANCE",
@@ -115,6 +128,7 @@ __all__ = [
     "drives_path",
     "dynamic_regressor",
     "evaluate_model",
+    "filtered_motion",
     "fit_drive_gains",
     "friction_regressor",
     "from_log_cholesky",
@@ -140,6 +154,7 @@ __all__ = [
     "twin_chain",
     "twin_description",
     "twin_robot",
+    "twin_speed_cutoff",
     "write_evaluation",
     "write_twin",
 ]

@@ -10,9 +10,13 @@ log it predicts
 * the motor current: ``i = tau / k`` per joint, with ``k`` the joint-side torque
   constant in N·m/A (the motor's torque constant times the gear ratio).
 
-Accelerations are the log's ``ddq`` columns, or central differences of the logged
-speed within each stretch between gaps (the ends of a stretch are dropped), as
-:func:`joulepath.identify.data_from_logs` computes them.
+The motion is derived as :func:`joulepath.identify.data_from_logs` derives it
+(:attr:`EvaluateConfig.speed_cutoff_hz`): accelerations the log's ``ddq`` columns, or
+central differences of the logged speed within each stretch between gaps (the ends of
+a stretch are dropped), or, with a cutoff, the speeds low-passed (zero phase) before
+their differentiation. Only the motion that predicts is filtered: the logged torques
+and currents are scored as logged, and the per-move energies and the rest detection
+use the logged speeds (measured and predicted energy alike).
 
 Scores (:class:`Evaluation`):
 
@@ -57,7 +61,13 @@ from joulepath.data import REST_SPEED, find_gaps, log_in_joints, read_log, segme
 from joulepath.dynamics import Robot
 from joulepath.energy import DRIVES_SUFFIX, TWIN_DRIVES_FILE, joint_energy, read_drives_toml
 from joulepath.errors import InvalidInput
-from joulepath.identify._data import _central
+from joulepath.identify._data import (
+    MotionDerivation,
+    SpeedCutoff,
+    check_speed_cutoff,
+    motion_record,
+    stretch_motion,
+)
 from joulepath.identify._fit import gear_side_speed, r2_per_joint
 
 MOVE_COLUMNS = ("move", "t_start", "t_end", "energy_measured_J", "energy_predicted_J", "error_pct")
@@ -159,14 +169,22 @@ class EvaluateConfig:
         ... or within this many amperes ...
     hold_abs_torque_Nm : float
         ... or (torques) within this many N·m.
+    speed_cutoff_hz : float, "auto" or None
+        How the motion that predicts is derived from the log, as in
+        :func:`joulepath.identify.data_from_logs`: None raw, a cutoff in Hz to low-pass the
+        logged speeds before their differentiation, ``"auto"`` by the sample rate. A twin
+        is best scored with the cutoff it was identified with (its card's ``motion``,
+        :func:`twin_speed_cutoff`).
     """
 
     min_rest_samples: int = 5
     hold_rel: float = 0.15
     hold_abs_current_A: float = 0.3
     hold_abs_torque_Nm: float = 1.0
+    speed_cutoff_hz: SpeedCutoff = None
 
     def __post_init__(self) -> None:
+        check_speed_cutoff(self.speed_cutoff_hz)
         if self.min_rest_samples < 1:
             raise InvalidInput(f"min_rest_samples must be at least 1, got {self.min_rest_samples}")
         for key in ("hold_rel", "hold_abs_current_A", "hold_abs_torque_Nm"):
@@ -207,6 +225,8 @@ class Evaluation:
     config : EvaluateConfig
     notes : tuple of str
         What could not be scored and what to provide for it.
+    motion : MotionDerivation or None
+        How the predicting motion was derived from the log (raw or low-passed).
     """
 
     log: str
@@ -226,6 +246,7 @@ class Evaluation:
     poses: list[dict[str, float]]
     config: EvaluateConfig
     notes: tuple[str, ...]
+    motion: MotionDerivation | None = None
 
     @property
     def n_joints(self) -> int:
@@ -293,7 +314,9 @@ class Evaluation:
                     "hold_rel": self.config.hold_rel,
                     "hold_abs_current_A": self.config.hold_abs_current_A,
                     "hold_abs_torque_Nm": self.config.hold_abs_torque_Nm,
+                    "speed_cutoff_hz": self.config.speed_cutoff_hz,
                 },
+                "motion": None if self.motion is None else self.motion.to_json(),
                 "notes": list(self.notes),
             }
         )
@@ -302,19 +325,26 @@ class Evaluation:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class _Samples:
+    """``q``, ``qd``, ``qdd``: the motion that predicts (raw or filtered); ``qd_logged``: as logged."""
+
     t: FloatArray
     q: FloatArray
     qd: FloatArray
     qdd: FloatArray
+    qd_logged: FloatArray
     dt: FloatArray
     tau: FloatArray | None
     current: FloatArray | None
     stretch: np.ndarray
     move: np.ndarray
+    motion: MotionDerivation
 
 
-def _samples(path: str | os.PathLike[str], robot: Robot) -> tuple[str, _Samples]:
-    """The log's samples with accelerations, stretch and move labels (ends of stretches dropped)."""
+def _samples(
+    path: str | os.PathLike[str], robot: Robot, speed_cutoff_hz: SpeedCutoff = None
+) -> tuple[str, _Samples]:
+    """The log's samples with accelerations, stretch and move labels (ends of stretches dropped
+    when the accelerations are differentiated); the motion derived as ``speed_cutoff_hz`` says."""
     from joulepath.data import check_limits as _check_limits  # the ingest check: ranges and speeds, named
 
     log = log_in_joints(read_log(path), robot)
@@ -326,7 +356,12 @@ def _samples(path: str | os.PathLike[str], robot: Robot) -> tuple[str, _Samples]
     _check_limits(log, robot)
     t = log.t
     bounds = np.r_[0, find_gaps(t), t.size]
+    record = motion_record(
+        t, bounds, log.q, log.qd, speed_cutoff_hz, has_qdd=log.qdd is not None, source=log.source
+    )
     rows: list[np.ndarray] = []
+    q_parts: list[FloatArray] = []
+    qd_parts: list[FloatArray] = []
     qdd_parts: list[FloatArray] = []
     dt_parts: list[FloatArray] = []
     stretch: list[np.ndarray] = []
@@ -336,18 +371,21 @@ def _samples(path: str | os.PathLike[str], robot: Robot) -> tuple[str, _Samples]
         if b - a < 3:
             continue
         sl = slice(a, b)
-        keep = np.arange(a, b) if log.qdd is not None else np.arange(a + 1, b - 1)
-        qdd = log.qdd[sl] if log.qdd is not None else _central(log.qd[sl], t[sl])
         tt = t[sl]
+        inner, q, qd, qdd = stretch_motion(
+            tt, log.q[sl], log.qd[sl], None if log.qdd is None else log.qdd[sl], record.cutoff_hz[0]
+        )
+        keep = inner + a
         dt = np.r_[np.diff(tt), np.diff(tt)[-1:]]
         if log.move is not None:
             _, labels = np.unique(log.move[sl], return_inverse=True)
             labels = labels.reshape(-1)
         else:
             labels = segment_moves(tt, log.qd[sl], speed_scale=robot.velocity_limit)
-        inner = keep - a
         rows.append(keep)
-        qdd_parts.append(qdd[inner])
+        q_parts.append(q)
+        qd_parts.append(qd)
+        qdd_parts.append(qdd)
         dt_parts.append(dt[inner])
         stretch.append(np.full(keep.size, s, dtype=np.int64))
         moves.append(np.where(labels[inner] >= 0, labels[inner] + n_moves, -1))
@@ -357,23 +395,53 @@ def _samples(path: str | os.PathLike[str], robot: Robot) -> tuple[str, _Samples]
     idx = np.concatenate(rows)
     return log.source, _Samples(
         t=t[idx],
-        q=log.q[idx],
-        qd=log.qd[idx],
+        q=np.concatenate(q_parts),
+        qd=np.concatenate(qd_parts),
         qdd=np.concatenate(qdd_parts),
+        qd_logged=log.qd[idx],
         dt=np.concatenate(dt_parts),
         tau=None if log.tau is None else log.tau[idx],
         current=None if log.current is None else log.current[idx],
         stretch=np.concatenate(stretch),
         move=np.concatenate(moves).astype(np.int64),
+        motion=record,
     )
 
 
 def _rest_poses(s: _Samples, min_samples: int) -> list[np.ndarray]:
     """Index arrays of the runs of at least ``min_samples`` samples at rest, each within one stretch."""
-    rest = np.abs(s.qd).max(axis=1) <= REST_SPEED
+    rest = np.abs(s.qd_logged).max(axis=1) <= REST_SPEED
     cut = np.r_[True, (s.stretch[1:] != s.stretch[:-1]) | (rest[1:] != rest[:-1])]
     runs = np.split(np.arange(rest.size), np.nonzero(cut)[0][1:])
     return [r for r in runs if rest[r[0]] and r.size >= min_samples]
+
+
+def twin_speed_cutoff(robot_source: str | os.PathLike[str]) -> tuple[bool, SpeedCutoff]:
+    """The speed cutoff a twin folder's card says it was identified with: ``(found, cutoff)``.
+
+    ``found`` is False when ``robot_source`` is no folder with a ``card.json`` holding a
+    ``motion`` entry (not a twin, or one written before the entry existed: identified raw).
+    ``cutoff`` is ``"auto"`` when the twin asked for it (the same rule then gives the same
+    20 Hz on any log fast enough), else the one cutoff applied (Hz), or None (raw).
+    """
+    from joulepath.dynamics import TWIN_CARD_FILE
+
+    card_path = Path(robot_source) / TWIN_CARD_FILE
+    if not card_path.is_file():
+        return False, None
+    try:
+        motion = json.loads(card_path.read_text()).get("motion")
+    except (OSError, ValueError, AttributeError):
+        return False, None
+    if not isinstance(motion, dict):
+        return False, None
+    if motion.get("requested") == "auto":
+        return True, "auto"
+    cuts = {c for c in motion.get("speed_cutoff_hz") or [None] if c is None or isinstance(c, int | float)}
+    if len(cuts) != 1:
+        return False, None
+    cut = cuts.pop()
+    return True, None if cut is None else check_speed_cutoff(float(cut))
 
 
 def predict_torque(robot: Robot, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> FloatArray:
@@ -419,7 +487,7 @@ def evaluate_model(
         ranges, drive gains of another joint count, or no stretch to evaluate.
     """
     cfg = config or EvaluateConfig()
-    source, s = _samples(log, robot)
+    source, s = _samples(log, robot, cfg.speed_cutoff_hz)
     n = robot.n_joints
     if drives is not None and len(drives.torque_constant) != n:
         raise InvalidInput(
@@ -456,8 +524,8 @@ def evaluate_model(
         notes.append(f"per-move energy not computable: no torques and no drive model; {need_k}")
     moves: list[dict[str, float]] = []
     if measured is not None:
-        e_meas = joint_energy(measured, s.qd, s.dt).sum(axis=1)
-        e_pred = joint_energy(tau_pred, s.qd, s.dt).sum(axis=1)
+        e_meas = joint_energy(measured, s.qd_logged, s.dt).sum(axis=1)
+        e_pred = joint_energy(tau_pred, s.qd_logged, s.dt).sum(axis=1)
         for m in np.unique(s.move[s.move >= 0]):
             sel = s.move == m
             em, ep = float(e_meas[sel].sum()), float(e_pred[sel].sum())
@@ -508,6 +576,7 @@ def evaluate_model(
         poses=poses,
         config=cfg,
         notes=tuple(notes),
+        motion=s.motion,
     )
 
 
@@ -620,5 +689,6 @@ __all__ = [
     "predict_torque",
     "predictions_frame",
     "read_drive_gains",
+    "twin_speed_cutoff",
     "write_evaluation",
 ]

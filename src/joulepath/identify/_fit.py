@@ -44,7 +44,7 @@ from joulepath.dynamics import IdentifiedFriction, Robot, motor_torque
 from joulepath.energy import joint_energy
 from joulepath.errors import InvalidInput
 from joulepath.identify._consistency import from_log_cholesky, min_eigenvalues, to_log_cholesky
-from joulepath.identify._data import IdentificationData
+from joulepath.identify._data import IdentificationData, MotionDerivation
 from joulepath.identify._regressor import (
     BaseParameters,
     base_parameters,
@@ -237,6 +237,9 @@ class Identification:
     armature : ndarray of shape (n,) or None
         kg·m² per joint (:attr:`joulepath.description.Chain.armature`), ≥ 0 when ``consistent``;
         None when not identified (``IdentifyOptions(armature=False)``).
+    motion : MotionDerivation or None
+        How the data's speeds and accelerations were derived from the logs
+        (:attr:`IdentificationData.motion`: raw, or low-passed at a cutoff); the card's ``motion``.
     """
 
     robot_name: str
@@ -257,6 +260,7 @@ class Identification:
     sources: tuple[str, ...] = field(default=())
     kept: tuple[KeptParameter, ...] = field(default=())
     armature: FloatArray | None = None
+    motion: MotionDerivation | None = None
 
     @property
     def parameters(self) -> FloatArray:
@@ -293,6 +297,7 @@ class Identification:
             "physically_consistent": self.consistent,
             "min_pseudo_inertia_eigenvalue": [float(v) for v in self.min_pseudo_inertia_eig],
             "armature": None if self.armature is None else [float(v) for v in self.armature],
+            "motion": None if self.motion is None else self.motion.to_json(),
             "fit": asdict(self.fit),
             "held_out": None if self.held_out is None else asdict(self.held_out),
             "options": asdict(self.options),
@@ -815,6 +820,7 @@ def identify(
         sources=data.sources,
         kept=kept_parameters,
         armature=armature,
+        motion=data.motion,
     )
 
 
