@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import math
 import re
+import sys
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -75,16 +76,26 @@ def parse_module(
     """Parse a module's text (line ends ``\\n``) into a :class:`~joulepath.rapid.nodes.Module`."""
     source = _blank_header(text)
     _check_nesting(source, path)
+    limit = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(limit, PARSE_RECURSION))  # a chain of operators is a tree as deep
     try:
-        tree = _parser().parse(source)
-    except lark.exceptions.UnexpectedInput as err:
-        raise RapidError(_syntax_message(err, source, path)) from None
-    try:
-        module = _Builder(path, text, encoding, newline).transform(tree)
-    except lark.exceptions.VisitError as err:
-        if isinstance(err.orig_exc, RapidError):
-            raise err.orig_exc from None
-        raise
+        try:
+            tree = _parser().parse(source)
+        except lark.exceptions.UnexpectedInput as err:
+            raise RapidError(_syntax_message(err, source, path)) from None
+        try:
+            module = _Builder(path, text, encoding, newline).transform(tree)
+        except lark.exceptions.VisitError as err:
+            if isinstance(err.orig_exc, RapidError):
+                raise err.orig_exc from None
+            raise
+    except RecursionError:
+        raise RapidError(
+            f"{path}: a statement chains more operators than this reader follows (a tree over "
+            f"{PARSE_RECURSION} calls deep); split it into shorter statements"
+        ) from None
+    finally:
+        sys.setrecursionlimit(limit)
     assert isinstance(module, n.Module)
     return module
 
@@ -118,6 +129,9 @@ def _syntax_message(err: lark.exceptions.UnexpectedInput, text: str, path: str) 
 
 MAX_NESTING = 32
 """Deepest nesting of brackets, signs and blocks (IF, FOR, WHILE, TEST) a module may hold."""
+PARSE_RECURSION = 30_000
+"""Python calls deep the parse may go: a chain of binary operators (``1 + 1 + ...``) is a tree as deep
+as it is long, and its building recurses (some thousands of terms are read; more are refused)."""
 
 _OPENERS = re.compile(r"\b(IF|FOR|WHILE|TEST|ENDIF|ENDFOR|ENDWHILE|ENDTEST|THEN)\b", re.IGNORECASE)
 

@@ -142,6 +142,11 @@ class Interpreter(Machine):
             ) from None
         except ReturnValue:
             pass
+        except RecursionError:
+            raise RapidError(
+                f"{self.task.source}: an expression or a chain of calls runs deeper than this interpreter "
+                "follows; split long expressions into shorter statements"
+            ) from None
         finally:
             sys.setrecursionlimit(limit)
         end = self.cycle_end if self.cycle_end is not None else len(self.events)
