@@ -211,6 +211,21 @@ class Machine:
             return "(expression)"
         return " ".join(m.text[pos.start : pos.end].split())
 
+    def snapshot(self) -> tuple[object, ...]:
+        """The task's data as it stands (values are immutable): every datum's value, the current
+        routine's, the outputs set, the motion settings, where the arm is and the random generator's
+        state (not the events: a wait adds one). Two equal snapshots a turn apart: the turn changed
+        nothing the task can see."""
+        frame = self.stack[-1].locals if self.stack else {}
+        return (
+            tuple((k, c.value) for k, c in self.cells.items()),
+            tuple((k, c.value) for k, c in frame.items() if isinstance(c, Cell)),
+            tuple(self.outputs.items()),
+            self.settings,
+            None if self.current_q is None else self.current_q.tobytes(),
+            repr(self.rng.bit_generator.state),
+        )
+
     def note(self, text: str) -> None:
         if text not in self._noted:
             self._noted.add(text)

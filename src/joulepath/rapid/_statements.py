@@ -35,7 +35,7 @@ from joulepath.rapid._state import (
     StopRun,
     show,
 )
-from joulepath.rapid._trace import CLEAN, Action, Taint
+from joulepath.rapid._trace import CLEAN, Action, Motion, Taint
 from joulepath.rapid._vocabulary import ALL_MOTIONS
 from joulepath.rapid.values import Array, Record, TypeErrorRapid, describe, equal, num
 
@@ -276,6 +276,11 @@ def _endless(ip: Machine, cond: n.Expr) -> bool:
     return False
 
 
+FIXED_TURNS = 2
+"""Turns a ``WHILE`` that moves nothing runs before each turn is compared with the one before: a turn
+that leaves the task's data as it found them (:meth:`Machine.snapshot`) would repeat for ever."""
+
+
 def exec_while(ip: Machine, s: n.While) -> None:
     if _endless(ip, s.cond):
         if ip.cycle_end is None and ip.loop is None:
@@ -294,8 +299,33 @@ def exec_while(ip: Machine, s: n.While) -> None:
         raise StopRun(f"{s.pos}: an endless loop inside the cycle")
     turns = 0
     moving = has_motion(ip, s.body, 0)
+    last: tuple[object, ...] | None = None
+    seen = len(ip.events)
     while True:
         v, t = condition(ip, s.cond)
+        still = not any(isinstance(e, Motion) for e in ip.events[seen:])  # the last turn moved nothing
+        seen = len(ip.events)
+        if v and not t and turns >= FIXED_TURNS:
+            now = ip.snapshot()
+            if now == last and still:  # a turn left every datum as it found it: it would spin for ever
+                ip.note(
+                    f"{s.pos}: WHILE spins, moving nothing, and a turn leaves the task's data as it found "
+                    "them: only the world outside the task (a PLC, the HMI, an operator, another task) "
+                    f"ends it; assumed to end after {turns} turns"
+                )
+                return
+            if now == last and ip.cycle_end is None and ip.loop is None:
+                # it moves, and each turn repeats the last: the production loop, until the outside ends it
+                ip.note(
+                    f"{s.pos}: WHILE repeats the same turn, moving, until the world outside the task ends "
+                    "it: taken as the production loop"
+                )
+                ip.loop = s.pos
+                ip.cycle_start = len(ip.events)
+                ip.exec_body(s.body)
+                ip.cycle_end = len(ip.events)
+                raise StopRun(f"{s.pos}: one turn of the production loop")
+            last = now
         if v and not t and not moving and turns >= SPIN_TURNS:
             shared = set_outside(
                 s.cond, ip.globals, ip.signals_used, but=set_in(s.body)

@@ -1,0 +1,146 @@
+"""Loops that spin on what the world outside the task sets (an HMI, a PLC, an operator, another task):
+a turn that leaves every datum as it found it would repeat for ever, so the loop is taken to end (moving
+nothing) or to be the production loop (moving); loops that change data, or draw random numbers, run
+as written."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import joulepath
+from joulepath.program import read_cycle_program
+
+EXT = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
+HEAD = f"""MODULE Cell
+    CONST jointtarget jA := [[10, 0, 0, 0, 30, 0], {EXT}];
+    CONST jointtarget jB := [[40, 20, -10, 15, 45, 30], {EXT}];
+    CONST jointtarget jC := [[-30, 10, 10, 0, 20, -20], {EXT}];
+"""
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return joulepath.load_robot("irb120")
+
+
+def _read(tmp_path, robot, text):
+    path = tmp_path / "cell.mod"
+    path.write_text(HEAD + text + "ENDMODULE\n")
+    spec, _ = read_cycle_program(path, robot)
+    labels = [s.label for s in spec.steps if s.kind == "move"]
+    return spec, labels
+
+
+def test_an_hmi_start_handshake_and_a_pattern_check_end_and_the_cycle_moves(tmp_path, robot):
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    PERS bool hmiStart := TRUE;
+    PERS num hmiCount := 0;
+    VAR num entered := 0;
+    PROC Handler()
+        IF hmiCount > entered THEN
+            entered := hmiCount;
+        ENDIF
+    ENDPROC
+    FUNC bool Valid()
+        RETURN entered > 0;
+    ENDFUNC
+    PROC WaitForPattern()
+        VAR bool ready;
+        ready := FALSE;
+        hmiStart := FALSE;
+        WHILE NOT ready DO
+            WHILE NOT hmiStart DO
+                Handler;
+                WaitTime 0.1;
+            ENDWHILE
+            Handler;
+            IF Valid() THEN
+                ready := TRUE;
+            ELSE
+                hmiStart := FALSE;
+            ENDIF
+        ENDWHILE
+    ENDPROC
+    PROC main()
+        WHILE TRUE DO
+            WaitForPattern;
+            MoveAbsJ jA, v1000, fine, tool0;
+            MoveAbsJ jB, v1000, fine, tool0;
+        ENDWHILE
+    ENDPROC
+""",
+    )
+    assert labels == ["MoveAbsJ jA", "MoveAbsJ jB"]
+    spins = [c for c in spec.choices if "WHILE spins, moving nothing" in c]
+    assert spins and all("assumed to end after" in c for c in spins)
+
+
+def test_a_loop_that_repeats_the_same_moving_turn_is_the_production_loop(tmp_path, robot):
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    VAR bool stopReq := FALSE;
+    VAR bool fault := FALSE;
+    PROC main()
+        MoveAbsJ jC, v1000, fine, tool0;
+        WHILE stopReq = FALSE AND fault = FALSE DO
+            MoveAbsJ jA, v1000, z10, tool0;
+            MoveAbsJ jB, v1000, fine, tool0;
+        ENDWHILE
+    ENDPROC
+""",
+    )
+    assert labels == ["MoveAbsJ jA", "MoveAbsJ jB"]
+    assert any("taken as the production loop" in c for c in spec.choices)
+    np.testing.assert_allclose(np.degrees(spec.start), [40, 20, -10, 15, 45, 30], atol=1e-9)
+
+
+def test_a_counting_loop_runs_every_turn(tmp_path, robot):
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    VAR num i := 0;
+    PROC main()
+        WHILE TRUE DO
+            i := 0;
+            WHILE i < 50 DO
+                i := i + 1;
+            ENDWHILE
+            IF i = 50 THEN
+                MoveAbsJ jA, v1000, fine, tool0;
+            ENDIF
+            MoveAbsJ jB, v1000, fine, tool0;
+        ENDWHILE
+    ENDPROC
+""",
+    )
+    assert labels == ["MoveAbsJ jA", "MoveAbsJ jB"]
+    assert not any("WHILE spins" in c for c in spec.choices)
+
+
+def test_a_loop_that_draws_random_numbers_is_not_cut(tmp_path, robot):
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    VAR bool found := FALSE;
+    PROC main()
+        WHILE TRUE DO
+            found := FALSE;
+            WHILE NOT found DO
+                IF Rand() > 0.9 THEN
+                    found := TRUE;
+                ENDIF
+            ENDWHILE
+            IF found THEN
+                MoveAbsJ jA, v1000, fine, tool0;
+            ENDIF
+            MoveAbsJ jB, v1000, fine, tool0;
+        ENDWHILE
+    ENDPROC
+""",
+    )
+    assert labels == ["MoveAbsJ jA", "MoveAbsJ jB"]
+    assert not any("WHILE spins" in c for c in spec.choices)
