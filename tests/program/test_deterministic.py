@@ -115,3 +115,28 @@ def test_a_plant_cell_gives_the_same_result_under_a_clock_that_jumps(tmp_path, m
             assert _without_wall(json.loads(text)) == _without_wall(json.loads(written))
         else:
             assert text == written, name
+
+
+def test_a_cycle_runs_on_one_blas_thread_whatever_the_callers(tmp_path, monkeypatch):
+    """Sums in BLAS depend on its thread count (the same search took another path with 2 threads than
+    with 1): the pipeline plans on one, so a machine's cores do not change the result."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    import joulepath.program._pipeline as pipeline
+
+    seen: list[int] = []
+    plan = pipeline.optimize_cycle
+
+    def spy(*args, **kwargs):
+        seen.extend(p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas")
+        return plan(*args, **kwargs)
+
+    monkeypatch.setattr(pipeline, "optimize_cycle", spy)
+    prog = tmp_path / "Pick.mod"
+    prog.write_text(PROGRAM)
+    with threadpool_limits(limits=2, user_api="blas"):
+        assert main(["cycle", str(prog), "--out", str(tmp_path / "run"), *SETTINGS, "--export", "egm"]) in (
+            0,
+            1,
+        )
+    assert seen and set(seen) == {1}

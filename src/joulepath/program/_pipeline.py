@@ -168,6 +168,22 @@ def optimize_program(
         The program cannot be read (:class:`~joulepath.errors.RapidError`, one line ``file:line``),
         a target is out of reach, or the cycle time cannot be met.
     """
+    from threadpoolctl import threadpool_limits
+
+    # one BLAS thread: sums in the same order on any machine, so the same input gives the same
+    # searches and files whatever its cores (a plant's cell runs so too)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _optimize_program(program, robot, out, settings, cell, progress)
+
+
+def _optimize_program(
+    program: str | Path | Sequence[str | Path],
+    robot: Robot,
+    out: Path,
+    settings: ProgramSettings | None,
+    cell: Any,
+    progress: Callable[[str], None] | None,
+) -> ProgramResult:
     settings = settings or ProgramSettings()
     t0 = time.perf_counter()
     say = progress or (lambda _: None)
