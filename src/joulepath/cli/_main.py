@@ -14,7 +14,7 @@ import os
 import re
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import typer
 
@@ -89,22 +89,32 @@ _PATH = re.compile(r"/[^\s:;,()'\"]+(?:/[^\s:;,()'\"]+)+")
 def short_paths(text: str, limit: int = ERROR_LINE_CHARS) -> str:
     """``text`` with its file paths written shorter where it is longer than ``limit``: relative to
     the working folder where that is below it (and short), else the last three parts after an ellipsis (the
-    file stays recognisable; a task's modules differ in their last parts)."""
+    file stays recognisable; a task's modules differ in their last parts), else its name alone; a line
+    still too long keeps its start (what and where) and its end (how to fix it) around an ellipsis."""
     if len(text) <= limit:
         return text
 
-    def shorter(m: re.Match[str]) -> str:
-        path = m.group(0)
-        try:
-            rel = os.path.relpath(path)
-        except ValueError:
-            rel = path
-        if not rel.startswith("..") and len(rel) <= _SHORT:
-            return rel
-        parts = path.split("/")
-        return path if len(parts) <= 4 else "…/" + "/".join(parts[-3:])
+    def shorter(keep: int) -> Callable[[re.Match[str]], str]:
+        def one(m: re.Match[str]) -> str:
+            path = m.group(0)
+            try:
+                rel = os.path.relpath(path)
+            except ValueError:
+                rel = path
+            if not rel.startswith("..") and len(rel) <= _SHORT:
+                return rel
+            parts = path.split("/")
+            return path if len(parts) <= keep + 1 else "…/" + "/".join(parts[-keep:])
 
-    return _PATH.sub(shorter, text)
+        return one
+
+    for keep in (3, 1):  # the last three parts of each path, else its name alone
+        out = _PATH.sub(shorter(keep), text)
+        if len(out) <= limit:
+            return out
+    text = out
+    head = limit * 2 // 3  # still long: what and where (its start), and how to fix it (its end)
+    return text[:head] + " … " + text[len(text) - (limit - head - 3) :]
 
 
 _FULL = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
