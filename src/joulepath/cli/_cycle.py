@@ -24,7 +24,9 @@ def _cycle_time(text: str) -> float | None:
             f"{text!r} is neither 'same' nor a number of seconds", param_hint="--cycle-time"
         ) from err
     if not (value > 0 and value < 3600):
-        raise typer.BadParameter(f"{text!r}: give a positive number of seconds", param_hint="--cycle-time")
+        raise typer.BadParameter(
+            f"{text!r}: give a positive number of seconds under 3600 (an hour)", param_hint="--cycle-time"
+        )
     return value
 
 
