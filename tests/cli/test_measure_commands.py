@@ -89,8 +89,8 @@ def test_simulate_program_needs_a_csv_and_a_readable_module(run, tmp_path, capsy
     assert main(["simulate", "--program", str(run / "path.mod"), "--out", str(tmp_path / "log")]) == 2
     assert "give a .csv file" in capsys.readouterr().err
     bad = tmp_path / "bad.mod"
-    bad.write_text((run / "path.mod").read_text().replace("TO REPEATS", "TO REPEATS REPEATS"))
+    bad.write_text((run / "path.mod").read_text().replace("TO REPEATS", "TO count"))
     assert main(["simulate", "--program", str(bad), "--out", str(tmp_path / "x.csv")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "bad.mod:" in err and "syntax error" in err
+    assert len(err.splitlines()) == 1 and "bad.mod:" in err and "'count'" in err
     assert not (tmp_path / "x.csv").exists()
