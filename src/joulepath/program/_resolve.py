@@ -617,7 +617,6 @@ def read_cycle_program(
     routine: str | None = None,
     seed: int = 0,
     given: Mapping[str, Any] | None = None,
-    as_written: bool = False,
 ) -> tuple[CycleSpec, bool]:
     """A program's cycle and whether it is RAPID: a ``.toml`` cycle file, else a RAPID task.
 
@@ -631,8 +630,7 @@ def read_cycle_program(
     joulepath wrote is read as the program it was written from (its targets as they are
     now: re-taught ones included; :func:`joulepath.program._rapid_write.restore_program`).
     ``progress`` (optional) is told each move (or step) read once the cycle is within the
-    moves limit. ``as_written``: the task as it is (a module joulepath wrote is run as written, not
-    restored), for a run of it rather than an optimization (no static module view either).
+    moves limit.
     """
     paths = [Path(path)] if isinstance(path, (str, Path)) else [Path(p) for p in path]
     if not paths:
@@ -645,12 +643,12 @@ def read_cycle_program(
         )
     from joulepath.program._task import read_task_cycle
 
-    restored = None if as_written else _restored(paths)
+    restored = _restored(paths)
     if restored is not None:
         paths = [restored]
     tc = read_task_cycle(paths, robot, io=io, routine=routine, seed=seed, progress=progress, given=given)
     steps = _mark_idle(tc, idle_waits)
-    module = None if as_written else _static_view(tc, steps, robot, routine, io)
+    module = _static_view(tc, steps, robot, routine, io)
     if module is not None:
         steps = module[1]
     moves = [st for st in steps if st.kind == "move"]

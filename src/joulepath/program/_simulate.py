@@ -26,7 +26,8 @@ from joulepath._io import atomic_write_text, make_folder
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
-from joulepath.program._resolve import CycleSpec, read_cycle_program
+from joulepath.program._parse import read_module
+from joulepath.program._resolve import CycleSpec, resolve_module
 from joulepath.sim import (
     ControllerConfig,
     PlannedCycle,
@@ -132,10 +133,8 @@ def simulate_program(
     Parameters
     ----------
     program : path
-        A RAPID module or task (its modules' folder), read by the RAPID interpreter as
-        :func:`joulepath.program.read_cycle_program` reads it (the production turn of ``main``),
-        e.g. the ``path.mod`` of ``joulepath optimize`` or the ``optimized.mod`` of ``joulepath cycle``,
-        run as written.
+        A RAPID module the reader accepts (:func:`joulepath.program.read_module`), e.g. the
+        ``path.mod`` of ``joulepath optimize`` or the ``optimized.mod`` of ``joulepath cycle``.
     out : path
         The controller log (CSV) to write, atomically.
     robot : Robot
@@ -163,7 +162,7 @@ def simulate_program(
     r = robot
     config = config or ControllerConfig()
     q0 = None if start is None else _check_start(r, start)
-    spec, _ = read_cycle_program(Path(program), r, progress=progress, as_written=True)
+    spec = resolve_module(read_module(Path(program)), r, progress=progress)
     motion = program_motion(spec, config, start=q0, progress=progress)
     check_motion_time(motion.plan, spec.source)
     if progress is not None:
