@@ -161,13 +161,13 @@ def test_short_paths_keeps_a_short_line_and_shortens_paths_of_a_long_one():
     assert out.count("part11_of_a_long_path/m.mod:") == 2
 
 
-def test_short_paths_keeps_every_line_within_the_limit_with_its_start_and_end():
+def test_short_paths_names_files_by_their_name_where_three_parts_are_too_long():
     from joulepath.cli._main import short_paths
 
-    where = "/" + "/".join(f"folder{k:02d}" for k in range(8)) + "/Module.mod:12"
-    names = ", ".join(f"Routine{k:03d}" for k in range(60))
+    where = "/" + "/".join(f"folder{k:02d}_of_a_long_name" for k in range(8)) + "/Module.mod:12"
+    names = ", ".join(f"Routine{k:03d}" for k in range(16))
     text = f"error: {where}: the cycle holds no move; give --routine NAME, one of: {names}; fix it so"
     out = short_paths(text)
     assert len(out) <= 300 < len(text)
     assert out.startswith("error: …/Module.mod:12: the cycle holds no move")
-    assert out.endswith("; fix it so")
+    assert out.endswith(f"{names}; fix it so")

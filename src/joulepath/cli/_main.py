@@ -89,8 +89,7 @@ _PATH = re.compile(r"/[^\s:;,()'\"]+(?:/[^\s:;,()'\"]+)+")
 def short_paths(text: str, limit: int = ERROR_LINE_CHARS) -> str:
     """``text`` with its file paths written shorter where it is longer than ``limit``: relative to
     the working folder where that is below it (and short), else the last three parts after an ellipsis (the
-    file stays recognisable; a task's modules differ in their last parts), else its name alone; a line
-    still too long keeps its start (what and where) and its end (how to fix it) around an ellipsis."""
+    file stays recognisable; a task's modules differ in their last parts), else its name alone."""
     if len(text) <= limit:
         return text
 
@@ -108,13 +107,12 @@ def short_paths(text: str, limit: int = ERROR_LINE_CHARS) -> str:
 
         return one
 
+    out = text
     for keep in (3, 1):  # the last three parts of each path, else its name alone
         out = _PATH.sub(shorter(keep), text)
         if len(out) <= limit:
-            return out
-    text = out
-    head = limit * 2 // 3  # still long: what and where (its start), and how to fix it (its end)
-    return text[:head] + " … " + text[len(text) - (limit - head - 3) :]
+            break
+    return out
 
 
 _FULL = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
