@@ -593,12 +593,21 @@ def check_moves_arm(spec: CycleSpec) -> None:
     moves = [st for st in spec.steps if st.kind == "move"]
     why = next((w for st in moves for w in st.kept if "an unknown target" in w), None)
     if not unknown and why is not None and all(st.kept for st in moves):
-        raise InvalidInput(f"no move of the cycle can be planned: its targets are unknown ({why[:200]})")
+        said = why.split("; the move to it", 1)[0]
+        if len(said) > 200:  # where and why only, never cut in a path: its run-time sources are listed
+            said = said.split(" (", 1)[0]
+        raise InvalidInput(f"no move of the cycle can be planned: its targets are unknown ({said})")
     if unknown and all(st.kept for st in moves):
         names = ", ".join(sorted({a.name for a in unknown})[:6])
+        shared = all(getattr(a, "shared", False) for a in unknown)
+        where = (
+            "PERS data declared without a value (another task's)"
+            if shared
+            else "declared nowhere in what was given"
+        )
         raise InvalidInput(
             f"{spec.source}: no move of the cycle can be planned: its targets are unknown (they come from "
-            f"{names}, declared nowhere in what was given); give the module that declares them, or their "
+            f"{names}, {where}); give the module that declares them, or their "
             "values in the scenario file ([targets], [wobj.NAME], [tool.NAME])"
         )
     raise InvalidInput(

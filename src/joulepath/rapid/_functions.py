@@ -60,13 +60,29 @@ def call_function(ip: Machine, e: n.FuncCall) -> tuple[Value, Taint]:
     try:
         result = builtin_function(ip, key, e, vals, {k: v for k, (v, _) in opt.items()})
     except (TypeErrorRapid, IndexError, ValueError, ZeroDivisionError) as err:
-        if not taint:
+        if not taint and not ip.ctx_taint:
             raise RapidError(f"{e.pos}: {e.name}: {err}; correct the arguments") from None
-        # a stand-in of run-time data the function cannot take: its result is a stand-in too
+        # a stand-in of run-time data the function cannot take (or a value met only in a branch
+        # taken on run-time data): its result is a stand-in too
         ip.note(f"{e.pos}: {e.name} of a stand-in value fails ({err}); its result is assumed")
-        return STANDIN_RESULT.get(key, 0.0), taint
+        why = f"{e.pos}: {e.name} of a value met in a branch taken on run-time data: known only at run time"
+        return _stand_in_result(ip, key), taint or frozenset({why})
     value, extra = result
     return value, taint | extra
+
+
+def _stand_in_result(ip: Machine, key: str) -> Value:
+    """The result a built-in function's failed call on a stand-in takes: its stated stand-in, else
+    the zero value of the type the function returns (:mod:`joulepath.rapid.builtins`), else 0."""
+    if key in STANDIN_RESULT:
+        return STANDIN_RESULT[key]
+    found = builtins.lookup(key)
+    if found is None or found.returns is None:
+        return 0.0
+    try:
+        return ip.types.default(found.returns)
+    except RapidError:
+        return 0.0
 
 
 def _present(ip: Machine, e: n.FuncCall) -> tuple[Value, Taint]:

@@ -294,14 +294,7 @@ class Machine:
         role = self.roles.get(key, "value")
         taint: Taint = CLEAN
         if key in self.given:
-            type_ = role if role != "value" else "num"
-            given = self.given[key]
-            try:
-                if isinstance(given, str) and type_ != "string":  # a RAPID literal: "[2000, 500, 5000, 1000]"
-                    given, _ = self.ev(parse_literal(given))
-                value = self.types.coerce(given, type_)
-            except TypeErrorRapid as err:
-                raise RapidError(f"{pos}: the scenario's {name}: {err}; give a {type_}") from None
+            value = self._given_value(name, role if role != "value" else "num", pos)
             said = "the scenario's value"
         else:
             value, taint, said = self._stand_in_value(name, role, pos)
@@ -311,6 +304,16 @@ class Machine:
         self.cells[("", key)] = cell
         self.assumed.append(standins.Assumption(name, role, said, pos))
         return cell
+
+    def _given_value(self, name: str, type_: str, pos: n.Pos) -> Value:
+        """The scenario's value for ``name`` as a ``type_`` (a RAPID literal where it is text)."""
+        given = self.given[name.lower()]
+        try:
+            if isinstance(given, str) and type_ != "string":  # a RAPID literal: "[2000, 500, 5000, 1000]"
+                given, _ = self.ev(parse_literal(given))
+            return self.types.coerce(given, type_)
+        except TypeErrorRapid as err:
+            raise RapidError(f"{pos}: the scenario's {name}: {err}; give a {type_}") from None
 
     def _stand_in_value(self, name: str, role: str, pos: n.Pos) -> tuple[Value, Taint, str]:
         pre = self.predefined
@@ -398,6 +401,10 @@ class Machine:
         elif dims:
             size = int(np.prod(dims))
             value = Array(type_, dims, tuple(self.types.default(type_) for _ in range(size)))
+            if decl.storage == "PERS":
+                value, taint = self._shared_persistent(decl, type_, value)
+        elif decl.storage == "PERS":
+            value, taint = self._shared_persistent(decl, type_, self.types.default(type_))
         else:
             value = self.types.default(type_)
             if type_ in standins.TARGET_TYPES and decl.storage == "VAR":  # known once the program sets it
@@ -407,6 +414,30 @@ class Machine:
                 else:
                     taint = frozenset({f"{decl.pos}: {decl.name} is declared without a value"})
         return Cell(decl.name, type_, decl.storage, value, taint, decl.pos)
+
+    def _shared_persistent(self, decl: n.DataDecl, type_: str, zero: Value) -> tuple[Value, Taint]:
+        """A ``PERS`` declared without a value: the controller gives it the value that another task's
+        declaration of the same name holds (a task shares it with a server or a PLC-fed task), not
+        given here. The scenario's value where it gives one; else a tool, work object, speed, zone or
+        load takes the stand-in of a name declared nowhere (said), and any other value its type's
+        zero, whose uses are marked as known only at run time (a target: an unknown target)."""
+        where = f"{decl.pos}: {decl.name} is a PERS declared without a value (another task's)"
+        if decl.name.lower() in self.given and not decl.dims:
+            value: Value = self._given_value(decl.name, type_, decl.pos)
+            self.assumed.append(standins.Assumption(decl.name, type_, "the scenario's value", decl.pos, True))
+            return value, CLEAN
+        if type_ in standins.STAND_IN_DATA and not decl.dims:
+            value, taint, said = self._stand_in_value(decl.name, type_, decl.pos)
+            self.assumed.append(standins.Assumption(decl.name, type_, said, decl.pos, True))
+            return value, taint
+        if type_ in standins.TARGET_TYPES:
+            said = (
+                f"{UNKNOWN_TARGET}: the moves to and from it are kept as taught; give it in the "
+                "scenario's [targets]"
+            )
+            self.assumed.append(standins.Assumption(decl.name, type_, said, decl.pos, True))
+            return zero, frozenset({f"{where}: {UNKNOWN_TARGET}"})
+        return zero, frozenset({f"{where}: known only at run time"})
 
     # ---- dispatch by node type
     def ev(self, e: n.Expr) -> tuple[Value, Taint]:
@@ -556,11 +587,14 @@ class Machine:
                 try:
                     cur.offset(tuple(idx))
                 except IndexError as err:
-                    if not any(self.ev(i)[1] for i in e.indices):
+                    if not any(self.ev(i)[1] for i in e.indices) and not self.ctx_taint:
                         raise RapidError(f"{e.pos}: {err}; correct the index") from None
-                    self.note(
-                        f"{e.pos}: an index from run-time data ({err} for its stand-in): element 1 assumed"
+                    where = (
+                        "an index from run-time data"
+                        if not self.ctx_taint
+                        else "an index in a branch taken on run-time data"
                     )
+                    self.note(f"{e.pos}: {where} ({err} for its stand-in): element 1 assumed")
                     idx = [1] * len(cur.dims)
                 return Ref(r.cell, (*r.path, ("idx", tuple(idx))))
             cur = r.get()

@@ -105,12 +105,11 @@ def _arguments(ip: Machine, s: n.Call, key: str, kind: str) -> _Move:
         fine = ip.predefined["fine"].value
         assert isinstance(fine, Record)
         zone = fine
-    if speed_t and not all(isinstance(v, float) and v > 0 for v in speed.values[:2]):
+    if (speed_t or ip.ctx_taint) and not all(isinstance(v, float) and v > 0 for v in speed.values[:2]):
         fallback = ip.predefined["v1000"].value
         assert isinstance(fallback, Record)
-        ip.note(
-            f"{s.pos}: {s.name}: its speed comes at run time and its stand-in is not a speed: v1000 taken"
-        )
+        how = "comes at run time" if speed_t else "is set in a branch taken on run-time data"
+        ip.note(f"{s.pos}: {s.name}: its speed {how} and its stand-in is not a speed: v1000 taken")
         speed = fallback
     _check_motion_data(speed, zone, s)
     if kind == "circular" and len(targets) < 2:

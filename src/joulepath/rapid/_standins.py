@@ -22,6 +22,8 @@ from joulepath.rapid import nodes as n
 
 ROBTARGET, JOINTTARGET = "robtarget", "jointtarget"
 TARGET_TYPES = (ROBTARGET, JOINTTARGET)
+STAND_IN_DATA = ("tooldata", "wobjdata", "speeddata", "zonedata", "loaddata")
+"""The data types whose value, where the task does not give it, a stated stand-in takes."""
 
 LOAD_FRACTION = 0.5
 """A tool declared nowhere carries this share of the robot's rated payload (at the flange, its
@@ -69,9 +71,16 @@ class Assumption:
     role: str
     value: str
     pos: n.Pos
+    shared: bool = False
+    """A ``PERS`` the task declares without a value (another task holds it), not a name declared nowhere."""
 
     def line(self) -> str:
-        return f"{self.pos}: {self.name} ({self.role}) is declared nowhere in what was given: {self.value}"
+        where = (
+            "is a PERS declared without a value (another task's)"
+            if self.shared
+            else ("is declared nowhere in what was given")
+        )
+        return f"{self.pos}: {self.name} ({self.role}) {where}: {self.value}"
 
     def as_json(self) -> dict[str, str]:
         return {"name": self.name, "role": self.role, "value": self.value, "at": f"{self.pos}"}
