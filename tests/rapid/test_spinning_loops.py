@@ -144,3 +144,50 @@ def test_a_loop_that_draws_random_numbers_is_not_cut(tmp_path, robot):
     )
     assert labels == ["MoveAbsJ jA", "MoveAbsJ jB"]
     assert not any("WHILE spins" in c for c in spec.choices)
+
+
+def test_an_operator_retry_written_with_goto_is_assumed_to_end_and_the_cycle_moves(tmp_path, robot):
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    PROC CheckGripper()
+        VAR btnres answer;
+        ask:
+        IF DInput(diGripperOk) = 0 THEN
+            answer := UIMessageBox(\\Header:="Gripper", \\BtnArray:=["", "", "", "", "OK"]);
+            GOTO ask;
+        ENDIF
+    ENDPROC
+    PROC main()
+        MoveAbsJ jA, v1000, fine, tool0;
+        CheckGripper;
+        MoveAbsJ jB, v1000, fine, tool0;
+        MoveAbsJ jC, v1000, fine, tool0;
+    ENDPROC
+""",
+    )
+    assert labels == ["MoveAbsJ jA", "MoveAbsJ jB", "MoveAbsJ jC"]
+    assert any(
+        "GOTO ask jumps back, moving nothing" in c and "assumed to end after" in c for c in spec.choices
+    )
+
+
+def test_a_goto_loop_that_counts_runs_as_written(tmp_path, robot):
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    PROC main()
+        VAR num k := 0;
+        again:
+        k := k + 1;
+        IF k < 50 THEN
+            GOTO again;
+        ENDIF
+        MoveAbsJ jA, v1000, fine, tool0;
+        IF k = 50 MoveAbsJ jB, v1000, fine, tool0;
+        MoveAbsJ jC, v1000, fine, tool0;
+    ENDPROC
+""",
+    )
+    assert labels == ["MoveAbsJ jA", "MoveAbsJ jB", "MoveAbsJ jC"]
+    assert not any("jumps back, moving nothing" in c for c in spec.choices)

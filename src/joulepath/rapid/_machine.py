@@ -39,7 +39,7 @@ from joulepath.rapid._state import (
     predefined_data,
     signal_kind,
 )
-from joulepath.rapid._trace import CLEAN, Event, Kinematics, MotionSettings, Taint
+from joulepath.rapid._trace import CLEAN, Event, Kinematics, Motion, MotionSettings, Taint
 from joulepath.rapid._vocabulary import PROCESS_CIRCULAR, PROCESS_LINEAR
 from joulepath.rapid.task import Task
 from joulepath.rapid.values import (
@@ -61,6 +61,10 @@ StmtHandler = Callable[["Machine", Any], None]
 """The handler of one statement node type."""
 CallHandler = Callable[["Machine", n.Call, str], None]
 """The handler of an instruction: the machine, the call, the instruction's name in lower case."""
+
+
+RETRY_TURNS = 2
+"""Jumps back to a label before each is compared with the one before (:meth:`Machine._retry_ends`)."""
 
 
 class Machine:
@@ -402,9 +406,9 @@ class Machine:
             size = int(np.prod(dims))
             value = Array(type_, dims, tuple(self.types.default(type_) for _ in range(size)))
             if decl.storage == "PERS":
-                value, taint = self._shared_persistent(decl, type_, value)
+                value, taint = shared_persistent(self, decl, type_, value)
         elif decl.storage == "PERS":
-            value, taint = self._shared_persistent(decl, type_, self.types.default(type_))
+            value, taint = shared_persistent(self, decl, type_, self.types.default(type_))
         else:
             value = self.types.default(type_)
             if type_ in standins.TARGET_TYPES and decl.storage == "VAR":  # known once the program sets it
@@ -414,30 +418,6 @@ class Machine:
                 else:
                     taint = frozenset({f"{decl.pos}: {decl.name} is declared without a value"})
         return Cell(decl.name, type_, decl.storage, value, taint, decl.pos)
-
-    def _shared_persistent(self, decl: n.DataDecl, type_: str, zero: Value) -> tuple[Value, Taint]:
-        """A ``PERS`` declared without a value: the controller gives it the value that another task's
-        declaration of the same name holds (a task shares it with a server or a PLC-fed task), not
-        given here. The scenario's value where it gives one; else a tool, work object, speed, zone or
-        load takes the stand-in of a name declared nowhere (said), and any other value its type's
-        zero, whose uses are marked as known only at run time (a target: an unknown target)."""
-        where = f"{decl.pos}: {decl.name} is a PERS declared without a value (another task's)"
-        if decl.name.lower() in self.given and not decl.dims:
-            value: Value = self._given_value(decl.name, type_, decl.pos)
-            self.assumed.append(standins.Assumption(decl.name, type_, "the scenario's value", decl.pos, True))
-            return value, CLEAN
-        if type_ in standins.STAND_IN_DATA and not decl.dims:
-            value, taint, said = self._stand_in_value(decl.name, type_, decl.pos)
-            self.assumed.append(standins.Assumption(decl.name, type_, said, decl.pos, True))
-            return value, taint
-        if type_ in standins.TARGET_TYPES:
-            said = (
-                f"{UNKNOWN_TARGET}: the moves to and from it are kept as taught; give it in the "
-                "scenario's [targets]"
-            )
-            self.assumed.append(standins.Assumption(decl.name, type_, said, decl.pos, True))
-            return zero, frozenset({f"{where}: {UNKNOWN_TARGET}"})
-        return zero, frozenset({f"{where}: known only at run time"})
 
     # ---- dispatch by node type
     def ev(self, e: n.Expr) -> tuple[Value, Taint]:
@@ -460,6 +440,7 @@ class Machine:
 
     def exec_body(self, body: tuple[n.Stmt, ...]) -> None:
         k = 0
+        retries: dict[int, tuple[int, object, int]] = {}  # label index -> (jumps back, snapshot, events)
         while k < len(body):
             s = body[k]
             try:
@@ -477,6 +458,9 @@ class Machine:
                     raise
                 if idx < k and isinstance(s, n.Goto) and self.cycle_end is None and self.loop is None:
                     self._goto_loop(body[idx + 1 : k], s)
+                if idx < k and retry_ends(self, retries, idx, g):
+                    k += 1  # the retry is over: on as if the branch that jumped back were not taken
+                    continue
                 k = idx + 1
                 continue
             k += 1
@@ -641,3 +625,53 @@ class Machine:
         self.io_used.add(r.cell.name.lower())
         r.set(value, CLEAN)
         return True
+
+
+def shared_persistent(ip: Machine, decl: n.DataDecl, type_: str, zero: Value) -> tuple[Value, Taint]:
+    """A ``PERS`` declared without a value: the controller gives it the value that another task's
+    declaration of the same name holds (a task shares it with a server or a PLC-fed task), not
+    given here. The scenario's value where it gives one; else a tool, work object, speed, zone or
+    load takes the stand-in of a name declared nowhere (said), and any other value its type's
+    zero, whose uses are marked as known only at run time (a target: an unknown target)."""
+    where = f"{decl.pos}: {decl.name} is a PERS declared without a value (another task's)"
+    if decl.name.lower() in ip.given and not decl.dims:
+        value: Value = ip._given_value(decl.name, type_, decl.pos)
+        ip.assumed.append(standins.Assumption(decl.name, type_, "the scenario's value", decl.pos, True))
+        return value, CLEAN
+    if type_ in standins.STAND_IN_DATA and not decl.dims:
+        value, taint, said = ip._stand_in_value(decl.name, type_, decl.pos)
+        ip.assumed.append(standins.Assumption(decl.name, type_, said, decl.pos, True))
+        return value, taint
+    if type_ in standins.TARGET_TYPES:
+        said = (
+            f"{UNKNOWN_TARGET}: the moves to and from it are kept as taught; give it in the "
+            "scenario's [targets]"
+        )
+        ip.assumed.append(standins.Assumption(decl.name, type_, said, decl.pos, True))
+        return zero, frozenset({f"{where}: {UNKNOWN_TARGET}"})
+    return zero, frozenset({f"{where}: known only at run time"})
+
+
+def retry_ends(ip: Machine, retries: dict[int, tuple[int, object, int]], idx: int, g: GotoLabel) -> bool:
+    """Whether a ``GOTO`` back to a label (a retry: ask the operator again, check the input again)
+    ends here: from its :data:`RETRY_TURNS`-th jump on, a jump that follows a turn which moved
+    nothing and left the task's data as it found them (:meth:`Machine.snapshot`) would repeat for ever;
+    only the world outside the task (the operator, a PLC, a sensor) ends it, so it is taken to
+    end, said once (as ``WHILE``'s rule: :data:`joulepath.rapid._statements.FIXED_TURNS`)."""
+    jumps, last, seen = retries.get(idx, (0, None, -1))
+    jumps += 1
+    if jumps < RETRY_TURNS:
+        retries[idx] = (jumps, None, len(ip.events))
+        return False
+    moved = any(isinstance(e, Motion) for e in ip.events[seen:]) if seen >= 0 else True
+    now = ip.snapshot()
+    retries[idx] = (jumps, now, len(ip.events))
+    if moved or now != last:
+        return False
+    ip.note(
+        f"{g.pos}: GOTO {g.label} jumps back, moving nothing, and a turn leaves the task's data as it "
+        "found them: only the world outside the task (an operator, a PLC, a sensor) ends it; assumed "
+        f"to end after {jumps} turns"
+    )
+    retries.pop(idx)
+    return True

@@ -354,14 +354,25 @@ def solve(
     exactly, the solution nearest the arm whose quadrants of axes 1, 4 and 6 lie within one of the
     programmed ones and whose ``cfx`` is the programmed one is taken, with a warning (the
     controller's configuration monitoring allows a quadrant's change); else the controller stops,
-    and so is the program refused. A linear or circular move's configuration follows its path
-    from where the arm is (``ConfL`` only monitors it): the solution nearest the arm, with a
-    warning where its confdata is not the programmed one. Out of reach: refused, saying how far
-    the target lies beyond the robot's reach (a program for a larger arm).
+    and so is the program refused. With ``ConfJ \\Off`` it goes to the programmed configuration
+    where that is reachable, else to the solution nearest the arm. A linear or circular move's
+    configuration follows its path from where the arm is (``ConfL`` only monitors it): the
+    solution nearest the arm, with a warning where its confdata is not the programmed one. Out of
+    reach: refused, saying how far the target lies beyond the robot's reach (a program for a
+    larger arm).
     """
     assert ip.kin is not None
     flange = np.linalg.inv(ip.base) @ target_flange(rt, tool, wobj, ip.pdisp)
     conf = conf_of(rt) if (ip.settings.conf_l if linear else ip.settings.conf_j) else None
+    if not linear and conf is None:
+        # ConfJ \Off: "the closest axis configuration", which ABB says differs from the programmed one
+        # only where that is wrong (written by hand, or displaced): the programmed one where it is
+        # reachable, else the solution nearest the arm
+        q = ip.kin.joints(flange, conf_of(rt), ip.current_q)
+        q = ip.kin.joints(flange, None, ip.current_q) if q is None else q
+        if q is None:
+            raise RapidError(f"{pos}: {what}: {_beyond_reach(ip, rt, flange)}")
+        return q
     q = ip.kin.joints(flange, conf, ip.current_q)
     if q is None:
         q = ip.kin.joints(flange, None, ip.current_q)

@@ -177,8 +177,9 @@ def exec_if(ip: Machine, s: n.If) -> None:
         shared = frozenset().union(*(_shared(ip, c) for c, _ in s.branches))
         if shared:  # the production turn of data the HMI, a PC or another task sets: stated, then known
             chosen, label = _production_turn(ip, s.pos, "IF", options, shared)
-    if taint and not has_motion(ip, chosen, 0):
+    if taint and not has_motion(ip, chosen, 0) and has_motion(ip, (s,), 0):
         # decided at run time: the stand-in's branch does not move; assume the one that moves most
+        # (where no branch moves, the stand-in's value decides, as it decides any other datum)
         chosen, label = _most_moving(ip, options, "assumed")
     if taint and not ip.ctx_taint:
         ip.note(f"{s.pos}: IF decided at run time: {'; '.join(sorted(taint))} -> {label} taken")
@@ -215,7 +216,7 @@ def exec_test(ip: Machine, s: n.Test) -> None:
         shared = _shared(ip, s.expr)
         if shared:
             chosen, label = _production_turn(ip, s.pos, "TEST", options, shared)
-    if t and not has_motion(ip, chosen, 0):
+    if t and not has_motion(ip, chosen, 0) and has_motion(ip, (s,), 0):
         chosen, label = _most_moving(ip, options, "assumed")
     if t and not ip.ctx_taint:
         ip.note(f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken")
