@@ -144,3 +144,31 @@ ENDMODULE
     assert len(err) == 1 and "no move of the cycle can be planned: its targets are unknown" in err[0]
     assert "(they come from jShared, PERS data declared without a value" in err[0]
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("conf_j", ["On", "Off"])
+def test_a_joint_move_goes_to_the_programmed_configuration_with_confj_on_and_off(tmp_path, robot, conf_j):
+    """ABB: with ``ConfJ \\Off`` the robot moves to the closest configuration, which differs from the
+    programmed one only where that is wrong; a programmed one that is reachable is taken, although
+    another turn of axis 6 lies nearer the arm."""
+    from joulepath.kinematics import confdata
+
+    q = np.radians([10.0, 20.0, 10.0, 30.0, 40.0, 30.0])
+    pose = robot.fk(q)
+    p, r = pose.position_mm, pose.quaternion
+    cf = [int(c) for c in confdata(robot.chain, q)]
+    target = f"[[{p[0]:.6f}, {p[1]:.6f}, {p[2]:.6f}], [{', '.join(f'{x:.9f}' for x in r)}], {cf}, {EXT}]"
+    spec = _read(
+        tmp_path,
+        robot,
+        f"""    CONST robtarget pT := {target};
+    CONST jointtarget jFar := [[10, 20, 10, 30, 40, 330], {EXT}];
+    PROC main()
+        ConfJ \\{conf_j};
+        MoveAbsJ jFar, v1000, fine, tool0;
+        MoveJ pT, v1000, fine, tool0;
+        MoveAbsJ jHome, v1000, fine, tool0;
+    ENDPROC
+""",
+    )
+    np.testing.assert_allclose(_moves(spec)[1].q, q, atol=1e-6)  # axis 6 at 30 deg, not at 390 deg
