@@ -370,7 +370,8 @@ def print_program_result(done: Any, out: Path, r: Any, *, use_waits: bool, cell:
             )
     if result.fixed_lines:
         console.print(
-            f"kept verbatim, run time treated as fixed: line(s) {', '.join(map(str, result.fixed_lines))}"
+            "kept verbatim, run time treated as fixed: line(s) "
+            + ", ".join(map(str, sorted(set(result.fixed_lines))))  # a line run several times: once
         )
     if rapid and "optimized.mod" not in files and "optimized_task" not in files:
         console.print(f"NOT WRITTEN: optimized.mod: {saved['rapid_refused']}")
