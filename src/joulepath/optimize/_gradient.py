@@ -533,8 +533,29 @@ class SplineProblem:
                 rows_a.append(sign * full[finite])
                 rows_b.append(b[finite])
                 rows_s.append(np.broadcast_to(sc, P.shape).ravel()[finite])
+        coupled = self._axis3_rows(*blocks[0])
+        if coupled is not None:
+            rows_a.append(coupled[0])
+            rows_b.append(coupled[1])
+            rows_s.append(np.full(coupled[1].size, coupled[2]))
         self.hull_scale = np.concatenate(rows_s)
         return np.concatenate(rows_a), np.concatenate(rows_b)
+
+    def _axis3_rows(self, M: FloatArray, P: FloatArray) -> tuple[FloatArray, FloatArray, float] | None:
+        """``A x + b ≥ 0`` rows keeping the controller's coupled axis 3 (a linear map of the joints,
+        joint 2 + joint 3 on the IRB 2400) inside its range at each control point (or sample) of q,
+        where the robot has one; with the row scale. None for any other arm."""
+        rng = self.robot.axis3_range
+        if rng is None or self.n < 3:
+            return None
+        zero = self.robot.joints_to_axes(np.zeros(self.n))[2]
+        c = self.robot.joints_to_axes(np.eye(self.n))[:, 2] - zero  # axis 3 = zero + c · q
+        full = np.kron(M, c[None, :])  # rows r: c · (control point r's change)
+        value = zero + P @ c
+        hi, lo = rng[1] - RANGE_MARGIN, rng[0] + RANGE_MARGIN
+        A = np.concatenate([-full, full])
+        b = np.concatenate([hi - value, value - lo])
+        return A, b, float(rng[1] - rng[0])
 
     def accel_slack(self, x: FloatArray) -> FloatArray:
         """Acceleration slack on the fine grid: ``amax - qdd`` then ``qdd + amax``, shape (2K, n)."""

@@ -135,6 +135,17 @@ def check_limits(
         return float(max(excess.max(axis=0).sum(), 0.0)) if excess[k, j] > tol else 0.0
 
     r = note("range", over_q, q, np.where(q > hi, hi, lo), TOLERANCE)
+    rng = robot.axis3_range
+    if rng is not None and q.shape[-1] >= 3:  # the controller's coupled axis 3 (joint 2 + joint 3)
+        a3 = robot.joints_to_axes(q)[..., 2:3]
+        over3 = np.maximum(a3 - rng[1], 0.0) + np.maximum(rng[0] - a3, 0.0)
+        r += note(
+            "axis-3 range",
+            over3 * np.eye(q.shape[-1])[2],
+            a3 * np.eye(q.shape[-1])[2],
+            np.where(a3 > rng[1], rng[1], rng[0]),
+            TOLERANCE,
+        )
     v_lim = np.where(np.isfinite(vmax) & (vmax > 0), vmax, np.inf)
     s = note("speed", np.abs(qd) / v_lim - 1.0, qd, v_lim, TOLERANCE)
     if acceleration_limit is not None:
