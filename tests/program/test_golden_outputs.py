@@ -7,7 +7,10 @@ ecb0354 (before the interpreter was split by node type and the cycle optimizer t
 program with ``--lever-plans 40``, so that the search ends by its bound of work, the same way in both.
 A change that is meant to change the outputs writes them again with the script and says so: corpus 34's
 were written again at stop 54, where the lever search's energy by runs and one BLAS thread changed its
-search's path (one zone z40 -> z50 in its optimized task; its executed energy by 2e-6 J).
+search's path (one zone z40 -> z50 in its optimized task; its executed energy by 2e-6 J). At stop 55
+the ``rapid_refused`` line of corpus 05, 27 and 34 was written again alone: it now says why this program
+has no module for the via-point writer (its modules, its scenario, a move kept, what the writer's static
+reader does not read), where it listed every possible reason.
 """
 
 import importlib.util

@@ -577,10 +577,10 @@ def _via_point_module(
     text = refused = check = layout = None
     follows = None
     if write_rapid and result.spec.module is None:
+        why = result.spec.static_note or "is not a RAPID module"
         refused = (
-            "the via-point RAPID writer edits a program of one module whose cycle is fully known "
-            "(this one spans several modules, runs a routine other than main, reads a scenario or keeps "
-            "moves as taught); the planned cycle is written for EGM instead"
+            "the via-point RAPID writer edits a program of one module whose cycle is fully known; "
+            f"this one {why}; the planned cycle is written for EGM instead"
         )
         write_rapid = False
     if write_rapid:

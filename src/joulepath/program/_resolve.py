@@ -74,6 +74,7 @@ class CycleSpec:
     kept: tuple[tuple[str, str], ...] = field(default=())  # (move, why it runs as taught)
     task: object | None = None  # the RAPID task's cycle (joulepath.program._task.TaskCycle)
     assumed: tuple[Any, ...] = field(default=())  # names declared nowhere (joulepath.rapid Assumption)
+    static_note: str = ""  # why the via-point writer has no module to edit (module None), in words
 
 
 def tool_transform(tool: ToolData) -> FloatArray:
@@ -657,7 +658,7 @@ def read_cycle_program(
         paths = [restored]
     tc = read_task_cycle(paths, robot, io=io, routine=routine, seed=seed, progress=progress, given=given)
     steps = _mark_idle(tc, idle_waits)
-    module = _static_view(tc, steps, robot, routine, io)
+    module, static_note = _static_view(tc, steps, robot, routine, io)
     if module is not None:
         steps = module[1]
     moves = [st for st in steps if st.kind == "move"]
@@ -676,6 +677,7 @@ def read_cycle_program(
             kept=tc.kept,
             task=tc,
             assumed=tc.trace.assumed,
+            static_note=static_note,
         ),
         True,
     )
@@ -741,33 +743,47 @@ def _static_view(
     robot: Robot,
     routine: str | None,
     io: Mapping[str, float | str | bool] | None,
-) -> tuple[Module, tuple[Step, ...]] | None:
+) -> tuple[tuple[Module, tuple[Step, ...]] | None, str]:
     """The static module view the via-point RAPID writer edits, where the task is one module that the
     static subset reader also reads to the same cycle (same statements, same targets to 1e-9 rad);
-    the steps then carry its statements. None otherwise (the task is written as EGM)."""
+    the steps then carry its statements. Else None (the task is written as EGM) and why, in words."""
     from joulepath.program._task import TaskCycle
 
     assert isinstance(tc, TaskCycle)
-    if len(tc.task.modules) != 1 or routine is not None or io or tc.kept:
-        return None
+    modules = len(tc.task.modules)
+    why = (
+        f"spans {modules} modules"
+        if modules != 1
+        else f"runs the routine {routine}, not main"
+        if routine is not None
+        else "reads an I/O scenario"
+        if io
+        else f"keeps {len(tc.kept)} move(s) as taught"
+        if tc.kept
+        else ""
+    )
+    if why:
+        return None, why
     m = tc.task.modules[0]
     try:
         module = parse_module(m.text, path=m.path)
         old = resolve_module(module, robot)
-    except (RapidError, InvalidInput, AssertionError):
-        return None
+    except (RapidError, InvalidInput, AssertionError) as err:
+        return None, f"holds what the writer's static reader does not read ({str(err)[:160]})"
+    if tc.task.moc is not None and tc.task.moc.base_pos_m != (0.0, 0.0, 0.0):
+        return None, "has its base frame from MOC.cfg, which the writer's static reader does not apply"
     if len(old.steps) != len(steps):
-        return None
+        return None, "runs other steps than the writer's static reader reads (calls, loops or waits)"
     out = []
     for a, b in zip(old.steps, steps, strict=True):
         if a.kind != b.kind or a.line != b.line:
-            return None
+            return None, f"runs other steps than the writer's static reader reads (line {b.line})"
         if a.kind == "move":
             assert a.q is not None and b.q is not None
             if np.abs(a.q - b.q).max() > 1e-9:
-                return None
+                return None, f"places line {b.line}'s target elsewhere than the writer's static reader does"
         out.append(replace(b, statement=a.statement))
-    return module, tuple(out)
+    return (module, tuple(out)), ""
 
 
 def _read_toml_with_waits(

@@ -39,6 +39,10 @@ class MotionConfig:
     base_pos_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     base_quat: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
     gravity_beta: float = 0.0
+    robot: str | None = None
+    """The ``ROBOT`` instance read (``ROB_2``), where the file names one."""
+    robots: tuple[str, ...] = ()
+    """Every ``ROBOT`` instance the file configures (a cell of several arms: ``ROB_1``, ``ROB_2``)."""
 
     @property
     def family(self) -> tuple[str, float | None, float | None] | None:
@@ -61,6 +65,11 @@ class MotionConfig:
         """What was read, a line each, for the run's notes."""
         out = []
         fam = self.family
+        if len(self.robots) > 1:
+            out.append(
+                f"{self.path}: {len(self.robots)} robots ({', '.join(self.robots)}): {self.robot}'s data "
+                "read (the task's number names it; else the first)"
+            )
         if self.robot_type is not None:
             what = (
                 f" (an IRB {fam[0]}, {fam[1]:g} m reach, {fam[2]:g} kg)" if fam and fam[1] and fam[2] else ""
@@ -80,13 +89,36 @@ class MotionConfig:
         return out
 
 
-def read_moc(path: Path) -> MotionConfig:
-    """The robot's type, base frame and mounting from a ``MOC.cfg`` (other sections are ignored)."""
+def task_number(paths: Sequence[str | Path]) -> int | None:
+    """The task's number that its modules' paths name (a backup's ``RAPID/TASK2``, a ``T_ROB2``
+    folder), where they all name the same one; else None."""
+    found = set()
+    for raw in paths:
+        for part in Path(raw).parts:
+            m = re.fullmatch(r"(?:TASK|T_ROB)(\d{1,2})", part, re.I)
+            if m:
+                found.add(int(m.group(1)))
+    return found.pop() if len(found) == 1 else None
+
+
+def read_moc(path: Path, task: int | None = None) -> MotionConfig:
+    """The robot's type, base frame and mounting from a ``MOC.cfg`` (other sections are ignored).
+
+    A cell of several arms configures several ``ROBOT`` instances (``-name "ROB_1"``, ``"ROB_2"``),
+    each with its own type and base frame: the one of task number ``task`` (``ROB_2`` for TASK2)
+    is read where the file has it, else the first; each instance's data alone."""
     data = read_capped(path, max_bytes=MAX_BYTES, what="a motion configuration (MOC.cfg)", error=RapidError)
     text, _, _ = decode(data)
     text = text.replace("\\\n", " ")
     section = re.search(r"^ROBOT:\s*$(.*?)(?=^[A-Z_]+:\s*$|\Z)", text, re.M | re.S)
-    body = section.group(1) if section else ""
+    whole = section.group(1) if section else ""
+    starts = [m.start() for m in re.finditer(r"-name\s+\"", whole)]
+    instances = [whole[a:b] for a, b in zip(starts, [*starts[1:], len(whole)], strict=True)] or [whole]
+    names = [m.group(1) if m else "" for m in (re.search(r'-name\s+"([^"]{1,40})"', i) for i in instances)]
+    chosen = 0
+    if task is not None:
+        chosen = next((k for k, name in enumerate(names) if re.fullmatch(rf"ROB_?{task}", name, re.I)), 0)
+    body = instances[chosen]
 
     def num(key: str, default: float) -> float:
         m = re.search(rf"-{key}\s+(-?[0-9.]+(?:[eE][-+]?[0-9]+)?)", body)
@@ -105,20 +137,27 @@ def read_moc(path: Path) -> MotionConfig:
         (num("base_frame_pos_x", 0.0), num("base_frame_pos_y", 0.0), num("base_frame_pos_z", 0.0)),
         tuple(v / norm for v in quat) if norm > 0.5 else (1.0, 0.0, 0.0, 0.0),  # type: ignore[arg-type]
         num("gravity_beta", 0.0),
+        names[chosen] or None,
+        tuple(n for n in names if n),
     )
 
 
 def find_moc(paths: Sequence[str | Path]) -> MotionConfig | None:
-    """The ``MOC.cfg`` given among ``paths`` or found in a folder of them, read; None where there is none."""
+    """The ``MOC.cfg`` given among ``paths`` or found in a folder of them, read (for the task whose
+    number the modules' paths name: :func:`task_number`); None where there is none."""
+    modules: list[Path] = []
+    moc: Path | None = None
     for raw in paths:
         p = Path(raw)
         if p.is_file() and p.name.lower() == "moc.cfg":
-            return read_moc(p)
-        if p.is_dir():
+            moc = moc or p
+        elif p.is_dir():
             found = sorted(f for f in p.rglob("*") if f.is_file() and f.name.lower() == "moc.cfg")
-            if found:
-                return read_moc(found[0])
-    return None
+            moc = moc or (found[0] if found else None)
+            modules.extend(f for f in p.rglob("*") if f.is_file() and f.suffix.lower() in MODULE_SUFFIXES)
+        else:
+            modules.append(p)
+    return None if moc is None else read_moc(moc, task_number(modules))
 
 
 @dataclass(frozen=True, slots=True)
@@ -214,6 +253,6 @@ def load_task(paths: Sequence[str | Path]) -> Task:
         signals,
         source,
         str(eio[0]) if eio else None,
-        read_moc(moc[0]) if moc else None,
+        read_moc(moc[0], task_number(unique)) if moc else None,
         tuple(notes),
     )
