@@ -770,8 +770,6 @@ def _static_view(
         old = resolve_module(module, robot)
     except (RapidError, InvalidInput, AssertionError) as err:
         return None, f"holds what the writer's static reader does not read ({str(err)[:160]})"
-    if tc.task.moc is not None and tc.task.moc.base_pos_m != (0.0, 0.0, 0.0):
-        return None, "has its base frame from MOC.cfg, which the writer's static reader does not apply"
     if len(old.steps) != len(steps):
         return None, "runs other steps than the writer's static reader reads (calls, loops or waits)"
     out = []
@@ -781,6 +779,15 @@ def _static_view(
         if a.kind == "move":
             assert a.q is not None and b.q is not None
             if np.abs(a.q - b.q).max() > 1e-9:
+                moc = tc.task.moc
+                if moc is not None and (moc.base_pos_m, moc.base_quat) != (
+                    (0.0, 0.0, 0.0),
+                    (1.0, 0.0, 0.0, 0.0),
+                ):
+                    return (
+                        None,
+                        "has its base frame from MOC.cfg, which the writer's static reader does not apply",
+                    )
                 return None, f"places line {b.line}'s target elsewhere than the writer's static reader does"
         out.append(replace(b, statement=a.statement))
     return (module, tuple(out)), ""
