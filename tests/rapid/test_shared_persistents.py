@@ -172,3 +172,28 @@ def test_a_joint_move_goes_to_the_programmed_configuration_with_confj_on_and_off
 """,
     )
     np.testing.assert_allclose(_moves(spec)[1].q, q, atol=1e-6)  # axis 6 at 30 deg, not at 390 deg
+
+
+def test_a_speed_declared_nowhere_that_the_task_sets_is_a_variable_stand_in(tmp_path, robot):
+    """A name declared nowhere whose component the task assigns (in a routine it calls) is data the task
+    owns: a stand-in variable that the assignment changes, not a constant it may not assign."""
+    spec = _read(
+        tmp_path,
+        robot,
+        """    PROC main()
+        MoveAbsJ jHome, v1000, fine, tool0;
+        MoveJ pA, vCell, fine, tool0;
+        SlowDown;
+        MoveL pB, vCell, fine, tool0;
+    ENDPROC
+    PROC SlowDown()
+        vCell.v_tcp := 100;
+    ENDPROC
+""",
+    )
+    assert [(a.name, a.role) for a in spec.assumed] == [("vCell", "speeddata")]
+    moves = _moves(spec)
+    assert moves[1].speed is not None and moves[2].speed is not None
+    assert moves[2].speed.v_tcp == pytest.approx(100.0) and moves[1].speed.v_tcp == pytest.approx(
+        1000.0
+    )  # mm/s

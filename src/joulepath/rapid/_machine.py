@@ -302,7 +302,8 @@ class Machine:
             said = "the scenario's value"
         else:
             value, taint, said = self._stand_in_value(name, role, pos)
-        storage = "CONST" if role in ("tooldata", "wobjdata", "speeddata", "zonedata", "loaddata") else "VAR"
+        data = role in ("tooldata", "wobjdata", "speeddata", "zonedata", "loaddata")
+        storage = "CONST" if data and key not in self.assigned and key not in self.set_names else "VAR"
         type_ = UNTYPED if role == "value" and key not in self.given else role
         cell = Cell(name, type_, storage, value, taint, pos)
         self.cells[("", key)] = cell
