@@ -191,3 +191,31 @@ def test_a_goto_loop_that_counts_runs_as_written(tmp_path, robot):
     )
     assert labels == ["MoveAbsJ jA", "MoveAbsJ jB", "MoveAbsJ jC"]
     assert not any("jumps back, moving nothing" in c for c in spec.choices)
+
+
+def test_a_while_true_that_a_function_returns_from_is_a_wait_for_an_answer_not_the_cycle(tmp_path, robot):
+    """An operator's menu: ``WHILE TRUE`` until a valid answer, then ``RETURN`` it. Not the production
+    loop (it is left by its RETURN): the answer is assumed to come, and the moves after it run."""
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    VAR num mode;
+    FUNC num AskMode()
+        VAR num key;
+        WHILE TRUE DO
+            TPReadFK key, "Mode?", "A", "B", stEmpty, stEmpty, stEmpty;
+            IF key = 1 OR key = 2 THEN
+                RETURN key;
+            ENDIF
+        ENDWHILE
+    ENDFUNC
+    PROC main()
+        MoveAbsJ jA, v1000, fine, tool0;
+        mode := AskMode();
+        MoveAbsJ jB, v1000, fine, tool0;
+        MoveAbsJ jC, v1000, fine, tool0;
+    ENDPROC
+""",
+    )
+    assert labels == ["MoveAbsJ jA", "MoveAbsJ jB", "MoveAbsJ jC"]
+    assert any("the way out of the loop that waits for it" in c for c in spec.choices)

@@ -111,6 +111,7 @@ class Machine:
         self.loop: n.Pos | None = None
         self.ctx_taint: Taint = CLEAN
         self.after_branch: Taint = CLEAN
+        self.leaving = False  # a spinning loop's last turn: run-time branches toward its way out
         self.settings = MotionSettings()
         self.pdisp: FloatArray | None = None
         self.current_q: FloatArray | None = None

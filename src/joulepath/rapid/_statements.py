@@ -181,6 +181,8 @@ def exec_if(ip: Machine, s: n.If) -> None:
         # decided at run time: the stand-in's branch does not move; assume the one that moves most
         # (where no branch moves, the stand-in's value decides, as it decides any other datum)
         chosen, label = _most_moving(ip, options, "assumed")
+    if taint and ip.leaving:
+        chosen, label = _way_out(options, chosen, label)
     if taint and not ip.ctx_taint:
         ip.note(f"{s.pos}: IF decided at run time: {'; '.join(sorted(taint))} -> {label} taken")
     elif (
@@ -218,6 +220,8 @@ def exec_test(ip: Machine, s: n.Test) -> None:
             chosen, label = _production_turn(ip, s.pos, "TEST", options, shared)
     if t and not has_motion(ip, chosen, 0) and has_motion(ip, (s,), 0):
         chosen, label = _most_moving(ip, options, "assumed")
+    if t and ip.leaving:
+        chosen, label = _way_out(options, chosen, label)
     if t and not ip.ctx_taint:
         ip.note(f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken")
     elif not t and not ip.ctx_taint and has_motion(ip, (s,), 0) and "assumed" not in label:
@@ -282,8 +286,31 @@ FIXED_TURNS = 2
 that leaves the task's data as it found them (:meth:`Machine.snapshot`) would repeat for ever."""
 
 
+def _left_by_a_statement(body: tuple[n.Stmt, ...]) -> bool:
+    """Whether a loop's body leaves it by a statement: ``RETURN``, ``EXIT``, ``RAISE``, or a ``GOTO`` to
+    a label outside it (a ``WHILE TRUE`` a routine returns from is a wait for an answer, not the
+    production loop)."""
+    labels = {s.name.lower() for s in n.walk_statements(body) if isinstance(s, n.Label)}
+    return any(
+        isinstance(s, (n.Return, n.Exit, n.Raise))
+        or (isinstance(s, n.Goto) and s.label.lower() not in labels)
+        for s in n.walk_statements(body)
+    )
+
+
+def _way_out(
+    options: list[tuple[tuple[n.Stmt, ...], str]], chosen: tuple[n.Stmt, ...], label: str
+) -> tuple[tuple[n.Stmt, ...], str]:
+    """In the last turn of a spinning loop that a statement leaves: the first branch holding that
+    statement (the answer the loop waits for), else the branch chosen."""
+    for body, name in options:
+        if any(isinstance(x, (n.Return, n.Exit, n.Raise, n.Goto)) for x in n.walk_statements(body)):
+            return body, f"{name} (assumed: the way out of the loop that waits for it)"
+    return chosen, label
+
+
 def exec_while(ip: Machine, s: n.While) -> None:
-    if _endless(ip, s.cond):
+    if _endless(ip, s.cond) and not _left_by_a_statement(s.body):
         if ip.cycle_end is None and ip.loop is None:
             # the production loop: its first turn starts from where the way there left the robot
             # and with the settings made before it; the turns after it are the cycle that repeats
@@ -309,11 +336,19 @@ def exec_while(ip: Machine, s: n.While) -> None:
         if v and not t and turns >= FIXED_TURNS:
             now = ip.snapshot()
             if now == last and still:  # a turn left every datum as it found it: it would spin for ever
+                leaves = _left_by_a_statement(s.body)
                 ip.note(
                     f"{s.pos}: WHILE spins, moving nothing, and a turn leaves the task's data as it found "
                     "them: only the world outside the task (a PLC, the HMI, an operator, another task) "
                     f"ends it; assumed to end after {turns} turns"
+                    + (", by the statement that leaves it" if leaves else "")
                 )
+                if leaves:  # a last turn, its branches decided at run time toward the way out
+                    ip.leaving = True
+                    try:
+                        ip.exec_body(s.body)
+                    finally:
+                        ip.leaving = False
                 return
             if now == last and ip.cycle_end is None and ip.loop is None:
                 # it moves, and each turn repeats the last: the production loop, until the outside ends it
