@@ -219,3 +219,26 @@ def test_a_while_true_that_a_function_returns_from_is_a_wait_for_an_answer_not_t
     )
     assert labels == ["MoveAbsJ jA", "MoveAbsJ jB", "MoveAbsJ jC"]
     assert any("the way out of the loop that waits for it" in c for c in spec.choices)
+
+
+def test_an_exitcycle_first_run_starts_main_again_with_its_data_kept(tmp_path, robot):
+    """A first run that sets a flag and breaks the cycle (``ExitCycle``): the controller starts main
+    again, data kept, and that run is the cycle; an ExitCycle after moves ends the cycle there."""
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    PERS bool bFirstDone := FALSE;
+    PROC main()
+        IF bFirstDone = FALSE THEN
+            bFirstDone := TRUE;
+            ExitCycle;
+        ENDIF
+        MoveAbsJ jA, v1000, fine, tool0;
+        MoveAbsJ jB, v1000, fine, tool0;
+        ExitCycle;
+        MoveAbsJ jC, v1000, fine, tool0;
+    ENDPROC
+""",
+    )
+    assert labels == ["MoveAbsJ jA", "MoveAbsJ jB"]
+    assert any("before any move: main starts again" in c for c in spec.choices)

@@ -15,7 +15,7 @@ from joulepath.rapid import geometry as geo
 from joulepath.rapid import nodes as n
 from joulepath.rapid._machine import CallHandler, Machine
 from joulepath.rapid._scan import pairs, set_outside
-from joulepath.rapid._state import Ref, StopRun
+from joulepath.rapid._state import CycleRestart, Ref
 from joulepath.rapid._trace import CLEAN, Action, Wait
 from joulepath.rapid._vocabulary import INPUT_WRITERS, IO_SETTERS, IO_WAITS, KNOWN_INSTRUCTIONS
 from joulepath.rapid.values import Record, Signal, Value, equal, num
@@ -69,7 +69,7 @@ def _change_num(ip: Machine, s: n.Call, key: str) -> None:
 
 
 def _exit_cycle(ip: Machine, s: n.Call, key: str) -> None:
-    raise StopRun(f"{s.pos}: ExitCycle ends the cycle")
+    raise CycleRestart(f"{s.pos}: ExitCycle ends the cycle")
 
 
 def _other(ip: Machine, s: n.Call, key: str) -> None:

@@ -52,6 +52,10 @@ class StopRun(Exception):
         self.why = why
 
 
+class CycleRestart(StopRun):
+    """``ExitCycle``: the controller breaks the cycle and starts ``main`` again, its data kept."""
+
+
 # ------------------------------------------------------------------ storage
 class Cell:
     """A datum: its type, storage class, value, the reasons it is uncertain, and where it is declared."""

@@ -42,6 +42,7 @@ from __future__ import annotations
 import sys
 
 from joulepath.errors import RapidError
+from joulepath.rapid import nodes as n
 from joulepath.rapid._expressions import EXPRESSIONS
 from joulepath.rapid._machine import Machine
 from joulepath.rapid._motion import target_flange
@@ -57,6 +58,7 @@ from joulepath.rapid._state import (
     UNKNOWN_TARGET,
     UNTYPED,
     ZONES,
+    CycleRestart,
     Frame,
     GotoLabel,
     ReturnValue,
@@ -89,11 +91,36 @@ __all__ = [
 ]
 
 
+RESTARTS = 3
+"""``ExitCycle`` before any move starts ``main`` again at most this many times (a first-run set-up)."""
+
+
 class Interpreter(Machine):
     """One run of a task: :meth:`run` gives the :class:`Trace` (see the module's docstring)."""
 
     expressions = EXPRESSIONS
     statements = STATEMENTS
+    restarted = 0
+    """The event where the last start of ``main`` after ``ExitCycle`` began (0: none)."""
+
+    def _run_main(self, r: n.Routine, m: n.Module) -> None:
+        """``main`` run as the controller runs it: an ``ExitCycle`` reached before any move (a first
+        run that sets a flag and breaks the cycle) starts it again from its first statement, the
+        data kept, and the cycle is that next run; one after a move ends the cycle there."""
+        for _ in range(RESTARTS):
+            start = len(self.events)
+            try:
+                invoke(self, r, m, (), r.pos)
+                return
+            except CycleRestart as stop:
+                if self.cycle_end is not None or any(isinstance(e, Motion) for e in self.events[start:]):
+                    raise
+                self.note(
+                    f"{stop.why} before any move: main starts again, its data kept (as the controller does)"
+                )
+                self.stack = [Frame(None, m, {}, set(), m.name)]
+                self.restarted = len(self.events)
+        invoke(self, r, m, (), r.pos)
 
     def run(self, routine: str | None = None) -> Trace:
         name = routine or "main"
@@ -132,7 +159,7 @@ class Interpreter(Machine):
         limit = sys.getrecursionlimit()
         sys.setrecursionlimit(max(limit, 20 * MAX_DEPTH + 2000))
         try:
-            invoke(self, r, m, (), r.pos)
+            self._run_main(r, m)
         except StopRun as stop:
             if self.cycle_end is None:
                 self.note(stop.why)
@@ -150,6 +177,8 @@ class Interpreter(Machine):
         finally:
             sys.setrecursionlimit(limit)
         end = self.cycle_end if self.cycle_end is not None else len(self.events)
+        if self.restarted:
+            self.cycle_start = max(self.cycle_start, self.restarted)
         return Trace(
             tuple(self.events),
             self.cycle_start,
