@@ -197,3 +197,32 @@ def test_a_speed_declared_nowhere_that_the_task_sets_is_a_variable_stand_in(tmp_
     assert moves[2].speed.v_tcp == pytest.approx(100.0) and moves[1].speed.v_tcp == pytest.approx(
         1000.0
     )  # mm/s
+
+
+ARC = "[5,0,24,120,0,0,0,0,0]"
+SEAM = f"[0.5,0.5,{ARC},1,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,1,{ARC},0,0,[0,0,0,0,0,0,0,0,0],0]"
+
+
+def test_an_options_data_components_and_an_egm_move_are_read_not_refused(tmp_path, robot):
+    """Arc's ``seamdata`` carried whole (its components set in a program: not modelled, said), and
+    ``EGMMoveL``: a linear move whose path a sensor corrects through EGM while it runs (kept)."""
+    spec = _read(
+        tmp_path,
+        robot,
+        f"""    PERS seamdata seams{{2}} := [{SEAM}, {SEAM}];
+    VAR egmident egmId;
+    PROC main()
+        seams{{2}}.ign_move_delay := 2;
+        MoveAbsJ jHome, v1000, fine, tool0;
+        MoveJ pA, v1000, fine, tool0;
+        EGMGetId egmId;
+        EGMMoveL egmId, pB, v100, fine, tool0;
+        MoveJ pA, v1000, fine, tool0;
+    ENDPROC
+""",
+    )
+    assert any("seams.ign_move_delay: a component of seamdata" in c for c in spec.choices)
+    labels = [s.label for s in _moves(spec)]
+    assert labels == ["MoveAbsJ jHome", "MoveJ pA", "EGMMoveL pB", "MoveJ pA"]
+    kept = dict(spec.kept)
+    assert any("corrected by a sensor through EGM" in why for why in kept.values())

@@ -584,6 +584,13 @@ class Machine:
                     idx = [1] * len(cur.dims)
                 return Ref(r.cell, (*r.path, ("idx", tuple(idx))))
             cur = r.get()
+            if not isinstance(cur, Record) and opaque_ok(self.types.resolve(r.cell.type)):
+                # an option's data (Arc's seamdata ...), carried whole: its components are not modelled
+                self.note(
+                    f"{e.pos}: {r.cell.name}.{e.name}: a component of {r.cell.type} (an option's data), not "
+                    "modelled: read as 0, set without effect on the motion"
+                )
+                return Ref(r.cell, (*r.path, ("opq", e.name.lower())))
             if not isinstance(cur, Record) or e.name.lower() not in cur.names:
                 raise RapidError(f"{e.pos}: {describe(cur)} has no component {e.name}; correct the name")
             return Ref(r.cell, (*r.path, ("fld", e.name.lower())))

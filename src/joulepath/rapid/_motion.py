@@ -24,6 +24,7 @@ from joulepath.rapid._trace import CLEAN, Motion, Taint
 from joulepath.rapid._vocabulary import (
     ABSJ_MOTIONS,
     CIRCULAR_MOTIONS,
+    EGM_MOTIONS,
     JOINT_MOTIONS,
     LINEAR_MOTIONS,
     PROCESS_CIRCULAR,
@@ -172,7 +173,9 @@ def _kept(s: n.Call, key: str, mv: _Move, taint: Taint, circular: bool) -> set[s
     kept = set(taint | mv.targets[-1][1] | mv.speed_t | mv.zone_t | mv.tool_t | mv.wobj_t)
     if circular:
         kept |= mv.targets[0][1]
-    if key in PROCESS_LINEAR or key in PROCESS_CIRCULAR:
+    if key in EGM_MOTIONS:
+        kept.add(f"{s.pos}: {s.name}: its path is corrected by a sensor through EGM while it runs")
+    elif key in PROCESS_LINEAR or key in PROCESS_CIRCULAR:
         kept.add(f"{s.pos}: {s.name} is a process instruction: its speed is the process's")
     if key in SEARCH_MOTIONS:
         kept.add(f"{s.pos}: {s.name} stops where its signal comes: its end is known only at run time")

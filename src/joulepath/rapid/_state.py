@@ -83,6 +83,8 @@ class Ref:
     def get(self) -> Value:
         v = self.cell.value
         for kind, key in self.path:
+            if kind == "opq":  # a component of an option's data that the interpreter does not model
+                return 0.0
             if kind == "idx":
                 assert isinstance(v, Array) and isinstance(key, tuple)
                 v = v.items[v.offset(key)]
@@ -105,6 +107,8 @@ class Ref:
             assert isinstance(v, Record) and isinstance(key, str)
             return v.replace(key, put(v.get(key), path[1:]))
 
+        if any(kind == "opq" for kind, _ in self.path):
+            return  # a component of an option's data (seamdata ...): not modelled, the datum kept
         self.cell.value = put(self.cell.value, self.path)
         self.cell.taint = (self.cell.taint | taint) if self.path else taint
 

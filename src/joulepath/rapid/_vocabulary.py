@@ -20,9 +20,13 @@ CIRCULAR_MOTIONS = {"movec": "MoveC", "movecdo": "MoveC", "movecsync": "MoveC", 
 ABSJ_MOTIONS = {"moveabsj": "MoveAbsJ", "moveabsjsync": "MoveAbsJ", "triggabsj": "MoveAbsJ"}
 PROCESS_LINEAR = {
     "arcl", "arclstart", "arclend", "arcl1", "arcl2", "paintl", "displ", "capl", "caplstart", "caplend",
-    "laserl", "cutl", "gluel", "dispensel",
+    "laserl", "cutl", "gluel", "dispensel", "egmmovel",
 }  # fmt: skip
-PROCESS_CIRCULAR = {"arcc", "arccstart", "arccend", "arcc1", "arcc2", "paintc", "dispc", "capc", "gluec"}
+PROCESS_CIRCULAR = {
+    "arcc", "arccstart", "arccend", "arcc1", "arcc2", "paintc", "dispc", "capc", "gluec", "egmmovec",
+}  # fmt: skip
+EGM_MOTIONS = {"egmmovel", "egmmovec"}
+"""Moves whose path an external sensor corrects through EGM while they run (``EGMMoveL``, ``EGMMoveC``)."""
 SEARCH_MOTIONS = {"searchl": "MoveL", "searchc": "MoveC", "searchj": "MoveJ", "searchextj": "MoveJ"}
 
 IO_SETTERS = {"setdo", "set", "reset", "pulsedo", "invertdo", "setgo", "setao", "setdosync"}
@@ -59,7 +63,7 @@ KNOWN_INSTRUCTIONS = {
     "triggrampaio", "triggdataset", "triggstopproc", "triggdatareset", "pathrecstart", "pathrecstop",
     "pathrecmovebwd", "pathrecmovefwd", "pathresol", "setsysdata", "getsysdata", "loadid",
     "egmactjoint", "egmactpose", "egmrunjoint", "egmrunpose", "egmstop", "egmreset", "egmsetupuc",
-    "egmgetid", "egmstreamstart", "egmstreamstop", "egmmovel", "egmmovec",
+    "egmgetid", "egmstreamstart", "egmstreamstop",
     # waits and flow
     "waittime", "waituntil", "waitdi", "waitdo", "waitgi", "waitgo", "waitai", "waitao", "waitsynctask",
     "waitload", "waittestandset", "waitwobj", "dropwobj", "stop", "break", "exitcycle", "systemstopaction",
