@@ -24,7 +24,7 @@ from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, RapidError
 from joulepath.kinematics import check_layout, confdata, solve_ik
 from joulepath.rapid import geometry as geo
-from joulepath.rapid.interpreter import UNKNOWN_TARGET, Action, Interpreter, Motion, Trace, Wait
+from joulepath.rapid.interpreter import UNKNOWN_TARGET, Action, Interpreter, Motion, Trace, Wait, listed
 from joulepath.rapid.interpreter import moves_in as _moves
 from joulepath.rapid.task import Task, load_task
 from joulepath.rapid.values import Record, num, pos_values
@@ -255,12 +255,13 @@ def read_task_cycle(
                 (r for m in task.modules for r in m.routines if r.name.lower() == trace.routine.lower()), None
             )
             where = str(found.pos) if found is not None else task.source
+        routines = {r.name.lower(): r for m in task.modules for r in m.routines}
         movers = sorted(
             {
                 r.name
                 for m in task.modules
                 for r in m.routines
-                if r.kind == "PROC" and _moves(r) and not r.params
+                if r.kind == "PROC" and _moves(r, routines) and not r.params
             }
             - {trace.routine}
         )
@@ -274,8 +275,7 @@ def read_task_cycle(
             )
             return replace(tc, trace=replace(tc.trace, notes=(said, *tc.trace.notes)))
         hint = (
-            f"; give --routine NAME, one of the routines that move the robot: {', '.join(movers[:8])}"
-            + (f" (and {len(movers) - 8} more)" if len(movers) > 8 else "")
+            f"; give --routine NAME, one of the routines that move the robot: {listed(movers)}"
             if movers
             else "; nothing to optimize"
         )

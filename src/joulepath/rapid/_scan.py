@@ -9,6 +9,7 @@ from joulepath.rapid import builtins
 from joulepath.rapid import nodes as n
 from joulepath.rapid._trace import Taint
 from joulepath.rapid._vocabulary import (
+    ALL_MOTIONS,
     IO_SETTERS,
     IO_WAITS,
 )
@@ -157,18 +158,44 @@ def pairs(args: tuple[n.Arg, ...]) -> list[tuple[str | None, n.Expr | None]]:
     return [(None if a.kind == "pos" else a.name, a.value) for a in args if a.kind in ("pos", "opt", "named")]
 
 
-def moves_in(r: n.Routine) -> bool:
-    """Whether a routine holds a move, or a call that may move (listed for the user to choose)."""
+def listed(names: list[str], most: int = 6) -> str:
+    """Names for an error line: at most ``most`` of them, and how many more (the line stays short).
 
-    def walk(body: tuple[n.Stmt, ...]) -> bool:
+    >>> listed(["a", "b", "c"], 2)
+    'a, b (and 1 more)'
+    """
+    more = f" (and {len(names) - most} more)" if len(names) > most else ""
+    return ", ".join(names[:most]) + more
+
+
+def moves_in(r: n.Routine, routines: Mapping[str, n.Routine] | None = None) -> bool:
+    """Whether a routine holds a move, or a call that may move (listed for the user to choose): a
+    motion instruction, a routine of ``routines`` that moves (followed 8 calls deep), a late-bound
+    call, or a call to a name neither the task nor RAPID's table declares; not a documented
+    instruction that does not move (``TPWrite``, ``SetDO`` ...)."""
+
+    def walk(body: tuple[n.Stmt, ...], depth: int) -> bool:
         for s in body:
+            if isinstance(s, n.LateCall):
+                return True
             if isinstance(s, n.Call):
-                return True  # a move, or a call that may move
-            if any(walk(b) for b in n.blocks(s)):
+                key = s.name.lower()
+                if key in ALL_MOTIONS:
+                    return True
+                found = None if routines is None else routines.get(key)
+                if found is not None:
+                    if depth >= 8 or walk(found.body, depth + 1):
+                        return True
+                    continue
+                known = builtins.lookup(key)
+                if known is None or known.motion is not None:
+                    return True  # declared nowhere (a module not given, an option's move) or a move
+                continue
+            if any(walk(b, depth) for b in n.blocks(s)):
                 return True
         return False
 
-    return walk(r.body)
+    return walk(r.body, 0)
 
 
 def set_outside(

@@ -47,7 +47,7 @@ from joulepath.rapid._expressions import EXPRESSIONS
 from joulepath.rapid._machine import Machine
 from joulepath.rapid._motion import target_flange
 from joulepath.rapid._routines import invoke
-from joulepath.rapid._scan import moves_in
+from joulepath.rapid._scan import listed, moves_in
 from joulepath.rapid._state import (
     MAX_DEPTH,
     MAX_LOOP_TURNS,
@@ -86,6 +86,7 @@ __all__ = [
     "Taint",
     "Trace",
     "Wait",
+    "listed",
     "moves_in",
     "target_flange",
 ]
@@ -129,17 +130,19 @@ class Interpreter(Machine):
             for m in self.task.modules:
                 found = self.local_routines[m.name.lower()].get(name.lower()) or found
         if found is None:
-            movers = sorted({r.name for r, _ in self.routines.values() if r.kind == "PROC" and moves_in(r)})
-            where = f"{self.task.modules[0].path}:{self.task.modules[0].pos.line}"
-            if routine is None:
-                raise RapidError(
-                    f"{where}: no main routine in {self.task.source}; give --routine NAME, one of the "
-                    f"routines that move the robot: {', '.join(movers) or '(none)'}"
-                )
-            raise RapidError(
-                f"{where}: no routine {routine} in {self.task.source}; give --routine NAME, one of: "
-                f"{', '.join(movers) or '(none)'}"
+            table = {k: r for k, (r, _) in self.routines.items()}
+            movers = sorted(
+                {r.name for r, _ in self.routines.values() if r.kind == "PROC" and moves_in(r, table)}
             )
+            where = f"{self.task.modules[0].path}:{self.task.modules[0].pos.line}"
+            which = (
+                f"give --routine NAME, one of the routines that move the robot: {listed(movers)}"
+                if movers
+                else "no routine of it moves the robot (no move instruction in what was given)"
+            )
+            if routine is None:
+                raise RapidError(f"{where}: no main routine in {self.task.source}; {which}")
+            raise RapidError(f"{where}: no routine {routine} in {self.task.source}; {which}")
         r, m = found
         if r.kind != "PROC" or any(not p.optional for p in r.params):
             raise RapidError(
