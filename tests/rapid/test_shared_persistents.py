@@ -226,3 +226,23 @@ def test_an_options_data_components_and_an_egm_move_are_read_not_refused(tmp_pat
     assert labels == ["MoveAbsJ jHome", "MoveJ pA", "EGMMoveL pB", "MoveJ pA"]
     kept = dict(spec.kept)
     assert any("corrected by a sensor through EGM" in why for why in kept.values())
+
+
+def test_a_cycle_that_does_not_move_on_its_stand_in_inputs_names_them(tmp_path, capsys):
+    path = tmp_path / "cell.mod"
+    path.write_text(
+        HEAD
+        + """    PROC main()
+        MoveAbsJ jHome, v1000, fine, tool0;
+        IF DInput(diPalletA) = 1 THEN
+            WaitTime 0.5;
+        ENDIF
+        MoveAbsJ jHome, v1000, fine, tool0;
+    ENDPROC
+ENDMODULE
+"""
+    )
+    assert main(["cycle", str(path), "--out", str(tmp_path / "out"), "--export", "egm"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "the cycle does not move the arm" in err[0]
+    assert "it reads inputs taken as 0 (diPalletA): where they choose its work, give them with --io" in err[0]

@@ -12,6 +12,7 @@ are taken into account (targets are TCP poses, the load is carried in the dynami
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -52,6 +53,7 @@ from joulepath.program._parse import (
     WOBJ0,
     parse_module,
 )
+from joulepath.rapid.interpreter import listed
 from joulepath.sim import SpeedData, Step
 
 
@@ -611,9 +613,16 @@ def check_moves_arm(spec: CycleSpec) -> None:
             f"{names}, {where}); give the module that declares them, or their "
             "values in the scenario file ([targets], [wobj.NAME], [tool.NAME])"
         )
+    inputs = sorted({m.group(1) for c in spec.choices for m in re.finditer(r"(\w+) is read at run time", c)})
+    hint = (
+        f"; it reads inputs taken as 0 ({listed(inputs, 4)}): where they choose its work, give them "
+        "with --io NAME=VALUE"
+        if inputs
+        else ": give targets that differ"
+    )
     raise InvalidInput(
         f"{spec.source}: the cycle does not move the arm (every move goes where the arm already is); "
-        "nothing to optimize: give targets that differ"
+        f"nothing to optimize{hint}"
     )
 
 
