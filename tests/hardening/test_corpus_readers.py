@@ -166,8 +166,8 @@ CASES = [
     C("rapid-parens-5000-deep", CYC, 2, "nested more than 32 deep", {"p.mod": mod(*AB, "WaitTime " + "(" * 5000 + "1" + ")" * 5000 + ";")}),
     C("rapid-signs-5000-deep", CYC, 2, "nested more than 32 deep", {"p.mod": mod(*AB, "WaitTime " + "-" * 5000 + "1;")}),
     C("rapid-if-2000-deep", CYC, 2, "blocks and calls nest more than 32 deep", {"p.mod": mod(AB[0], *["IF TRUE THEN"] * 2000, AB[1], *["ENDIF"] * 2000)}),
-    C("rapid-1500-chained-procedures", CYC, 2, "calls nest more than 32 deep", {"p.mod": mod(AB[0], "p0;", procs=CHAIN_1500)}),
-    C("rapid-1500-chained-recursive", CYC, 2, "calls nest more than 32 deep", {"p.mod": mod(AB[0], "p0;", procs=CHAIN_1500.replace("MoveAbsJ jB, v1000, fine, tool0;", "p0;"))}),
+    C("rapid-1500-chained-procedures", CYC, 2, "calls nest more than 128 deep", {"p.mod": mod(AB[0], "p0;", procs=CHAIN_1500)}),
+    C("rapid-1500-chained-recursive", CYC, 2, "calls nest more than 128 deep", {"p.mod": mod(AB[0], "p0;", procs=CHAIN_1500.replace("MoveAbsJ jB, v1000, fine, tool0;", "p0;"))}),
     C("rapid-recursion", CYC, 2, "calls itself", {"p.mod": mod(AB[0], "p0;", procs="    PROC p0()\n        p1;\n    ENDPROC\n    PROC p1()\n        p0;\n    ENDPROC\n")}),
     # ---- linear time
     C("rapid-30-procedures-each-call-the-next-twice", CYC, 2, "more than 200000 statements", {"p.mod": mod(*AB, "p0;", procs=DOUBLE_30)}),

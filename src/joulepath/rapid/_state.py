@@ -17,8 +17,9 @@ MAX_STEPS = 200_000
 MAX_SECONDS: float | None = None
 """Wall time one run may take (s; None: none, the default: a run is bounded by its statements, so the
 same program is read the same on any machine)."""
-MAX_DEPTH = 32
-"""Deepest routine call (recursion) one run may take."""
+MAX_DEPTH = 128
+"""Deepest routine call (recursion) one run may take: published programs nest deeper than 32 (a
+welding task's call chain; a palletizer that recurses once per box)."""
 MAX_LOOP_TURNS = 200_000
 """Turns one loop may take."""
 SPIN_TURNS = 1000
