@@ -129,7 +129,11 @@ CLASSES: list[tuple[str, str, re.Pattern[str]]] = [
             re.I,
         ),
     ),
-    ("no-motion", "no motion in the cycle", re.compile(r"holds no move|no move|no motion|does not move the arm")),
+    (
+        "no-motion",
+        "no motion in the cycle",
+        re.compile(r"holds no move|no move|no motion|does not move the arm"),
+    ),
 ]
 TIMEOUT_CLASS = "timeout"
 
