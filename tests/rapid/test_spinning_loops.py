@@ -242,3 +242,47 @@ def test_an_exitcycle_first_run_starts_main_again_with_its_data_kept(tmp_path, r
     )
     assert labels == ["MoveAbsJ jA", "MoveAbsJ jB"]
     assert any("before any move: main starts again" in c for c in spec.choices)
+
+
+def test_an_error_flag_of_an_operators_read_is_no_error_of_any_kind(tmp_path, robot):
+    """``\\BreakFlag`` of an operator's read gives an errnum known only at run time; its stand-in (0, no
+    error) equals no ``ERR_`` constant, so the alarm branch that ends the program is not taken."""
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    VAR num answer;
+    PROC main()
+        VAR errnum errvar;
+        MoveAbsJ jA, v1000, fine, tool0;
+        TPReadFK answer, "Mode?", "Run", stEmpty, stEmpty, stEmpty, stEmpty \\BreakFlag:=errvar;
+        IF errvar = ERR_TP_MAXTIME EXIT;
+        IF ERR_TP_MAXTIME = ERR_TP_DIBREAK EXIT;
+        MoveAbsJ jB, v1000, fine, tool0;
+        MoveAbsJ jC, v1000, fine, tool0;
+    ENDPROC
+""",
+    )
+    assert labels == ["MoveAbsJ jA", "MoveAbsJ jB", "MoveAbsJ jC"]
+
+
+def test_a_menu_that_shows_itself_again_is_left_not_recursed_for_ever(tmp_path, robot):
+    spec, labels = _read(
+        tmp_path,
+        robot,
+        """    VAR num answer;
+    PROC ServiceMenu()
+        TPReadFK answer, "Service", "Home", "Back", stEmpty, stEmpty, stEmpty;
+        IF answer = 1 THEN
+            MoveAbsJ jC, v1000, fine, tool0;
+            ServiceMenu;
+        ENDIF
+    ENDPROC
+    PROC main()
+        MoveAbsJ jA, v1000, fine, tool0;
+        ServiceMenu;
+        MoveAbsJ jB, v1000, fine, tool0;
+    ENDPROC
+""",
+    )
+    assert labels[0] == "MoveAbsJ jA" and labels[-1] == "MoveAbsJ jB"
+    assert any("ServiceMenu calls itself again from a choice made at run time" in c for c in spec.choices)

@@ -112,6 +112,7 @@ class Machine:
         self.ctx_taint: Taint = CLEAN
         self.after_branch: Taint = CLEAN
         self.leaving = False  # a spinning loop's last turn: run-time branches toward its way out
+        self.error_codes: dict[str, float] = {}  # ERR_ constants met, each a distinct number
         self.settings = MotionSettings()
         self.pdisp: FloatArray | None = None
         self.current_q: FloatArray | None = None
@@ -284,8 +285,11 @@ class Machine:
             if ck not in self.cells:
                 self.cells[ck] = Cell(name, "signal", "IO", Signal(name, signal_kind(name)), CLEAN, None)
             return self.cells[ck]
-        if key == "errno" or key.startswith("err_"):
+        if key == "errno":
             return Cell(name, "errnum", "CONST", 0.0, CLEAN, None)
+        if key.startswith("err_"):  # each error constant its own number, none 0 (a flag's "no error")
+            code = self.error_codes.setdefault(key, float(len(self.error_codes) + 1))
+            return Cell(name, "errnum", "CONST", code, CLEAN, None)
         return self.stand_in(name, pos)
 
     def stand_in(self, name: str, pos: n.Pos) -> Cell:

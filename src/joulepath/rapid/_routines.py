@@ -10,6 +10,10 @@ from joulepath.rapid._state import MAX_DEPTH, Cell, Frame, ReturnValue
 from joulepath.rapid._trace import CLEAN, Taint
 from joulepath.rapid.values import SIGNAL_TYPES, Array, TypeErrorRapid, Value, describe
 
+MENU_REENTRIES = 2
+"""Entries of a procedure that calls itself from branches decided at run time before the last call is
+taken as the way out (:func:`invoke`)."""
+
 
 def invoke(
     ip: Machine, r: n.Routine, m: n.Module, args: tuple[n.Arg, ...], pos: n.Pos
@@ -24,6 +28,14 @@ def invoke(
             f"{pos}: {r.name}: calls nest more than {MAX_DEPTH} deep (a chain of routines); call fewer "
             "routines from each other"
         )
+    if r.kind == "PROC" and ip.ctx_taint and sum(f.routine is r for f in ip.stack) >= MENU_REENTRIES:
+        # a procedure that calls itself again from a branch decided at run time: an operator's menu
+        # shown again after each choice; the operator is taken to leave it here
+        ip.note(
+            f"{pos}: {r.name} calls itself again from a choice made at run time (a menu shown again): "
+            f"taken to be left after {MENU_REENTRIES} entries"
+        )
+        return 0.0, CLEAN
     frame = Frame(r, m, {}, set(), f"{r.name} ({pos.file}:{pos.line})")
     positional = [p for p in r.params if not p.optional]
     given = [a for a in args if a.kind == "pos"]
