@@ -177,9 +177,9 @@ def exec_if(ip: Machine, s: n.If) -> None:
         shared = frozenset().union(*(_shared(ip, c) for c, _ in s.branches))
         if shared:  # the production turn of data the HMI, a PC or another task sets: stated, then known
             chosen, label = _production_turn(ip, s.pos, "IF", options, shared)
-    if taint and not has_motion(ip, chosen, 0) and has_motion(ip, (s,), 0):
+    if taint and not has_motion(ip, chosen, 0):
         # decided at run time: the stand-in's branch does not move; assume the one that moves most
-        # (where no branch moves, the stand-in's value decides, as it decides any other datum)
+        # (of equals the first: where no branch moves, a menu's first choice, which moves on)
         chosen, label = _most_moving(ip, options, "assumed")
     if taint and ip.leaving:
         chosen, label = _way_out(options, chosen, label)
@@ -218,7 +218,7 @@ def exec_test(ip: Machine, s: n.Test) -> None:
         shared = _shared(ip, s.expr)
         if shared:
             chosen, label = _production_turn(ip, s.pos, "TEST", options, shared)
-    if t and not has_motion(ip, chosen, 0) and has_motion(ip, (s,), 0):
+    if t and not has_motion(ip, chosen, 0):
         chosen, label = _most_moving(ip, options, "assumed")
     if t and ip.leaving:
         chosen, label = _way_out(options, chosen, label)
@@ -309,8 +309,30 @@ def _way_out(
     return chosen, label
 
 
+def _wait_for_an_answer(ip: Machine, s: n.While) -> None:
+    """A ``WHILE TRUE`` that moves nothing and that a statement leaves (``RETURN`` the operator's
+    answer, ``GOTO`` on): a wait for the world outside the task. Its turns run; where they do not
+    leave it, the last takes, at each choice made at run time, the branch that leaves it (the answer
+    assumed to come). Returns only where even that turn stays in the loop."""
+    for _ in range(FIXED_TURNS):
+        ip.exec_body(s.body)
+    ip.leaving = True
+    try:
+        ip.exec_body(s.body)
+    except (ReturnValue, GotoLabel, StopRun):
+        ip.note(
+            f"{s.pos}: WHILE TRUE waits, moving nothing, for what only the world outside the task "
+            "gives (an operator, a PLC): its way out taken"
+        )
+        raise
+    finally:
+        ip.leaving = False
+
+
 def exec_while(ip: Machine, s: n.While) -> None:
-    if _endless(ip, s.cond) and not _left_by_a_statement(s.body):
+    if _endless(ip, s.cond) and _left_by_a_statement(s.body) and not has_motion(ip, s.body, 0):
+        _wait_for_an_answer(ip, s)  # returns only where no turn leaves it: as any endless loop below
+    if _endless(ip, s.cond):
         if ip.cycle_end is None and ip.loop is None:
             # the production loop: its first turn starts from where the way there left the robot
             # and with the settings made before it; the turns after it are the cycle that repeats
@@ -476,11 +498,20 @@ def _motion_weight(ip: Machine, body: tuple[n.Stmt, ...], depth: int = 0) -> int
     return total
 
 
+def _ends_the_program(body: tuple[n.Stmt, ...]) -> bool:
+    return any(isinstance(x, n.Exit) for x in n.walk_statements(body))
+
+
 def _most_moving(
     ip: Machine, options: list[tuple[tuple[n.Stmt, ...], str]], why: str
 ) -> tuple[tuple[n.Stmt, ...], str]:
-    """The branch that runs the most moves (the first of equals), labelled with ``why``."""
-    body, label = max(options, key=lambda o: _motion_weight(ip, o[0]))
+    """The branch that runs the most moves (the first of equals; of branches that move nothing, the
+    first that does not end the program: an alarm's ``EXIT`` is not the production turn), labelled
+    with ``why``."""
+    weights = [_motion_weight(ip, o[0]) for o in options]
+    top = max(weights)
+    tied = [o for o, w in zip(options, weights, strict=True) if w == top]
+    body, label = next((o for o in tied if top > 0 or not _ends_the_program(o[0])), tied[0])
     return body, f"{label} ({why}: the branch that moves most)"
 
 
