@@ -788,11 +788,7 @@ def _static_view(
         if a.kind == "move":
             assert a.q is not None and b.q is not None
             if np.abs(a.q - b.q).max() > 1e-9:
-                moc = tc.task.moc
-                if moc is not None and (moc.base_pos_m, moc.base_quat) != (
-                    (0.0, 0.0, 0.0),
-                    (1.0, 0.0, 0.0, 0.0),
-                ):
+                if tc.task.moc is not None and tc.task.moc.moves_the_base:
                     return (
                         None,
                         "has its base frame from MOC.cfg, which the writer's static reader does not apply",

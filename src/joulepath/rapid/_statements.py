@@ -286,14 +286,17 @@ FIXED_TURNS = 2
 that leaves the task's data as it found them (:meth:`Machine.snapshot`) would repeat for ever."""
 
 
+LEAVING = (n.Return, n.Exit, n.Raise)
+"""Statements that leave a loop wherever they stand (a ``GOTO``: where its label is outside)."""
+
+
 def _left_by_a_statement(body: tuple[n.Stmt, ...]) -> bool:
     """Whether a loop's body leaves it by a statement: ``RETURN``, ``EXIT``, ``RAISE``, or a ``GOTO`` to
     a label outside it (a ``WHILE TRUE`` a routine returns from is a wait for an answer, not the
     production loop)."""
     labels = {s.name.lower() for s in n.walk_statements(body) if isinstance(s, n.Label)}
     return any(
-        isinstance(s, (n.Return, n.Exit, n.Raise))
-        or (isinstance(s, n.Goto) and s.label.lower() not in labels)
+        isinstance(s, LEAVING) or (isinstance(s, n.Goto) and s.label.lower() not in labels)
         for s in n.walk_statements(body)
     )
 
@@ -304,7 +307,7 @@ def _way_out(
     """In the last turn of a spinning loop that a statement leaves: the first branch holding that
     statement (the answer the loop waits for), else the branch chosen."""
     for body, name in options:
-        if any(isinstance(x, (n.Return, n.Exit, n.Raise, n.Goto)) for x in n.walk_statements(body)):
+        if any(isinstance(x, (*LEAVING, n.Goto)) for x in n.walk_statements(body)):
             return body, f"{name} (assumed: the way out of the loop that waits for it)"
     return chosen, label
 

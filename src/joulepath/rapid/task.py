@@ -55,6 +55,11 @@ class MotionConfig:
         return m.group(1), float(m.group(2)), float(m.group(3))
 
     @property
+    def moves_the_base(self) -> bool:
+        """Whether the base frame is other than the world's (targets go by it)."""
+        return self.base_pos_m != (0.0, 0.0, 0.0) or self.base_quat != (1.0, 0.0, 0.0, 0.0)
+
+    @property
     def mounting(self) -> str:
         beta = abs(self.gravity_beta) % (2 * math.pi)
         if beta < 0.1 or beta > 2 * math.pi - 0.1:
@@ -75,7 +80,7 @@ class MotionConfig:
                 f" (an IRB {fam[0]}, {fam[1]:g} m reach, {fam[2]:g} kg)" if fam and fam[1] and fam[2] else ""
             )
             out.append(f"{self.path}: the robot type is {self.robot_type}{what}")
-        if self.base_pos_m != (0.0, 0.0, 0.0) or self.base_quat != (1.0, 0.0, 0.0, 0.0):
+        if self.moves_the_base:
             pos = ", ".join(f"{1000 * v:.0f}" for v in self.base_pos_m)
             quat = ", ".join(f"{v:.4g}" for v in self.base_quat)
             out.append(
