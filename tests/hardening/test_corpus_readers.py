@@ -172,8 +172,8 @@ CASES = [
     # ---- linear time
     C("rapid-30-procedures-each-call-the-next-twice", CYC, 2, "more than 200000 statements", {"p.mod": mod(*AB, "p0;", procs=DOUBLE_30)}),
     C("rapid-30-procedures-with-arguments-twice", CYC, 2, "more than 200000", {"p.mod": mod(*AB, "p0 1;", procs=DOUBLE_30.replace("()", "(num x)").replace("p30(num x)", "p30(num x)\n        MoveAbsJ jA, v1000, fine, tool0;").replace(";\n", " x;\n").replace("TPWrite \"x\" x;", "TPWrite \"x\";").replace("tool0 x;", "tool0;"))}),
-    C("rapid-1mb-multiline-statement", "simulate --program {in}/p.mod --out {out}/a.csv", 0, "2 moves", {"p.mod": mod(*AB, decl=DECL + "    CONST num x := " + "1 +\n" * 200_000 + "1;\n")}),
-    C("rapid-1mb-statement", "simulate --program {in}/p.mod --out {out}/a.csv", 0, "2 moves", {"p.mod": mod(*AB, decl=DECL + "    CONST num x := " + "1+" * 500_000 + "1;\n")}),
+    C("rapid-1mb-multiline-statement", "simulate --program {in}/p.mod --out {out}/a.csv", 2, "chains more operators", {"p.mod": mod(*AB, decl=DECL + "    CONST num x := " + "1 +\n" * 200_000 + "1;\n")}),
+    C("rapid-1mb-statement", "simulate --program {in}/p.mod --out {out}/a.csv", 2, "chains more operators", {"p.mod": mod(*AB, decl=DECL + "    CONST num x := " + "1+" * 500_000 + "1;\n")}),
     # ---- work bounded before it starts (each names its limit and the variable that changes it)
     C("rapid-tiny-v", CYC, 2, "JOULEPATH_MAX_MOTION_S", {"p.mod": mod(AB[0], "MoveAbsJ jB, v1000\\V:=0.0001, fine, tool0;")}),
     C("rapid-speeddata-1e-9", CYC, 2, "JOULEPATH_MAX_MOTION_S", {"p.mod": mod(AB[0], "MoveAbsJ jB, vs, fine, tool0;", decl=DECL + "    CONST speeddata vs := [1e-9, 1e-9, 1e-9, 1e-9];\n")}),

@@ -6,7 +6,7 @@ import pytest
 from joulepath import load_robot
 from joulepath.data import read_log
 from joulepath.errors import InvalidInput
-from joulepath.program import RapidError, program_motion, read_module, resolve_module, simulate_program
+from joulepath.program import RapidError, program_motion, read_rapid_cycle, simulate_program
 from joulepath.sim import ControllerConfig, make_plant
 
 EXT = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
@@ -48,7 +48,7 @@ def test_simulate_program_writes_the_controller_log(tmp_path, program, robot):
     assert np.abs(log.qd[-1]).max() < 1e-6
     # main runs once: twice to jB (1.2 s each, \T) after the move back to jA and its wait
     config = ControllerConfig()
-    plan = program_motion(resolve_module(read_module(program), robot), config).plan
+    plan = program_motion(read_rapid_cycle([program], robot), config).plan
     assert res.program_time_s == pytest.approx(plan.cycle_time)
     assert res.duration_s == pytest.approx(plan.cycle_time + 2 * config.idle, abs=2 * config.sample_period)
     to_b = [m for m in plan.moves if m.step.label == "MoveAbsJ jB"]
@@ -87,8 +87,8 @@ def test_simulate_program_refuses_a_start_outside_the_ranges(tmp_path, program, 
 
 def test_simulate_program_refuses_an_unreadable_module(tmp_path, robot):
     bad = tmp_path / "bad.mod"
-    bad.write_text(PROGRAM.replace("TO 2", "TO n"))
-    with pytest.raises(RapidError, match=r"bad.mod:5: the FOR loop's TO 'n'"):
+    bad.write_text(PROGRAM.replace("TO 2 DO", "TO 2"))
+    with pytest.raises(RapidError, match=r"bad.mod:6: syntax error at .MoveAbsJ.: RAPID expects DO"):
         simulate_program(bad, tmp_path / "log.csv", robot=robot)
     assert not (tmp_path / "log.csv").exists()
 
@@ -103,10 +103,24 @@ def test_collection_program_in_table_mode_runs_as_simulate_draws_it(tmp_path, ro
     config = ControllerConfig()
     drawn = draw_moves(robot, 12, range_set="collection", rng=np.random.default_rng(4))
     direct = plan_moves(robot, robot.home, drawn, config)
-    spec = resolve_module(read_module(path), robot)
+    spec = read_rapid_cycle([path], robot)
     program = program_motion(spec, config, start=robot.home)
     assert len(program.plan.moves) == len(direct.segments) == 12
     for seg, move in zip(direct.segments, program.plan.moves, strict=True):
         np.testing.assert_allclose(move.step.q, seg.move.target, atol=1e-5)  # 4 decimals of a degree
         assert move.t0 + program.offset == pytest.approx(seg.t0, abs=1e-3)
         assert move.t_end + program.offset == pytest.approx(seg.t_end, abs=1e-3)
+
+
+def test_simulate_program_runs_a_task_folder_as_the_interpreter_reads_it(tmp_path, program, robot):
+    """A task of two modules (the targets in one, main in the other) runs as the one-module program."""
+    task = tmp_path / "task"
+    task.mkdir()
+    decls = "\n".join(line for line in PROGRAM.splitlines() if "CONST jointtarget" in line)
+    (task / "Data.mod").write_text(f"MODULE Data\n{decls}\nENDMODULE\n")
+    body = "\n".join(line for line in PROGRAM.splitlines()[1:] if "CONST jointtarget" not in line)
+    (task / "Main.mod").write_text(f"MODULE Main\n{body}\n")
+    one = simulate_program(program, tmp_path / "one.csv", robot=robot, plant="sim", seed=2)
+    two = simulate_program(task, tmp_path / "two.csv", robot=robot, plant="sim", seed=2)
+    assert two.n_moves == one.n_moves == 4
+    assert two.log.read_text() == one.log.read_text()

@@ -121,8 +121,9 @@ def simulate(
     program: Path | None = typer.Option(
         None,
         "--program",
-        help="Run this RAPID module's main once (e.g. path.mod of `joulepath optimize`) on the emulated "
-        "controller and the plant, instead of random moves; --out is the log file (.csv).",
+        help="Run this RAPID module's (or task folder's) main once, as the RAPID interpreter reads it (e.g. "
+        "path.mod of `joulepath optimize`), on the emulated controller and the plant, instead of random "
+        "moves; --out is the log file (.csv).",
     ),
     start: str = typer.Option(
         "",

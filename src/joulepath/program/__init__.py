@@ -21,7 +21,13 @@ from joulepath.program._pipeline import (
     ProgramSettings,
     optimize_program,
 )
-from joulepath.program._resolve import CycleSpec, read_cycle_program, read_cycle_toml, resolve_module
+from joulepath.program._resolve import (
+    CycleSpec,
+    read_cycle_program,
+    read_cycle_toml,
+    read_rapid_cycle,
+    resolve_module,
+)
 from joulepath.program._scenario import Scenario, read_scenario, scenario_from_dict
 from joulepath.program._simulate import ProgramMotion, ProgramRun, program_motion, simulate_program
 from joulepath.program._via_levers import ViaLevers, via_levers
@@ -64,6 +70,7 @@ __all__ = [
     "read_cycle_program",
     "read_cycle_toml",
     "read_module",
+    "read_rapid_cycle",
     "read_scenario",
     "resolve_module",
     "scenario_from_dict",

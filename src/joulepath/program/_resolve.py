@@ -660,35 +660,62 @@ def read_cycle_program(
         raise InvalidInput(
             f"{', '.join(map(str, paths))}: a .toml cycle file is a whole program on its own; give it alone"
         )
+    restored = _restored(paths)
+    spec = read_rapid_cycle(
+        [restored] if restored is not None else paths,
+        robot,
+        idle_waits=idle_waits,
+        progress=progress,
+        io=io,
+        routine=routine,
+        seed=seed,
+        given=given,
+    )
+    module, static_note = _static_view(spec, robot, routine, io)
+    if restored is not None:
+        spec = replace(spec, source=f"{path} (the program it was optimized from)")
+    if module is None:
+        return replace(spec, static_note=static_note), True
+    return replace(spec, steps=module[1], module=module[0]), True
+
+
+def read_rapid_cycle(
+    paths: Sequence[Path],
+    robot: Robot,
+    *,
+    idle_waits: Collection[int] = (),
+    progress: Callable[[str], None] | None = None,
+    io: Mapping[str, float | str | bool] | None = None,
+    routine: str | None = None,
+    seed: int = 0,
+    given: Mapping[str, Any] | None = None,
+) -> CycleSpec:
+    """A RAPID task's cycle as the interpreter runs it, as written (a module joulepath wrote included).
+
+    ``paths``: one module, several modules, or a task's folder; the other arguments as for
+    :func:`read_cycle_program`. The steps are the interpreter's trace
+    (:func:`joulepath.program._task.read_task_cycle`); no static view is attached.
+    """
     from joulepath.program._task import read_task_cycle
 
-    restored = _restored(paths)
-    if restored is not None:
-        paths = [restored]
-    tc = read_task_cycle(paths, robot, io=io, routine=routine, seed=seed, progress=progress, given=given)
+    tc = read_task_cycle(
+        list(paths), robot, io=io, routine=routine, seed=seed, progress=progress, given=given
+    )
     steps = _mark_idle(tc, idle_waits)
-    module, static_note = _static_view(tc, steps, robot, routine, io)
-    if module is not None:
-        steps = module[1]
     moves = [st for st in steps if st.kind == "move"]
     assert moves[-1].q is not None
-    source = tc.task.source if restored is None else f"{path} (the program it was optimized from)"
     fixed = tuple(st.line for st in steps if st.kind == "fixed")
-    return (
-        CycleSpec(
-            steps,
-            moves[-1].q.copy(),
-            source,
-            None if module is None else module[0],
-            fixed,
-            robot,
-            tc.trace.notes,
-            kept=tc.kept,
-            task=tc,
-            assumed=tc.trace.assumed,
-            static_note=static_note,
-        ),
-        True,
+    return CycleSpec(
+        steps,
+        moves[-1].q.copy(),
+        tc.task.source,
+        None,
+        fixed,
+        robot,
+        tc.trace.notes,
+        kept=tc.kept,
+        task=tc,
+        assumed=tc.trace.assumed,
     )
 
 
@@ -747,8 +774,7 @@ def _mark_idle(tc: object, idle_waits: Collection[int]) -> tuple[Step, ...]:
 
 
 def _static_view(
-    tc: object,
-    steps: tuple[Step, ...],
+    spec: CycleSpec,
     robot: Robot,
     routine: str | None,
     io: Mapping[str, float | str | bool] | None,
@@ -758,6 +784,7 @@ def _static_view(
     the steps then carry its statements. Else None (the task is written as EGM) and why, in words."""
     from joulepath.program._task import TaskCycle
 
+    tc, steps = spec.task, spec.steps
     assert isinstance(tc, TaskCycle)
     modules = len(tc.task.modules)
     why = (

@@ -26,8 +26,7 @@ from joulepath._io import atomic_write_text, make_folder
 from joulepath._typing import FloatArray
 from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput
-from joulepath.program._parse import read_module
-from joulepath.program._resolve import CycleSpec, resolve_module
+from joulepath.program._resolve import CycleSpec, read_rapid_cycle
 from joulepath.sim import (
     ControllerConfig,
     PlannedCycle,
@@ -128,13 +127,14 @@ def simulate_program(
     instance_seed: int = 120,
     progress: Callable[[str], None] | None = None,
 ) -> ProgramRun:
-    """Run a RAPID module's ``main`` once on the emulated controller and a plant; write the log.
+    """Run a RAPID program's ``main`` once on the emulated controller and a plant; write the log.
 
     Parameters
     ----------
     program : path
-        A RAPID module the reader accepts (:func:`joulepath.program.read_module`), e.g. the
-        ``path.mod`` of ``joulepath optimize`` or the ``optimized.mod`` of ``joulepath cycle``.
+        A RAPID module (or a task's folder) as the RAPID interpreter runs it, e.g. the
+        ``path.mod`` of ``joulepath optimize`` or the ``optimized.mod`` of ``joulepath cycle``
+        (run as written, not as the program it was optimized from).
     out : path
         The controller log (CSV) to write, atomically.
     robot : Robot
@@ -162,7 +162,7 @@ def simulate_program(
     r = robot
     config = config or ControllerConfig()
     q0 = None if start is None else _check_start(r, start)
-    spec = resolve_module(read_module(Path(program)), r, progress=progress)
+    spec = read_rapid_cycle([Path(program)], r, progress=progress)
     motion = program_motion(spec, config, start=q0, progress=progress)
     check_motion_time(motion.plan, spec.source)
     if progress is not None:

@@ -12,6 +12,7 @@ with its reasons in ``Step.kept``.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -201,6 +202,24 @@ def steps_of(
     return tuple(steps), tuple(kept)
 
 
+def _unknowns_read(trace: Trace) -> str:
+    """What the run read without a value, where a cycle came out empty: values declared nowhere and
+    inputs taken as 0 (they may be what skipped its moves), in words; "" where there are none."""
+    values = [
+        a.name
+        for a in trace.assumed
+        if a.role in ("value", "num", "bool") and a.value != "the scenario's value"
+    ]
+    inputs = [m.group(1) for note in trace.notes for m in re.finditer(r"(\w+) is read at run time", note)]
+    names = list(dict.fromkeys([*values, *inputs]))
+    if not names:
+        return ""
+    return (
+        f" with what it reads taken as 0 ({listed(names, 4)}: declared nowhere or read at run time; "
+        "give them with --io NAME=VALUE or the scenario file)"
+    )
+
+
 def read_task_cycle(
     paths: Sequence[str | Path],
     robot: Robot,
@@ -279,7 +298,7 @@ def read_task_cycle(
             if movers
             else "; nothing to optimize"
         )
-        raise RapidError(f"{where}: the cycle ({trace.routine}) holds no move{hint}")
+        raise RapidError(f"{where}: the cycle ({trace.routine}) holds no move{_unknowns_read(trace)}{hint}")
     check_work(
         "moves",
         len(moves),
