@@ -124,3 +124,14 @@ def test_simulate_program_runs_a_task_folder_as_the_interpreter_reads_it(tmp_pat
     two = simulate_program(task, tmp_path / "two.csv", robot=robot, plant="sim", seed=2)
     assert two.n_moves == one.n_moves == 4
     assert two.log.read_text() == one.log.read_text()
+
+
+def test_simulate_program_says_what_it_assumed(tmp_path, program, robot):
+    """A bound declared nowhere is a stand-in (0 taken): the run says so, a line, and runs what is left."""
+    text = PROGRAM.replace(
+        "FOR i FROM 1 TO 2 DO", "MoveAbsJ jB, v1000, fine, tool0;\n        FOR i FROM 1 TO nTimes DO"
+    )
+    (tmp_path / "p.mod").write_text(text)
+    res = simulate_program(tmp_path / "p.mod", tmp_path / "log.csv", robot=robot, plant="sim")
+    assert res.n_moves == 1
+    assert any(line.startswith("assumed: ") and "nTimes" in line for line in res.said), res.said

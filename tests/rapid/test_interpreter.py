@@ -142,8 +142,10 @@ def test_an_input_without_a_value_marks_what_it_decides():
     )
     _, trace = run(body)
     kept = [bool(m.kept) for m in trace.motions]
-    # the branch's move and the move after it (its start depends on the branch); the others known
-    assert kept == [False, True, True, False]
+    # the branch taken is assumed (a note says so) and its move planned; the move after the IF is kept
+    # (its start depends on which branch runs); the others known
+    assert kept == [False, False, True, False]
+    assert any("diBig" in n and "assumed" in n for n in trace.notes)
     assert trace.motions[1].target.get("trans").get("y") == -50.0  # the stand-in: the input reads 0
     assert any("diBig" in n and "ELSE" in n for n in trace.notes)
     _, given = run(body, io={"diBig": 1})

@@ -237,6 +237,8 @@ def _simulate_program(
     q0 = parse_joints(start, option="--start", degrees=degrees, n=r.n_joints) if start else None
     with progress_lines(f"running {program.name} on the emulated controller and the {plant} plant...") as say:
         res = simulate_program(program, out, robot=r, plant=plant, seed=seed, start=q0, progress=say)
+    for line in res.said:
+        console.print(line, markup=False)
     console.print(
         f"wrote {res.log} ({res.n_rows:,} rows: {res.n_moves} moves of {program.name} in "
         f"{res.program_time_s:.2f} s on the {res.plant} plant, {res.plant_note})"

@@ -68,7 +68,8 @@ class ProgramRun:
 
     ``program_time_s`` is the time the controller emulation takes to run ``main`` (from
     the first move's start to the last move's end and dwell); ``duration_s`` the time
-    the log covers (with the rest before and after).
+    the log covers (with the rest before and after); ``said`` what the reading of the program
+    decided or assumed (a name declared nowhere, a branch decided at run time), a line each.
     """
 
     log: Path
@@ -79,6 +80,7 @@ class ProgramRun:
     start_rad: tuple[float, ...]
     plant: str
     plant_note: str
+    said: tuple[str, ...] = ()  # what the reading decided or assumed, a line each
 
 
 def program_motion(
@@ -183,4 +185,9 @@ def simulate_program(
         start_rad=tuple(float(v) for v in motion.plan.start),
         plant=the_plant.name,
         plant_note=the_plant.note,
+        said=(
+            *(f"read: {c}" for c in spec.choices),
+            *(f"assumed: {a.line()}" for a in spec.assumed),
+            *(f"kept as taught (run as written): {move}: {why}" for move, why in spec.kept),
+        ),
     )

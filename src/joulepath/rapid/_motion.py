@@ -20,7 +20,7 @@ from joulepath.rapid import geometry as geo
 from joulepath.rapid import nodes as n
 from joulepath.rapid._machine import CallHandler, Machine
 from joulepath.rapid._state import UNKNOWN_TARGET
-from joulepath.rapid._trace import CLEAN, Motion, Taint
+from joulepath.rapid._trace import CLEAN, Motion, Taint, run_time
 from joulepath.rapid._vocabulary import (
     ABSJ_MOTIONS,
     CIRCULAR_MOTIONS,
@@ -170,9 +170,9 @@ def _check_targets(s: n.Call, kind: str, targets: list[tuple[Record, Taint, str]
 
 def _kept(s: n.Call, key: str, mv: _Move, taint: Taint, circular: bool) -> set[str]:
     """Why the move must stay as taught, but for an unknown target (empty: it is known)."""
-    kept = set(taint | mv.targets[-1][1] | mv.speed_t | mv.zone_t | mv.tool_t | mv.wobj_t)
+    kept = set(run_time(taint | mv.targets[-1][1] | mv.speed_t | mv.zone_t | mv.tool_t | mv.wobj_t))
     if circular:
-        kept |= mv.targets[0][1]
+        kept |= run_time(mv.targets[0][1])
     if key in EGM_MOTIONS:
         kept.add(f"{s.pos}: {s.name}: its path is corrected by a sensor through EGM while it runs")
     elif key in PROCESS_LINEAR or key in PROCESS_CIRCULAR:

@@ -35,7 +35,7 @@ from joulepath.rapid._state import (
     StopRun,
     show,
 )
-from joulepath.rapid._trace import CLEAN, Action, Motion, Taint
+from joulepath.rapid._trace import CLEAN, Action, Motion, Taint, assumed, run_time
 from joulepath.rapid._vocabulary import ALL_MOTIONS
 from joulepath.rapid.values import Array, Record, TypeErrorRapid, describe, equal, num
 
@@ -160,13 +160,16 @@ def late_call(ip: Machine, s: n.LateCall) -> None:
     under(ip, t, lambda: call(ip, late), s)
 
 
+PLANNED_FOR = " (assumed: its moves are planned; give the value in the scenario to plan another)"
+
+
 def exec_if(ip: Machine, s: n.If) -> None:
     taint: Taint = CLEAN
     chosen: tuple[n.Stmt, ...] = s.orelse
     label = "ELSE" if s.orelse else "no branch"
     for k, (cond, body) in enumerate(s.branches):
         v, t = condition(ip, cond)
-        taint |= t
+        taint |= run_time(t)  # a value known under an assumed branch decides as it is
         if v:
             chosen, label = body, "THEN" if k == 0 else f"ELSEIF at line {cond.pos.line}"
             break
@@ -184,7 +187,7 @@ def exec_if(ip: Machine, s: n.If) -> None:
     if taint and ip.leaving:
         chosen, label = _way_out(options, chosen, label)
     if taint and not ip.ctx_taint:
-        ip.note(f"{s.pos}: IF decided at run time: {'; '.join(sorted(taint))} -> {label} taken")
+        ip.note(f"{s.pos}: IF decided at run time: {'; '.join(sorted(taint))} -> {label} taken{PLANNED_FOR}")
     elif (
         not taint
         and not ip.ctx_taint
@@ -200,13 +203,14 @@ def exec_if(ip: Machine, s: n.If) -> None:
 
 def exec_test(ip: Machine, s: n.Test) -> None:
     v, t = ip.ev(s.expr)
+    t = run_time(t)
     v = ip.signal_value(v, s.pos)
     chosen = s.default or ()
     label = "DEFAULT"
     for values, body in s.cases:
         for ve in values:
             cv, ct = ip.ev(ve)
-            t |= ct
+            t |= run_time(ct)
             if equal(v, cv):
                 chosen, label = body, f"CASE {show(cv)} (line {ve.pos.line})"
                 break
@@ -223,7 +227,7 @@ def exec_test(ip: Machine, s: n.Test) -> None:
     if t and ip.leaving:
         chosen, label = _way_out(options, chosen, label)
     if t and not ip.ctx_taint:
-        ip.note(f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken")
+        ip.note(f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken{PLANNED_FOR}")
     elif not t and not ip.ctx_taint and has_motion(ip, (s,), 0) and "assumed" not in label:
         ip.note(f"{s.pos}: TEST {ip.source_of(s.expr.pos)} ({show(v)}) -> {label} branch")
     under(ip, t, lambda: ip.exec_body(chosen), s)
@@ -236,7 +240,7 @@ def exec_for(ip: Machine, s: n.For) -> None:
     a, b, step = ip.as_num(a, s.pos), ip.as_num(b, s.pos), ip.as_num(step, s.pos)
     if step == 0:
         raise RapidError(f"{s.pos}: FOR with STEP 0 never ends; give a step")
-    taint = ta | tb | ts
+    taint = run_time(ta | tb | ts)
     if taint and not ip.ctx_taint:
         ip.note(f"{s.pos}: FOR bounds known only at run time: {'; '.join(sorted(taint))}")
     frame = ip.stack[-1]
@@ -356,6 +360,7 @@ def exec_while(ip: Machine, s: n.While) -> None:
     seen = len(ip.events)
     while True:
         v, t = condition(ip, s.cond)
+        t = run_time(t)
         still = not any(isinstance(e, Motion) for e in ip.events[seen:])  # the last turn moved nothing
         seen = len(ip.events)
         if v and not t and turns >= FIXED_TURNS:
@@ -435,7 +440,7 @@ def under(ip: Machine, taint: Taint, run: Callable[[], None], stmt: n.Stmt | Non
         run()
         return
     saved = ip.ctx_taint
-    ip.ctx_taint = saved | taint
+    ip.ctx_taint = saved | assumed(taint)  # what runs inside is known once this branch is assumed
     try:
         run()
     finally:

@@ -14,6 +14,21 @@ from joulepath.rapid.values import Record, num
 Taint = frozenset[str]
 CLEAN: Taint = frozenset()
 
+ASSUMED_CHOICE = " (the branch taken on it is assumed)"
+"""The end of a reason whose value is known once a branch decided at run time is assumed taken: data
+set inside that branch, and the branch's own moves. The branch is stated (a note); what it runs is
+known under that assumption, so it is planned, not kept as taught."""
+
+
+def assumed(taint: Taint) -> Taint:
+    """``taint`` as what runs inside a branch decided on it (its reasons marked :data:`ASSUMED_CHOICE`)."""
+    return frozenset(r if r.endswith(ASSUMED_CHOICE) else r + ASSUMED_CHOICE for r in taint)
+
+
+def run_time(taint: Taint) -> Taint:
+    """The reasons of ``taint`` that are known only at run time, not under an assumed branch."""
+    return frozenset(r for r in taint if not r.endswith(ASSUMED_CHOICE))
+
 
 class Kinematics(Protocol):
     """What the interpreter asks of the robot (SI, 4x4 transforms of the flange in the base).
