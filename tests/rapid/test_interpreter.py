@@ -153,6 +153,22 @@ def test_an_input_without_a_value_marks_what_it_decides():
     assert given.motions[1].target.get("trans").get("y") == 50.0
 
 
+def test_data_set_in_a_branch_that_moves_nothing_stay_known_only_at_run_time():
+    """A branch decided at run time that moves nothing (a message parsed, a flag set) is not an
+    assumption about the cycle: what it sets decides later branches toward the motion, as at run time."""
+    body = (
+        "    n := GInput(giMsg);\n"
+        "    IF n > 5 THEN\n      k := -1;\n    ELSE\n      k := 7;\n    ENDIF\n"
+        "    MoveJ p10, v1000, z10, tG;\n"
+        "    IF k = 7 THEN\n      MoveJ Offs(p10, 0, 50, 0), v1000, z10, tG;\n    ENDIF\n"
+        "    MoveJ p10, v1000, fine, tG;"
+    )
+    _, trace = run(body, decl="  VAR num n; VAR num k;\n")
+    assert len(trace.motions) == 3  # the later IF is decided toward its move, whichever k the first set
+    # that IF's moving branch is then the one assumed (planned); the move after it starts from either
+    assert [bool(m.kept) for m in trace.motions] == [False, False, True]
+
+
 def test_marks_flow_through_data_and_calls():
     _, trace = run(
         "    n := GInput(giLayer);\n    k := n * 2 + 1;\n    MoveL Offs(p10, 0, 0, k), v100, fine, tG;\n"

@@ -198,7 +198,7 @@ def exec_if(ip: Machine, s: n.If) -> None:
         cond = s.branches[0][0]
         v, _ = condition(ip, cond)
         ip.note(f"{s.pos}: IF {ip.source_of(cond.pos)} ({'TRUE' if v else 'FALSE'}) -> {label} branch")
-    under(ip, taint, lambda: ip.exec_body(chosen), s)
+    under(ip, taint, lambda: ip.exec_body(chosen), s, assume=has_motion(ip, chosen, 0))
 
 
 def exec_test(ip: Machine, s: n.Test) -> None:
@@ -230,7 +230,7 @@ def exec_test(ip: Machine, s: n.Test) -> None:
         ip.note(f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken{PLANNED_FOR}")
     elif not t and not ip.ctx_taint and has_motion(ip, (s,), 0) and "assumed" not in label:
         ip.note(f"{s.pos}: TEST {ip.source_of(s.expr.pos)} ({show(v)}) -> {label} branch")
-    under(ip, t, lambda: ip.exec_body(chosen), s)
+    under(ip, t, lambda: ip.exec_body(chosen), s, assume=has_motion(ip, chosen, 0))
 
 
 def exec_for(ip: Machine, s: n.For) -> None:
@@ -262,7 +262,7 @@ def exec_for(ip: Machine, s: n.For) -> None:
             i += step
 
     try:
-        under(ip, taint, run, s)
+        under(ip, taint, run, s, assume=has_motion(ip, s.body, 0))
     finally:
         if saved is not None:
             frame.locals[key] = saved
@@ -411,7 +411,7 @@ def exec_while(ip: Machine, s: n.While) -> None:
         if t:
             if not ip.ctx_taint:
                 ip.note(f"{s.pos}: WHILE decided at run time: {'; '.join(sorted(t))} -> one turn taken")
-            under(ip, t, lambda: ip.exec_body(s.body), s)
+            under(ip, t, lambda: ip.exec_body(s.body), s, assume=has_motion(ip, s.body, 0))
             return
         turns += 1
         if turns > MAX_LOOP_TURNS:
@@ -433,14 +433,21 @@ def condition(ip: Machine, e: n.Expr) -> tuple[bool, Taint]:
     return v, t
 
 
-def under(ip: Machine, taint: Taint, run: Callable[[], None], stmt: n.Stmt | None = None) -> None:
+def under(
+    ip: Machine, taint: Taint, run: Callable[[], None], stmt: n.Stmt | None = None, *, assume: bool = False
+) -> None:
     """Run ``run`` with ``taint`` added to everything it does (a branch decided at run time); where
-    the statement holds a move (``stmt``), the first move after it starts from a place decided too."""
+    the statement holds a move (``stmt``), the first move after it starts from a place decided too.
+
+    ``assume``: the branch run moves the arm and is the one assumed taken (said): what runs inside it
+    is known under that assumption (:data:`ASSUMED_CHOICE`), so its moves are planned. A branch that
+    moves nothing passes the run-time mark on to the data it sets, so that the decisions they make
+    later are taken toward the motion as any decision at run time."""
     if not taint:
         run()
         return
     saved = ip.ctx_taint
-    ip.ctx_taint = saved | assumed(taint)  # what runs inside is known once this branch is assumed
+    ip.ctx_taint = saved | (assumed(taint) if assume else taint)
     try:
         run()
     finally:
