@@ -12,7 +12,6 @@ are taken into account (targets are TCP poses, the load is carried in the dynami
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -53,7 +52,7 @@ from joulepath.program._parse import (
     WOBJ0,
     parse_module,
 )
-from joulepath.rapid.interpreter import listed
+from joulepath.rapid.interpreter import inputs_read, listed
 from joulepath.sim import SpeedData, Step
 
 
@@ -613,7 +612,7 @@ def check_moves_arm(spec: CycleSpec) -> None:
             f"{names}, {where}); give the module that declares them, or their "
             "values in the scenario file ([targets], [wobj.NAME], [tool.NAME])"
         )
-    inputs = sorted({m.group(1) for c in spec.choices for m in re.finditer(r"(\w+) is read at run time", c)})
+    inputs = sorted(inputs_read(spec.choices))
     hint = (
         f"; it reads inputs taken as 0 ({listed(inputs, 4)}): where they choose its work, give them "
         "with --io NAME=VALUE"

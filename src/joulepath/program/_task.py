@@ -12,7 +12,6 @@ with its reasons in ``Step.kept``.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -25,7 +24,16 @@ from joulepath.dynamics import Robot
 from joulepath.errors import InvalidInput, RapidError
 from joulepath.kinematics import check_layout, confdata, solve_ik
 from joulepath.rapid import geometry as geo
-from joulepath.rapid.interpreter import UNKNOWN_TARGET, Action, Interpreter, Motion, Trace, Wait, listed
+from joulepath.rapid.interpreter import (
+    UNKNOWN_TARGET,
+    Action,
+    Interpreter,
+    Motion,
+    Trace,
+    Wait,
+    inputs_read,
+    listed,
+)
 from joulepath.rapid.interpreter import moves_in as _moves
 from joulepath.rapid.task import Task, load_task
 from joulepath.rapid.values import Record, num, pos_values
@@ -210,8 +218,7 @@ def _unknowns_read(trace: Trace) -> str:
         for a in trace.assumed
         if a.role in ("value", "num", "bool") and a.value != "the scenario's value"
     ]
-    inputs = [m.group(1) for note in trace.notes for m in re.finditer(r"(\w+) is read at run time", note)]
-    names = list(dict.fromkeys([*values, *inputs]))
+    names = list(dict.fromkeys([*values, *inputs_read(trace.notes)]))
     if not names:
         return ""
     return (

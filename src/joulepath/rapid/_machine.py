@@ -12,8 +12,9 @@ in the way of :class:`ast.NodeVisitor`. It has no ``isinstance`` chain over node
 
 from __future__ import annotations
 
+import re
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any, ClassVar
 
 import numpy as np
@@ -65,6 +66,16 @@ CallHandler = Callable[["Machine", n.Call, str], None]
 
 RETRY_TURNS = 2
 """Jumps back to a label before each is compared with the one before (:meth:`Machine._retry_ends`)."""
+
+
+READ_AT_RUN_TIME = "is read at run time"
+"""How a note names an input read with no value (:meth:`Machine.signal_value`): ``NAME is read ...``."""
+
+
+def inputs_read(notes: Iterable[str]) -> list[str]:
+    """The inputs that ``notes`` say were read with no value (taken as 0), each once, in order."""
+    found = (m.group(1) for note in notes for m in re.finditer(rf"(\w+) {READ_AT_RUN_TIME}", note))
+    return list(dict.fromkeys(found))
 
 
 class Machine:
@@ -552,7 +563,7 @@ class Machine:
         kind = sig.kind or signal_kind(sig.name)
         if kind in ("do", "go", "ao"):
             return 0.0, CLEAN  # an output the program has not set: its value at start, 0
-        why = f"{pos}: {sig.name} is read at run time (not in the scenario; 0 assumed)"
+        why = f"{pos}: {sig.name} {READ_AT_RUN_TIME} (not in the scenario; 0 assumed)"
         return 0.0, frozenset({why})
 
     def ref(self, e: n.Expr) -> Cell | Ref:

@@ -186,8 +186,12 @@ def exec_if(ip: Machine, s: n.If) -> None:
         chosen, label = _most_moving(ip, options, "assumed")
     if taint and ip.leaving:
         chosen, label = _way_out(options, chosen, label)
+    moves = has_motion(ip, chosen, 0)
     if taint and not ip.ctx_taint:
-        ip.note(f"{s.pos}: IF decided at run time: {'; '.join(sorted(taint))} -> {label} taken{PLANNED_FOR}")
+        ip.note(
+            f"{s.pos}: IF decided at run time: {'; '.join(sorted(taint))} -> {label} taken"
+            + (PLANNED_FOR if moves else "")
+        )
     elif (
         not taint
         and not ip.ctx_taint
@@ -198,7 +202,7 @@ def exec_if(ip: Machine, s: n.If) -> None:
         cond = s.branches[0][0]
         v, _ = condition(ip, cond)
         ip.note(f"{s.pos}: IF {ip.source_of(cond.pos)} ({'TRUE' if v else 'FALSE'}) -> {label} branch")
-    under(ip, taint, lambda: ip.exec_body(chosen), s, assume=has_motion(ip, chosen, 0))
+    under(ip, taint, lambda: ip.exec_body(chosen), s, assume=moves)
 
 
 def exec_test(ip: Machine, s: n.Test) -> None:
@@ -226,11 +230,15 @@ def exec_test(ip: Machine, s: n.Test) -> None:
         chosen, label = _most_moving(ip, options, "assumed")
     if t and ip.leaving:
         chosen, label = _way_out(options, chosen, label)
+    moves = has_motion(ip, chosen, 0)
     if t and not ip.ctx_taint:
-        ip.note(f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken{PLANNED_FOR}")
+        ip.note(
+            f"{s.pos}: TEST decided at run time: {'; '.join(sorted(t))} -> {label} taken"
+            + (PLANNED_FOR if moves else "")
+        )
     elif not t and not ip.ctx_taint and has_motion(ip, (s,), 0) and "assumed" not in label:
         ip.note(f"{s.pos}: TEST {ip.source_of(s.expr.pos)} ({show(v)}) -> {label} branch")
-    under(ip, t, lambda: ip.exec_body(chosen), s, assume=has_motion(ip, chosen, 0))
+    under(ip, t, lambda: ip.exec_body(chosen), s, assume=moves)
 
 
 def exec_for(ip: Machine, s: n.For) -> None:

@@ -44,7 +44,7 @@ import sys
 from joulepath.errors import RapidError
 from joulepath.rapid import nodes as n
 from joulepath.rapid._expressions import EXPRESSIONS
-from joulepath.rapid._machine import Machine
+from joulepath.rapid._machine import Machine, inputs_read
 from joulepath.rapid._motion import target_flange
 from joulepath.rapid._routines import invoke
 from joulepath.rapid._scan import listed, moves_in
@@ -86,6 +86,7 @@ __all__ = [
     "Taint",
     "Trace",
     "Wait",
+    "inputs_read",
     "listed",
     "moves_in",
     "target_flange",
